@@ -1,0 +1,47 @@
+# Two entry points: `make run` and `make test`. Everything else is plumbing.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+HOST   ?= 127.0.0.1
+PORT   ?= 8080
+CHROMIUM ?= /usr/bin/chromium
+SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+.PHONY: run test install install-test chromium bench report lint clean
+
+$(VENV)/bin/activate:
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --upgrade pip
+
+$(VENV)/.installed: pyproject.toml | $(VENV)/bin/activate
+	$(PY) -m pip install -e .
+	touch $@
+
+$(VENV)/.installed-test: pyproject.toml | $(VENV)/bin/activate
+	$(PY) -m pip install -e '.[test,report]'
+	touch $@ $(VENV)/.installed
+
+install: $(VENV)/.installed
+install-test: $(VENV)/.installed-test
+
+# Debian's Chromium drives the real-browser tests (playwright uses it via executable_path).
+chromium:
+	@if [ -x "$(CHROMIUM)" ]; then echo "chromium: $(CHROMIUM)"; else \
+		echo "installing Debian's chromium"; \
+		$(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y chromium; fi
+
+run: install
+	$(VENV)/bin/poinsot serve --host $(HOST) --port $(PORT)
+
+test: install-test chromium
+	$(PY) -m pytest
+
+bench: install
+	$(PY) -m physics.benchmark
+
+lint: install-test
+	$(PY) -m pip install -q ruff
+	$(VENV)/bin/ruff check physics app tests
+
+clean:
+	rm -rf $(VENV) .pytest_cache build *.egg-info
