@@ -2,4 +2,14 @@
 
 The closed-form elliptic-function solution of Euler's equations and the attitude, for every
 regime, plus the geometry of Poinsot's construction (polhode, herpolhode, invariable plane).
+
+    >>> from physics import FreeRigidBody
+    >>> body = FreeRigidBody(inertia=(1.0, 2.0, 3.0), omega0=(1.0, 0.1, 0.5))
+    >>> body.omega([0.0, 1.0]).shape
+    (2, 3)
 """
+
+from physics.regime import Regime
+from physics.rigid_body import FreeRigidBody, attitude_with_L_along_z, omega_from_energy
+
+__all__ = ["FreeRigidBody", "Regime", "attitude_with_L_along_z", "omega_from_energy"]

@@ -1,0 +1,729 @@
+"""The exact motion of a free rigid body: angular velocity and attitude in closed form.
+
+Solve once, evaluate many: :class:`FreeRigidBody` classifies the motion from the initial state
+(:class:`~physics.regime.Regime`), precomputes the constants of the closed form, and then
+evaluates ω(t) and the attitude R(t) on whole arrays of times with no integration and no drift.
+
+Frames and conventions (see ``shared/PHYSICS.md``):
+
+* *Body frame*: the caller's principal axes, in the caller's order. Internally the moments
+  are sorted with a *proper* relabelling (a signed permutation with det +1) and, for the
+  minor-axis family, relabelled once more so that the axis the polhode circles (the *pole*)
+  is always the third one. All results are mapped back.
+* *Space frame*: the caller's, fixed by ``attitude0`` (``R(0)``). Internally a space frame with
+  ``e_z ∥ L`` carries Z-X-Z Euler angles ``R = Rz(φ) Rx(θ) Rz(ψ)`` with
+  ``m/G = (sinθ sinψ, sinθ cosψ, cosθ)`` (Landau 37.13-37.14).
+* Attitude ``R(t)`` maps body coordinates to space coordinates; quaternions are scipy's
+  scalar-last ``(x, y, z, w)``.
+* Units are the caller's: ω in rad per time unit, moments in any consistent unit.
+
+To stay finite for any scale (ω0 ~ 1e-200, moments ~ 1e100), the constants are computed in
+units where the largest moment and the largest |ω0| component are powers of two near 1. Powers
+of two scale floating-point numbers exactly, so the classification (``Δ2 == 0``) is the same
+as in the caller's units.
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from physics import elliptic
+from physics.regime import Regime
+
+__all__ = ["FreeRigidBody", "omega_from_energy", "attitude_with_L_along_z"]
+
+_HALF_PI = 0.5 * math.pi
+
+
+# ---------------------------------------------------------------------------------------------
+# Input checks: clear messages for students, raised before anything is computed.
+# ---------------------------------------------------------------------------------------------
+
+
+def _vector3(value, name: str) -> np.ndarray:
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be three real numbers, got {value!r}") from exc
+    if arr.shape != (3,):
+        raise ValueError(f"{name} must be three numbers (shape (3,)), got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+    return arr
+
+
+def _check_inertia(value) -> np.ndarray:
+    inertia = _vector3(value, "the moments of inertia")
+    if np.any(inertia <= 0.0):
+        raise ValueError(
+            f"the moments of inertia must be positive, got {inertia.tolist()} "
+            "(a principal moment is a sum of m·r², never zero or negative)"
+        )
+    return inertia
+
+
+def _check_times(t) -> tuple[np.ndarray, bool]:
+    """Return the times as a 1-D float array and whether the caller passed a scalar."""
+    try:
+        arr = np.asarray(t, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"time must be a number or a 1-D array of numbers, got {t!r}") from exc
+    if arr.ndim > 1:
+        raise ValueError(f"time must be a number or a 1-D array, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError("time must be finite (got NaN or infinity)")
+    return arr.reshape(-1), arr.ndim == 0
+
+
+def _pow2(x: float) -> float:
+    """The power of two nearest below ``x > 0`` (scaling by it is exact)."""
+    return math.ldexp(1.0, math.frexp(x)[1] - 1)
+
+
+# ---------------------------------------------------------------------------------------------
+# Proper relabellings of the body axes (signed permutations with det +1).
+# ---------------------------------------------------------------------------------------------
+
+
+class _AxisMap:
+    """``x_internal = C @ x_user`` for a signed permutation ``C`` with det +1.
+
+    Stored as ``index`` and ``sign`` so that ``x_internal[k] = sign[k] * x_user[index[k]]``.
+    """
+
+    def __init__(self, index: np.ndarray, sign: np.ndarray):
+        self.index = np.asarray(index, dtype=int)
+        self.sign = np.asarray(sign, dtype=float)
+        self.matrix = np.zeros((3, 3))
+        self.matrix[np.arange(3), self.index] = self.sign
+        assert round(np.linalg.det(self.matrix)) == 1
+        # Quaternion of the user->internal map, used on the right of the internal attitude.
+        self.quat = Rotation.from_matrix(self.matrix).as_quat()
+
+    def to_internal(self, x: np.ndarray) -> np.ndarray:
+        return self.sign * x[..., self.index]
+
+    def to_user_columns(self, cols: tuple[np.ndarray, ...]) -> np.ndarray:
+        """Stack internal components ``cols[k]`` (each (N,)) into user-order (N, 3)."""
+        out = np.empty((cols[0].shape[0], 3))
+        for k in range(3):
+            out[:, self.index[k]] = self.sign[k] * cols[k]
+        return out
+
+    def compose(self, other: _AxisMap) -> _AxisMap:
+        """The map ``other ∘ self`` (apply self first)."""
+        return _AxisMap(self.index[other.index], other.sign * self.sign[other.index])
+
+
+def _sorting_map(inertia: np.ndarray) -> _AxisMap:
+    """Proper relabelling that sorts the moments ascending (flip one sign if the permutation is odd)."""
+    order = np.argsort(inertia, kind="stable")
+    parity = round(np.linalg.det(np.eye(3)[order]))
+    sign = np.array([parity, 1.0, 1.0])  # an odd permutation gets axis 1 reversed
+    return _AxisMap(order, sign)
+
+
+# Reverse the sorted axes, pole = smallest moment becomes axis 3: x'' = (x3, x2, -x1).
+_REVERSE = _AxisMap(np.array([2, 1, 0]), np.array([1.0, 1.0, -1.0]))
+
+
+# ---------------------------------------------------------------------------------------------
+# Quaternion helpers (scalar-last, vectorised over leading axes).
+# ---------------------------------------------------------------------------------------------
+
+
+def _qmul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Hamilton product ``p ⊗ q`` of scalar-last quaternions (broadcasting (..., 4))."""
+    px, py, pz, pw = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
+    qx, qy, qz, qw = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return np.stack(
+        [
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+            pw * qw - px * qx - py * qy - pz * qz,
+        ],
+        axis=-1,
+    )
+
+
+def _axis_angle_quat(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Quaternions (N, 4) of rotations by ``angle`` (N,) about the unit ``axis`` (3,)."""
+    half = 0.5 * angle
+    s = np.sin(half)
+    return np.stack([axis[0] * s, axis[1] * s, axis[2] * s, np.cos(half)], axis=-1)
+
+
+def _zxz_from_momentum(
+    m1: np.ndarray, m2: np.ndarray, m3: np.ndarray, G: float, phi: np.ndarray
+) -> np.ndarray:
+    """Quaternion of ``Rz(φ) Rx(θ) Rz(ψ)`` with θ, ψ read off ``m/G`` (Landau 37.13-37.14).
+
+    ``cos θ = m3/G``, ``sin θ = ρ/G`` with ``ρ = hypot(m1, m2)``, ``ψ = atan2(m1, m2)``. The
+    half-angle of θ is taken from whichever of ``G ± m3`` has no cancellation
+    (``G - m3 = ρ²/(G + m3)``), so it is accurate at both poles.
+    """
+    rho = np.hypot(m1, m2)
+    psi = np.arctan2(m1, m2)
+    # cos(θ/2) = sqrt((G + m3)/2G), sin(θ/2) = ρ / (2G cos(θ/2)); swap roles when m3 < 0.
+    upper = m3 >= 0.0
+    big = np.sqrt(0.5 * (G + np.abs(m3)) / G)
+    small = rho / (2.0 * G * big)
+    cos_half = np.where(upper, big, small)
+    sin_half = np.where(upper, small, big)
+    sum_half = 0.5 * (phi + psi)
+    dif_half = 0.5 * (phi - psi)
+    return np.stack(
+        [
+            sin_half * np.cos(dif_half),
+            sin_half * np.sin(dif_half),
+            cos_half * np.sin(sum_half),
+            cos_half * np.cos(sum_half),
+        ],
+        axis=-1,
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# The three closed forms. Each works in its internal frame and dimensionless time τ = t·ω_ref.
+# ---------------------------------------------------------------------------------------------
+
+
+class _Elliptic:
+    """Major- or minor-axis family, in the pole frame (pole = axis 3), Landau 37.10.
+
+    ``ω = (A1 cn u, A2 sn u, s A3 dn u)`` with ``u = u0 + σ τ``, ``σ = s λ`` in the major
+    family. In the minor family the pole frame has its moments in decreasing order, which turns
+    the sign of every right-hand side of Euler's equations, so ``σ = -s λ``.
+    """
+
+    def __init__(self, J: np.ndarray, w: np.ndarray, delta: tuple[float, float, float]):
+        J1, J2, J3 = (float(x) for x in J)
+        d1, d2, d3 = delta
+        self.J = J
+        # Amplitudes and frequency (Landau 37.10, written with Δi = G² - 2T Ii so that each
+        # ratio is a quotient of same-signed quantities in both families).
+        self.A = np.array(
+            [
+                math.sqrt(d3 / (J1 - J3) / J1),
+                math.sqrt(d3 / (J2 - J3) / J2),
+                math.sqrt(d1 / (J3 - J1) / J3),
+            ]
+        )
+        lam = math.sqrt((J3 - J2) / J1 * (d1 / J2) / J3)
+        # m and 1 - m, each from its own product: no subtraction near the separatrix.
+        m = (J1 - J2) / (J3 - J2) * (d3 / d1)
+        mc = (J3 - J1) / (J3 - J2) * (d2 / d1)
+        m, mc = min(max(m, 0.0), 1.0), min(max(mc, 0.0), 1.0)
+        self.par = elliptic.JacobiParameter.from_pair(m, mc)
+        self.s = 1.0 if w[2] > 0.0 else -1.0
+        direction = 1.0 if J3 > J1 else -1.0
+        self.lam = lam
+        self.sigma = direction * self.s * lam
+        K = self.par.K
+        # Initial phase u0 = F(φ0 | m), φ0 = atan2(sn0, cn0) (Landau after 37.10).
+        sn0, cn0 = w[1] / self.A[1], w[0] / self.A[0]
+        self.u0 = elliptic.ellipf_from_angle(sn0, cn0, m, mc)
+        # Precession rate (Landau 37.16): φ' = G/J3 + c / (1 - N sn²u), N < 0, c = G(J3-J1)/(J1 J3).
+        m_body = J * w
+        self.G = float(np.linalg.norm(m_body))
+        self.N = -J3 / J1 * ((J2 - J1) / (J3 - J2))
+        self.c = self.G * ((J3 - J1) / J1 / J3)
+        # Π(N; am u) = (Πc/K) u + P(u) with P 2K-periodic: the secular part joins G/J3 in the
+        # mean precession rate, the periodic part is evaluated on the reduced argument.
+        pi_complete = elliptic.ellippi_complete(self.N, m, mc)
+        self.pi_slope = pi_complete / K
+        self.nu = self.G / J3 + self.c * self.pi_slope
+        self.period = 4.0 * K / lam
+        self.P0 = self._periodic_pi(np.array([self.u0]))[0]
+
+    def _reduced(self, tau: np.ndarray):
+        u = self.u0 + self.sigma * tau
+        r, j = elliptic.reduce_argument(u, self.par.K)
+        sn, cn, dn = elliptic.sncndn_reduced(r, self.par)
+        sign = 1.0 - 2.0 * np.mod(j, 2.0)
+        return r, sign, sn, cn, dn
+
+    def _periodic_pi(self, u: np.ndarray) -> np.ndarray:
+        r, _ = elliptic.reduce_argument(u, self.par.K)
+        sn, cn, dn = elliptic.sncndn_reduced(r, self.par)
+        return elliptic.ellippi_from_jacobi(self.N, sn, cn, dn) - self.pi_slope * r
+
+    def omega(self, tau: np.ndarray) -> tuple[np.ndarray, ...]:
+        _, sign, sn, cn, dn = self._reduced(tau)
+        A1, A2, A3 = self.A
+        return (A1 * sign * cn, A2 * sign * sn, (self.s * A3) * dn)
+
+    def quat(self, tau: np.ndarray) -> tuple[tuple[np.ndarray, ...], np.ndarray]:
+        r, sign, sn, cn, dn = self._reduced(tau)
+        A1, A2, A3 = self.A
+        w = (A1 * sign * cn, A2 * sign * sn, (self.s * A3) * dn)
+        J1, J2, J3 = self.J
+        P = elliptic.ellippi_from_jacobi(self.N, sn, cn, dn) - self.pi_slope * r
+        phi = self.nu * tau + (self.c / self.sigma) * (P - self.P0)
+        return w, _zxz_from_momentum(J1 * w[0], J2 * w[1], J3 * w[2], self.G, phi)
+
+    def polhode(self, n: int) -> tuple[np.ndarray, ...]:
+        # Uniform in the amplitude φ = am u: sn = sin φ, cn = cos φ, dn² = cos²φ + mc sin²φ.
+        ang = np.linspace(0.0, 2.0 * math.pi, n, endpoint=False)
+        s, c = np.sin(ang), np.cos(ang)
+        dn = np.sqrt(c * c + self.par.mc * s * s)
+        A1, A2, A3 = self.A
+        return (A1 * c, A2 * s, (self.s * A3) * dn)
+
+
+class _Separatrix:
+    """The limiting polhode, ``Δ2 = 0`` exactly (seed 000 eq. 7.79, Landau §37 problem 2).
+
+    ``ω = (s1 A1 sech u, A2 tanh u, s3 A3 sech u)``, ``u = u0 + s1 s3 λ τ``; with m = 1 the
+    precession integral is elementary: ``∫ du / (1 - N tanh²u) = (u + a atan(a tanh u))/(1 - N)``
+    with ``a = sqrt(-N)``.
+    """
+
+    def __init__(self, J: np.ndarray, w: np.ndarray, delta: tuple[float, float, float]):
+        J1, J2, J3 = (float(x) for x in J)
+        d1, _, d3 = delta
+        self.J = J
+        self.A = np.array(
+            [
+                math.sqrt(d3 / (J1 - J3) / J1),
+                math.sqrt(d3 / (J2 - J3) / J2),
+                math.sqrt(d1 / (J3 - J1) / J3),
+            ]
+        )
+        lam = math.sqrt((J3 - J2) / J1 * (d1 / J2) / J3)
+        self.s1 = 1.0 if w[0] > 0.0 else -1.0
+        self.s3 = 1.0 if w[2] > 0.0 else -1.0
+        self.lam = lam
+        self.sigma = self.s1 * self.s3 * lam
+        # tanh u0 = ω2/A2 and sech u0 = |ω1|/A1, so sinh u0 = (ω2/A2) / (|ω1|/A1).
+        self.u0 = math.asinh((w[1] / self.A[1]) / (abs(w[0]) / self.A[0]))
+        self.G = float(np.linalg.norm(J * w))
+        N = -J3 / J1 * ((J2 - J1) / (J3 - J2))
+        self.a = math.sqrt(-N)
+        c = self.G * ((J3 - J1) / J1 / J3)
+        self.nu = self.G / J3 + c / (1.0 - N)
+        self.amp = c * self.a / (self.sigma * (1.0 - N))
+        self.period = math.inf
+        self.atan0 = math.atan(self.a * math.tanh(self.u0))
+
+    def omega(self, tau: np.ndarray) -> tuple[np.ndarray, ...]:
+        th, sech = elliptic.tanh_sech(self.u0 + self.sigma * tau)
+        A1, A2, A3 = self.A
+        return ((self.s1 * A1) * sech, A2 * th, (self.s3 * A3) * sech)
+
+    def quat(self, tau: np.ndarray) -> tuple[tuple[np.ndarray, ...], np.ndarray]:
+        th, sech = elliptic.tanh_sech(self.u0 + self.sigma * tau)
+        A1, A2, A3 = self.A
+        w = ((self.s1 * A1) * sech, A2 * th, (self.s3 * A3) * sech)
+        phi = self.nu * tau + self.amp * (np.arctan(self.a * th) - self.atan0)
+        J1, J2, J3 = self.J
+        return w, _zxz_from_momentum(J1 * w[0], J2 * w[1], J3 * w[2], self.G, phi)
+
+    def polhode(self, n: int) -> tuple[np.ndarray, ...]:
+        # The heteroclinic arc from -e2 to +e2: with φ = gd(u), tanh u = sin φ, sech u = cos φ.
+        ang = np.linspace(-_HALF_PI, _HALF_PI, n)
+        c, s = np.cos(ang), np.sin(ang)
+        A1, A2, A3 = self.A
+        return ((self.s1 * A1) * c, A2 * s, (self.s3 * A3) * c)
+
+
+class _Circular:
+    """Uniform motions: symmetric body, sphere, permanent rotation, rest (seed 003).
+
+    The body precesses about L at ``p = G/I`` and spins about its symmetry axis ``e`` at
+    ``s = ((I - J)/I) ω_e`` relative to the precessing frame, so in the internal frame (which
+    here is the sorted body frame, with space = the caller's space)
+    ``R(t) = Rot(L̂, p t) · R(0) · Rot(e, s t)`` and ``ω(t) = Rot(e, -s t) ω0``. A permanent
+    rotation or a rest is the case ``I = J`` along the axis of ω.
+    """
+
+    def __init__(self, w: np.ndarray, axis: np.ndarray, I_t: float, J_a: float, inertia: np.ndarray):
+        self.w0 = w
+        self.axis = axis
+        self.m0 = inertia * w
+        self.G = float(np.linalg.norm(self.m0))
+        w_axial = float(w @ axis)
+        self.p = self.G / I_t
+        self.spin = (I_t - J_a) / I_t * w_axial
+        w_perp = w - w_axial * axis
+        moving = self.spin != 0.0 and np.any(w_perp != 0.0)
+        self.period = 2.0 * math.pi / abs(self.spin) if moving else math.inf
+        self.nu = self.p
+
+    def omega_rotated(self, angle: np.ndarray) -> tuple[np.ndarray, ...]:
+        # Rodrigues with a unit axis e: v cos a + (e × v) sin a + e (e·v)(1 - cos a).
+        e, v = self.axis, self.w0
+        c, s = np.cos(angle), np.sin(angle)
+        ev = float(e @ v)
+        exv = np.cross(e, v)
+        return tuple(v[k] * c + exv[k] * s + e[k] * ev * (1.0 - c) for k in range(3))
+
+    def omega(self, tau: np.ndarray) -> tuple[np.ndarray, ...]:
+        if self.spin == 0.0:
+            return tuple(np.full(tau.shape, self.w0[k]) for k in range(3))
+        return self.omega_rotated(-self.spin * tau)
+
+    def polhode(self, n: int) -> tuple[np.ndarray, ...]:
+        if self.period == math.inf:
+            return tuple(np.full(n, self.w0[k]) for k in range(3))
+        return self.omega_rotated(np.linspace(0.0, 2.0 * math.pi, n, endpoint=False))
+
+
+# ---------------------------------------------------------------------------------------------
+# The public object.
+# ---------------------------------------------------------------------------------------------
+
+
+class FreeRigidBody:
+    """Exact torque-free motion of a rigid body from its principal moments and initial ω.
+
+    Args:
+        inertia: (3,) principal moments ``(I1, I2, I3)``, positive and finite, in any order;
+            they name the caller's body axes and every result uses the same axes.
+        omega0: (3,) body-frame angular velocity at ``t = 0`` [rad per time unit].
+        attitude0: attitude at ``t = 0`` as a single :class:`scipy.spatial.transform.Rotation`
+            (body -> space); ``None`` means the identity (space axes = body axes at t = 0).
+
+    Raises:
+        ValueError: moments not positive or not finite, ω0 not finite, wrong shapes, or an
+            ``attitude0`` that is not a single rotation.
+
+    The constructor classifies the motion (:attr:`regime`) and precomputes the constants;
+    :meth:`omega` and :meth:`attitude` then cost O(1) per time, for any time, with no drift.
+    The moments need not obey the triangle inequality ``I1 + I2 >= I3``: the mathematics holds
+    for any positive moments, only real mass distributions must obey it.
+    """
+
+    def __init__(self, inertia, omega0, attitude0: Rotation | None = None):
+        self.inertia = _check_inertia(inertia)
+        self.omega0 = _vector3(omega0, "the initial angular velocity omega0")
+        if attitude0 is None:
+            attitude0 = Rotation.identity()
+        if not isinstance(attitude0, Rotation) or not attitude0.single:
+            raise ValueError("attitude0 must be one scipy Rotation (body -> space) or None")
+        self.attitude0 = attitude0
+
+        # Exact power-of-two scaling: moments and ω near 1 whatever the caller's units.
+        self._I_ref = _pow2(float(self.inertia.max()))
+        w_max = float(np.abs(self.omega0).max())
+        self._w_ref = _pow2(w_max) if w_max > 0.0 else 1.0
+        inertia_s = self.inertia / self._I_ref
+        omega_s = self.omega0 / self._w_ref
+
+        sort = _sorting_map(self.inertia)
+        J = sort.to_internal(inertia_s) * sort.sign  # moments are not signed
+        w = sort.to_internal(omega_s)
+        self._classify_and_build(sort, J, w, inertia_s, omega_s)
+
+        # Invariants in the caller's units (they may overflow only if the physical values do).
+        m_user = self.inertia * self.omega0
+        self.angular_momentum = self.attitude0.apply(m_user)
+        self.energy = 0.5 * float(self.omega0 @ m_user)
+        G = float(np.linalg.norm(self.angular_momentum))
+        self._G = G
+        if self.regime is Regime.REST:
+            self.D = 0.0
+            self.plane_distance = 0.0
+            self.plane_normal = np.array([0.0, 0.0, 1.0])
+        else:
+            self.D = self._scaled_D * self._I_ref
+            self.plane_distance = self._scaled_h * self._w_ref
+            self.plane_normal = self.angular_momentum / G
+
+    # -- construction ---------------------------------------------------------------------
+
+    def _classify_and_build(self, sort, J, w, inertia_s, omega_s) -> None:
+        J1, J2, J3 = J
+        m = J * w
+        G2 = float(m @ m)
+        two_T = float(w @ m)
+        self._scaled_D = G2 / two_T if two_T > 0 else 0.0
+        self._scaled_h = two_T / math.sqrt(G2) if G2 > 0 else 0.0
+        self._frame = sort
+        self._solver: _Elliptic | _Separatrix | _Circular
+        self.parameter = 0.0
+        self.complementary_parameter = 1.0
+        self.frequency = 0.0
+
+        zero = w == 0.0
+        if zero.all():
+            regime = Regime.REST
+            axis = np.array([0.0, 0.0, 1.0])
+            circ = _Circular(omega_s, axis, 1.0, 1.0, inertia_s)
+        elif J1 == J3:
+            regime = Regime.SPHERE
+            circ = _Circular(omega_s, np.array([0.0, 0.0, 1.0]), float(J1), float(J1), inertia_s)
+        else:
+            circ = self._circular_or_none(sort, J, w, zero, inertia_s, omega_s)
+            regime = None if circ is None else circ[0]
+            circ = None if circ is None else circ[1]
+        if circ is not None:
+            self.regime = regime
+            self._solver = circ
+            self._frame = None  # _Circular works in the caller's own body frame
+            self._q_space = self.attitude0.as_quat()
+            self.period = circ.period / self._w_ref
+            self._finish_precession(circ.nu)
+            return
+
+        # Triaxial and not a permanent rotation: Δi = G² - 2T·Ii, exactly rounded (below).
+        delta = _deltas(J, w)
+        if delta[1] == 0.0:
+            self.regime = Regime.SEPARATRIX
+            solver = _Separatrix(J, w, delta)
+            self.parameter, self.complementary_parameter = 1.0, 0.0
+        else:
+            if delta[1] > 0.0:
+                self.regime = Regime.MAJOR_AXIS
+                pole = sort
+                Jp, wp, dp = J, w, delta
+            else:
+                self.regime = Regime.MINOR_AXIS
+                pole = sort.compose(_REVERSE)
+                Jp, wp = _REVERSE.to_internal(J) * _REVERSE.sign, _REVERSE.to_internal(w)
+                dp = (delta[2], delta[1], delta[0])
+            solver = _Elliptic(Jp, wp, dp)
+            self._frame = pole
+            self.parameter = solver.par.m
+            self.complementary_parameter = solver.par.mc
+        self._solver = solver
+        self.frequency = solver.lam * self._w_ref
+        self.period = solver.period / self._w_ref
+        self._finish_precession(solver.nu)
+        # R_user(t) = S · R_int(t) · C with S fixed so that R_user(0) = attitude0.
+        _, q0 = solver.quat(np.zeros(1))
+        r_int0 = Rotation.from_quat(q0[0])
+        frame_rot = Rotation.from_quat(self._frame.quat)
+        self._q_space = (self.attitude0 * frame_rot.inv() * r_int0.inv()).as_quat()
+
+    def _circular_or_none(self, sort, J, w, zero, inertia_s, omega_s):
+        """Permanent rotations and symmetric bodies: (regime, _Circular), else None."""
+        J1, J2, J3 = J
+        e_user = [sort.matrix[k] for k in range(3)]  # internal axis k in user coordinates
+        if zero.sum() == 2:  # along one principal axis of a triaxial body
+            k = int(np.flatnonzero(~zero)[0])
+            return Regime.PERMANENT_ROTATION, _Circular(
+                omega_s, e_user[k], float(J[k]), float(J[k]), inertia_s
+            )
+        if J1 == J2 or J2 == J3:
+            a = 2 if J1 == J2 else 0  # the distinct (symmetry) axis
+            I_t = float(J[1])
+            transverse = [k for k in range(3) if k != a]
+            if zero[a] or (zero[transverse[0]] and zero[transverse[1]]):
+                regime = Regime.PERMANENT_ROTATION
+            else:
+                regime = Regime.SYMMETRIC
+            return regime, _Circular(omega_s, e_user[a], I_t, float(J[a]), inertia_s)
+        return None
+
+    def _finish_precession(self, nu_scaled: float) -> None:
+        self.mean_precession_rate = nu_scaled * self._w_ref
+        if math.isfinite(self.period):
+            self.precession_per_period = self.mean_precession_rate * self.period
+            self.second_period = (
+                2.0 * math.pi / self.mean_precession_rate
+                if self.mean_precession_rate != 0.0
+                else math.inf
+            )
+        else:
+            self.precession_per_period = 0.0
+            self.second_period = math.inf
+
+    # -- evaluation -----------------------------------------------------------------------
+
+    def _omega_user(self, tau: np.ndarray) -> np.ndarray:
+        cols = self._solver.omega(tau)
+        if self._frame is None:
+            return np.stack(cols, axis=-1) * self._w_ref
+        return self._frame.to_user_columns(cols) * self._w_ref
+
+    def omega(self, t):
+        """Body-frame angular velocity ω(t) in the caller's axes [rad per time unit].
+
+        Args:
+            t: time, a float or a (N,) array.
+
+        Returns:
+            (3,) for a scalar ``t``, (N, 3) for an array.
+        """
+        tt, scalar = _check_times(t)
+        out = self._omega_user(tt * self._w_ref)
+        return out[0] if scalar else out
+
+    def _quat_user(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(ω (N,3) in user axes and caller units, attitude quaternions (N, 4) scalar-last)."""
+        solver = self._solver
+        if isinstance(solver, _Circular):
+            q = _axis_angle_quat(self.plane_normal_internal(), solver.p * tau)
+            q = _qmul(q, self._q_space)
+            if solver.spin != 0.0:
+                q = _qmul(q, _axis_angle_quat(solver.axis, solver.spin * tau))
+            return self._omega_user(tau), q
+        cols, q_int = solver.quat(tau)
+        q = _qmul(self._q_space, _qmul(q_int, self._frame.quat))
+        return self._frame.to_user_columns(cols) * self._w_ref, q
+
+    def plane_normal_internal(self) -> np.ndarray:
+        # _Circular rotates about L in the caller's space frame.
+        return self.plane_normal
+
+    def attitude(self, t) -> Rotation:
+        """Attitude R(t), body -> space, as a scipy Rotation (single, or a stack of N).
+
+        ``attitude(0)`` equals ``attitude0`` to rounding.
+        """
+        tt, scalar = _check_times(t)
+        _, q = self._quat_user(tt * self._w_ref)
+        rot = Rotation.from_quat(q)
+        return rot[0] if scalar else rot
+
+    def state(self, t) -> tuple[np.ndarray, Rotation]:
+        """ω(t) and R(t) together (cheaper than two calls): ((N,3) or (3,), Rotation)."""
+        tt, scalar = _check_times(t)
+        w, q = self._quat_user(tt * self._w_ref)
+        rot = Rotation.from_quat(q)
+        return (w[0], rot[0]) if scalar else (w, rot)
+
+    def contact_point(self, t) -> np.ndarray:
+        """The tip of ω in space, ``R(t) ω(t)`` (the herpolhode): (3,) or (N, 3).
+
+        It lies on the invariable plane ``x·L = 2T``, where the energy ellipsoid touches it.
+        """
+        tt, scalar = _check_times(t)
+        w, q = self._quat_user(tt * self._w_ref)
+        out = Rotation.from_quat(q).apply(w)
+        return out[0] if scalar else out
+
+    herpolhode = contact_point
+
+    def polhode(self, n: int = 256) -> np.ndarray:
+        """The polhode: the closed curve ω traces in the body frame (caller's axes), (n, 3).
+
+        Points are spaced uniformly in the amplitude (not in time, which would crowd them near
+        the separatrix); the curve closes from the last point back to the first. On the
+        separatrix it is the arc between the two intermediate-axis poles, endpoints included;
+        for a constant ω it is that one point repeated.
+        """
+        if int(n) < 2:
+            raise ValueError(f"the polhode needs at least 2 points, got n={n}")
+        cols = self._solver.polhode(int(n))
+        if self._frame is None:
+            return np.stack(cols, axis=-1) * self._w_ref
+        return self._frame.to_user_columns(cols) * self._w_ref
+
+    @property
+    def semi_axes(self) -> np.ndarray:
+        """(3,) semi-axes ``sqrt(2T/Ii)`` of the energy ellipsoid ``x·I·x = 2T`` (caller order)."""
+        return np.sqrt(2.0 * self.energy / self.inertia)
+
+    def __repr__(self) -> str:
+        return (
+            f"FreeRigidBody(inertia={self.inertia.tolist()}, omega0={self.omega0.tolist()}, "
+            f"regime={self.regime.value!r})"
+        )
+
+
+def _deltas(J: np.ndarray, w: np.ndarray) -> tuple[float, float, float]:
+    """``Δi = G² - 2T·Ii = Σ_j Ij ωj² (Ij - Ii)``, each correctly rounded.
+
+    Δ2 is the small difference that decides the regime and gives ``1 - m``; near the separatrix
+    its two terms cancel, so it is summed exactly in rational arithmetic (three scalars, once
+    per body) and rounded once. Δ1 and Δ3 are sums of same-signed terms; they get the same
+    treatment for uniformity.
+    """
+    Jf = [Fraction(float(x)) for x in J]
+    wf = [Fraction(float(x)) for x in w]
+    out = []
+    for i in range(3):
+        total = sum(Jf[j] * wf[j] * wf[j] * (Jf[j] - Jf[i]) for j in range(3) if j != i)
+        out.append(float(total))
+    return out[0], out[1], out[2]
+
+
+# ---------------------------------------------------------------------------------------------
+# Initial states for the scene.
+# ---------------------------------------------------------------------------------------------
+
+
+def omega_from_energy(inertia, D: float, omega_norm: float = 1.0, pole_sign: float = 1.0) -> np.ndarray:
+    """An initial ω with ``|L|²/2T = D``, on the plane ``ω2 = 0`` of the sorted axes.
+
+    Args:
+        inertia: (3,) positive moments in the caller's order.
+        D: the energy parameter ``|L|²/2T`` in ``[min I, max I]`` (same units as the moments).
+        omega_norm: the length of the returned ω [rad per time unit], > 0.
+        pole_sign: +1 or -1, which of the two polhodes with this D (the sign of the component
+            on the axis the polhode circles: the largest-moment axis when ``D > I2``, the
+            smallest-moment axis otherwise).
+
+    Returns:
+        (3,) ω0 in the caller's axes.
+
+    With ``m2 = 0`` the momentum sphere ``|m| = G`` and the ellipsoid ``Σ mi²/Ii = G²/D`` meet
+    where ``m1² = G² I1 (I3 - D)/(D (I3 - I1))`` and ``m3² = G² I3 (D - I1)/(D (I3 - I1))``
+    (sorted axes). ``D = I1`` or ``I3`` is the pure spin about that axis; ``D = I2`` lands on
+    the separatrix up to rounding.
+
+    Raises:
+        ValueError: if D lies outside ``[min I, max I]``, or omega_norm is not positive.
+    """
+    inertia = _check_inertia(inertia)
+    D = float(D)
+    if not math.isfinite(D):
+        raise ValueError(f"D must be a finite number, got {D}")
+    if not (math.isfinite(omega_norm) and omega_norm > 0.0):
+        raise ValueError(f"|omega0| must be positive and finite, got {omega_norm}")
+    lo, hi = float(inertia.min()), float(inertia.max())
+    if not (lo <= D <= hi):
+        raise ValueError(
+            f"D = |L|²/2T must lie between the smallest and largest moments [{lo:g}, {hi:g}], got {D:g}"
+        )
+    sort = _sorting_map(inertia)
+    J1, J2, J3 = np.sort(inertia)
+    sign = 1.0 if pole_sign >= 0 else -1.0
+    if J1 == J3:
+        m = np.array([0.0, 0.0, 1.0])
+    else:
+        m1 = math.sqrt(max(J1 * (J3 - D) / (D * (J3 - J1)), 0.0))
+        m3 = math.sqrt(max(J3 * (D - J1) / (D * (J3 - J1)), 0.0))
+        if D > J2 or (D == J2 and m3 > 0):
+            m = np.array([m1, 0.0, sign * m3])
+        else:
+            m = np.array([sign * m1, 0.0, m3])
+    w_sorted = m / np.array([J1, J2, J3])
+    w_sorted *= omega_norm / np.linalg.norm(w_sorted)
+    # Back to the caller's axes: x_user[index[k]] = sign[k] * x_internal[k].
+    out = np.empty(3)
+    out[sort.index] = sort.sign * w_sorted
+    return out
+
+
+def attitude_with_L_along_z(inertia, omega0) -> Rotation:
+    """An attitude ``R0`` (body -> space) with ``R0 · I ω0`` along +z: L vertical in the scene.
+
+    Args:
+        inertia: (3,) positive moments (caller's axes). omega0: (3,) body-frame ω.
+
+    Returns:
+        A single Rotation; the identity for a body at rest.
+    """
+    inertia = _check_inertia(inertia)
+    omega0 = _vector3(omega0, "omega0")
+    m = inertia * omega0
+    G = float(np.linalg.norm(m))
+    if G == 0.0:
+        return Rotation.identity()
+    # Smallest rotation taking m̂ to e_z (the roll about L is irrelevant to the scene).
+    mhat = m / G
+    z = np.array([0.0, 0.0, 1.0])
+    axis = np.cross(mhat, z)
+    s = float(np.linalg.norm(axis))
+    c = float(mhat @ z)
+    if s < 1e-300:
+        return Rotation.identity() if c > 0 else Rotation.from_rotvec([math.pi, 0.0, 0.0])
+    return Rotation.from_rotvec(axis / s * math.atan2(s, c))
