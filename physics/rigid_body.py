@@ -25,6 +25,7 @@ as in the caller's units.
 
 from __future__ import annotations
 
+import functools
 import math
 from fractions import Fraction
 
@@ -93,14 +94,16 @@ class _AxisMap:
     """``x_internal = C @ x_user`` for a signed permutation ``C`` with det +1.
 
     Stored as ``index`` and ``sign`` so that ``x_internal[k] = sign[k] * x_user[index[k]]``.
+    There are only 24 of them, so each is built once (:func:`_axis_map`).
     """
 
-    def __init__(self, index: np.ndarray, sign: np.ndarray):
+    def __init__(self, index: tuple[int, ...], sign: tuple[float, ...]):
         self.index = np.asarray(index, dtype=int)
         self.sign = np.asarray(sign, dtype=float)
         self.matrix = np.zeros((3, 3))
         self.matrix[np.arange(3), self.index] = self.sign
-        assert round(np.linalg.det(self.matrix)) == 1
+        if round(np.linalg.det(self.matrix)) != 1:
+            raise AssertionError("an axis relabelling must be a proper rotation")
         # Quaternion of the user->internal map, used on the right of the internal attitude.
         self.quat = Rotation.from_matrix(self.matrix).as_quat()
 
@@ -116,19 +119,27 @@ class _AxisMap:
 
     def compose(self, other: _AxisMap) -> _AxisMap:
         """The map ``other ∘ self`` (apply self first)."""
-        return _AxisMap(self.index[other.index], other.sign * self.sign[other.index])
+        return _axis_map(
+            tuple(int(i) for i in self.index[other.index]),
+            tuple(float(x) for x in other.sign * self.sign[other.index]),
+        )
+
+
+@functools.lru_cache(maxsize=None)
+def _axis_map(index: tuple[int, ...], sign: tuple[float, ...]) -> _AxisMap:
+    return _AxisMap(index, sign)
 
 
 def _sorting_map(inertia: np.ndarray) -> _AxisMap:
     """Proper relabelling that sorts the moments ascending (flip one sign if the permutation is odd)."""
-    order = np.argsort(inertia, kind="stable")
-    parity = round(np.linalg.det(np.eye(3)[order]))
-    sign = np.array([parity, 1.0, 1.0])  # an odd permutation gets axis 1 reversed
-    return _AxisMap(order, sign)
+    order = tuple(int(i) for i in np.argsort(inertia, kind="stable"))
+    inversions = sum(order[i] > order[j] for i in range(3) for j in range(i + 1, 3))
+    parity = -1.0 if inversions % 2 else 1.0  # an odd permutation gets axis 1 reversed
+    return _axis_map(order, (parity, 1.0, 1.0))
 
 
 # Reverse the sorted axes, pole = smallest moment becomes axis 3: x'' = (x3, x2, -x1).
-_REVERSE = _AxisMap(np.array([2, 1, 0]), np.array([1.0, 1.0, -1.0]))
+_REVERSE = _axis_map((2, 1, 0), (1.0, 1.0, -1.0))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -497,9 +508,8 @@ class FreeRigidBody:
         self._finish_precession(solver.nu)
         # R_user(t) = S · R_int(t) · C with S fixed so that R_user(0) = attitude0.
         _, q0 = solver.quat(np.zeros(1))
-        r_int0 = Rotation.from_quat(q0[0])
-        frame_rot = Rotation.from_quat(self._frame.quat)
-        self._q_space = (self.attitude0 * frame_rot.inv() * r_int0.inv()).as_quat()
+        conj = np.array([-1.0, -1.0, -1.0, 1.0])
+        self._q_space = _qmul(_qmul(self.attitude0.as_quat(), self._frame.quat * conj), q0[0] * conj)
 
     def _circular_or_none(self, sort, J, w, zero, inertia_s, omega_s):
         """Permanent rotations and symmetric bodies: (regime, _Circular), else None."""
@@ -629,20 +639,20 @@ class FreeRigidBody:
 
 
 def _deltas(J: np.ndarray, w: np.ndarray) -> tuple[float, float, float]:
-    """``Δi = G² - 2T·Ii = Σ_j Ij ωj² (Ij - Ii)``, each correctly rounded.
+    """``Δi = G² - 2T·Ii = Σ_j Ij ωj² (Ij - Ii)`` (sorted axes, PHYSICS.md "Cancellation").
 
-    Δ2 is the small difference that decides the regime and gives ``1 - m``; near the separatrix
-    its two terms cancel, so it is summed exactly in rational arithmetic (three scalars, once
-    per body) and rounded once. Δ1 and Δ3 are sums of same-signed terms; they get the same
-    treatment for uniformity.
+    Δ1 and Δ3 are sums of same-signed terms, accurate in floating point. Δ2 is the small
+    difference that decides the regime and gives ``1 - m``; near the separatrix its two terms
+    cancel, so it is summed exactly in rational arithmetic (two products, once per body) and
+    rounded once: the classification ``Δ2 == 0`` and ``mc`` are then those of the exact data.
     """
-    Jf = [Fraction(float(x)) for x in J]
-    wf = [Fraction(float(x)) for x in w]
-    out = []
-    for i in range(3):
-        total = sum(Jf[j] * wf[j] * wf[j] * (Jf[j] - Jf[i]) for j in range(3) if j != i)
-        out.append(float(total))
-    return out[0], out[1], out[2]
+    J1, J2, J3 = (float(x) for x in J)
+    w1, w2, w3 = (float(x) for x in w)
+    d1 = J2 * w2 * w2 * (J2 - J1) + J3 * w3 * w3 * (J3 - J1)
+    d3 = J1 * w1 * w1 * (J1 - J3) + J2 * w2 * w2 * (J2 - J3)
+    F = Fraction
+    d2 = float(F(J1) * F(w1) ** 2 * (F(J1) - F(J2)) + F(J3) * F(w3) ** 2 * (F(J3) - F(J2)))
+    return d1, d2, d3
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1,0 +1,91 @@
+"""Speed of the closed form against bare ``scipy.special.ellipj``: ``python -m physics.benchmark``.
+
+Prints, for 10⁶ times measured in this one run (so the ratios are meaningful on a noisy
+machine), the nanoseconds per point of ``omega(t)`` and ``attitude(t)`` next to bare
+``ellipj`` on the same arguments, and the construction cost of a ``FreeRigidBody``.
+Targets (issue 2): omega ≤ 1.5× ellipj, attitude ≤ 4× ellipj.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+from scipy import special
+
+from physics.rigid_body import FreeRigidBody
+
+# Cases timed: (label, inertia, omega0). Bare ellipj is run on the very same (u, m).
+CASES = (
+    ("generic (1,2,3)", (1.0, 2.0, 3.0), (1.0, 0.1, 0.5)),
+    ("near separatrix 1-m~1e-10", (2.0, 3.0, 6.0), (3.0, 0.25, 1.0 + 2e-11)),
+    ("extreme (1,10,1000)", (1.0, 10.0, 1000.0), (1.0, 0.1, 0.5)),
+)
+
+
+def _best(fn, repeat: int) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def run(n: int = 1_000_000, repeat: int = 5) -> list[dict]:
+    """Time the cases; returns one dict of figures per case (ns per point, ratios, µs)."""
+    rows = []
+    for label, inertia, omega0 in CASES:
+        body = FreeRigidBody(inertia, omega0)
+        t = np.linspace(0.0, 100.0 * body.period, n)
+        solver = body._solver
+        u = solver.u0 + solver.sigma * t * body._w_ref
+        m = body.parameter
+        t_ellipj = _best(lambda: special.ellipj(u, m), repeat)  # noqa: B023
+        t_omega = _best(lambda: body.omega(t), repeat)  # noqa: B023
+        t_att = _best(lambda: body.attitude(t), repeat)  # noqa: B023
+        n_build = 2000
+        t0 = time.perf_counter()
+        for _ in range(n_build):
+            FreeRigidBody(inertia, omega0)
+        t_build = (time.perf_counter() - t0) / n_build
+        rows.append(
+            {
+                "case": label,
+                "regime": body.regime.value,
+                "ellipj_ns": t_ellipj / n * 1e9,
+                "omega_ns": t_omega / n * 1e9,
+                "attitude_ns": t_att / n * 1e9,
+                "omega_ratio": t_omega / t_ellipj,
+                "attitude_ratio": t_att / t_ellipj,
+                "construct_us": t_build * 1e6,
+            }
+        )
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m physics.benchmark", description=__doc__)
+    parser.add_argument("-n", type=int, default=1_000_000, help="times per evaluation")
+    parser.add_argument("--repeat", type=int, default=5, help="best of this many runs")
+    args = parser.parse_args(argv)
+    rows = run(args.n, args.repeat)
+    print(f"FreeRigidBody speed, {args.n:,} times per call, best of {args.repeat}")
+    header = (
+        f"{'case':28s} {'ellipj':>9s} {'omega':>9s} {'ratio':>6s} "
+        f"{'attitude':>9s} {'ratio':>6s} {'build':>9s}"
+    )
+    print(header)
+    print("-" * len(header))
+    for r in rows:
+        print(
+            f"{r['case']:28s} {r['ellipj_ns']:7.1f}ns {r['omega_ns']:7.1f}ns {r['omega_ratio']:5.2f}x "
+            f"{r['attitude_ns']:7.1f}ns {r['attitude_ratio']:5.2f}x {r['construct_us']:7.1f}us"
+        )
+    print("targets: omega <= 1.5x ellipj, attitude <= 4x ellipj")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
