@@ -84,6 +84,10 @@ def main(argv: list[str] | None = None) -> int:
             f"{r['attitude_ns']:7.1f}ns {r['attitude_ratio']:5.2f}x {r['construct_us']:7.1f}us"
         )
     print("targets: omega <= 1.5x ellipj, attitude <= 4x ellipj")
+    print(
+        "note: for 1-m < 1e-9 bare ellipj takes a first-order tanh/sech shortcut that is wrong\n"
+        "      for u beyond ~1 (PHYSICS.md), so that row's ratio compares against a wrong answer."
+    )
     return 0
 
 

@@ -38,6 +38,8 @@ from physics.regime import Regime
 __all__ = ["FreeRigidBody", "omega_from_energy", "attitude_with_L_along_z"]
 
 _HALF_PI = 0.5 * math.pi
+# Times evaluated per block (see FreeRigidBody._quat_user): ~20 temporaries of 128 KiB fit in L2.
+_BLOCK = 16384
 
 
 # ---------------------------------------------------------------------------------------------
@@ -250,7 +252,9 @@ class _Elliptic:
         self.pi_slope = pi_complete / K
         self.nu = self.G / J3 + self.c * self.pi_slope
         self.period = 4.0 * K / lam
+        self.phase_scale = self.c / self.sigma
         self.P0 = self._periodic_pi(np.array([self.u0]))[0]
+        self.sine_series = _sine_series(lambda u: self.phase_scale * self._periodic_pi(u), K)
 
     def _reduced(self, tau: np.ndarray):
         u = self.u0 + self.sigma * tau
@@ -274,9 +278,23 @@ class _Elliptic:
         A1, A2, A3 = self.A
         w = (A1 * sign * cn, A2 * sign * sn, (self.s * A3) * dn)
         J1, J2, J3 = self.J
-        P = elliptic.ellippi_from_jacobi(self.N, sn, cn, dn) - self.pi_slope * r
-        phi = self.nu * tau + (self.c / self.sigma) * (P - self.P0)
+        phi = self.nu * tau + self.precession_wobble(r, sn, cn, dn)
         return w, _zxz_from_momentum(J1 * w[0], J2 * w[1], J3 * w[2], self.G, phi)
+
+    def precession_wobble(self, r, sn, cn, dn) -> np.ndarray:
+        """The periodic part of φ: ``(c/σ) (P(u) - P(u0))`` at the reduced argument ``r``.
+
+        ``P`` is analytic and 2K-periodic, so away from the separatrix its sine series
+        converges geometrically (the nome q decays the coefficients) and a few terms summed
+        by Clenshaw's recurrence reproduce Carlson's ``R_F``/``R_J`` evaluation to rounding at
+        a fraction of the cost. Where more terms would be needed (1 - m small), ``Π`` is
+        evaluated directly per point.
+        """
+        if self.sine_series is None:
+            P = elliptic.ellippi_from_jacobi(self.N, sn, cn, dn) - self.pi_slope * r
+            return self.phase_scale * (P - self.P0)
+        theta = r * (math.pi / self.par.K)
+        return _clenshaw_sine(self.sine_series, theta) - self.phase_scale * self.P0
 
     def polhode(self, n: int) -> tuple[np.ndarray, ...]:
         # Uniform in the amplitude φ = am u: sn = sin φ, cn = cos φ, dn² = cos²φ + mc sin²φ.
@@ -285,6 +303,47 @@ class _Elliptic:
         dn = np.sqrt(c * c + self.par.mc * s * s)
         A1, A2, A3 = self.A
         return (A1 * c, A2 * s, (self.s * A3) * dn)
+
+
+# A periodic wobble of φ is represented by its sine series when this many terms or fewer reach
+# the rounding floor of its samples (|b_k| <= _SERIES_TOL_EPS · eps · max|f|: below that the FFT
+# coefficients are noise); _SERIES_SAMPLES >= 12 × the terms kept leaves aliasing negligible.
+_SERIES_MAX_TERMS = 40
+_SERIES_SAMPLES = 512
+_SERIES_TOL_EPS = 4.0
+
+
+def _sine_series(f, K: float) -> np.ndarray | None:
+    """Sine coefficients ``b_1..b_n`` of an odd 2K-periodic ``f(u) = Σ b_k sin(kπu/K)``.
+
+    Returns None when more than ``_SERIES_MAX_TERMS`` terms stand above the rounding floor (or
+    the samples show ``f`` is not odd to rounding), so the caller evaluates ``f`` directly.
+    """
+    theta = 2.0 * math.pi * np.arange(_SERIES_SAMPLES) / _SERIES_SAMPLES
+    values = f(theta * (K / math.pi))
+    spectrum = np.fft.rfft(values)
+    b = -2.0 * spectrum.imag / _SERIES_SAMPLES
+    scale = float(np.abs(values).max())
+    tol = _SERIES_TOL_EPS * np.finfo(float).eps * scale
+    if np.abs(spectrum.real).max() / _SERIES_SAMPLES > 100.0 * tol:
+        return None  # not odd to rounding: evaluate directly
+    big = np.flatnonzero(np.abs(b[1:]) > tol)
+    n = int(big[-1]) + 1 if big.size else 0
+    if n > _SERIES_MAX_TERMS:
+        return None
+    return b[1 : n + 1].copy()
+
+
+def _clenshaw_sine(b: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """``Σ_k b_k sin(k θ)`` by Clenshaw's recurrence (k = 1..len(b))."""
+    if b.size == 0:
+        return np.zeros_like(theta)
+    two_cos = 2.0 * np.cos(theta)
+    y1 = np.full_like(theta, b[-1])
+    y2 = np.zeros_like(theta)
+    for bk in b[-2::-1]:
+        y1, y2 = bk + two_cos * y1 - y2, y1
+    return y1 * np.sin(theta)
 
 
 class _Separatrix:
@@ -547,6 +606,11 @@ class FreeRigidBody:
     # -- evaluation -----------------------------------------------------------------------
 
     def _omega_user(self, tau: np.ndarray) -> np.ndarray:
+        if tau.shape[0] > _BLOCK:  # cache-sized blocks, as in _quat_user
+            out = np.empty((tau.shape[0], 3))
+            for start in range(0, tau.shape[0], _BLOCK):
+                out[start : start + _BLOCK] = self._omega_user(tau[start : start + _BLOCK])
+            return out
         cols = self._solver.omega(tau)
         if self._frame is None:
             return np.stack(cols, axis=-1) * self._w_ref
@@ -566,7 +630,21 @@ class FreeRigidBody:
         return out[0] if scalar else out
 
     def _quat_user(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(ω (N,3) in user axes and caller units, attitude quaternions (N, 4) scalar-last)."""
+        """(ω (N,3) in user axes and caller units, attitude quaternions (N, 4) scalar-last).
+
+        Long arrays are processed in blocks of ``_BLOCK`` times: every temporary then stays in
+        the CPU cache, which makes the element-wise numpy work ~2x faster than on whole arrays.
+        """
+        if tau.shape[0] <= _BLOCK:
+            return self._quat_block(tau)
+        w = np.empty((tau.shape[0], 3))
+        q = np.empty((tau.shape[0], 4))
+        for start in range(0, tau.shape[0], _BLOCK):
+            block = slice(start, start + _BLOCK)
+            w[block], q[block] = self._quat_block(tau[block])
+        return w, q
+
+    def _quat_block(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         solver = self._solver
         if isinstance(solver, _Circular):
             q = _axis_angle_quat(self.plane_normal_internal(), solver.p * tau)
