@@ -25,14 +25,16 @@ as in the caller's units.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
+from decimal import localcontext
 from fractions import Fraction
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from physics import elliptic
+from physics import elliptic, precise
 from physics.regime import Regime
 
 __all__ = ["FreeRigidBody", "omega_from_energy", "attitude_with_L_along_z"]
@@ -214,9 +216,11 @@ class _Elliptic:
     the sign of every right-hand side of Euler's equations, so ``σ = -s λ``.
     """
 
-    def __init__(self, J: np.ndarray, w: np.ndarray, delta: tuple[float, float, float]):
+    def __init__(self, J: np.ndarray, w: np.ndarray, delta: tuple[Fraction, Fraction, Fraction]):
         J1, J2, J3 = (float(x) for x in J)
-        d1, d2, d3 = delta
+        F1, F2, F3 = (Fraction(x) for x in (J1, J2, J3))
+        e1, e2, e3 = delta  # exact
+        d1, d3 = float(e1), float(e3)
         self.J = J
         # Amplitudes and frequency (Landau 37.10, written with Δi = G² - 2T Ii so that each
         # ratio is a quotient of same-signed quantities in both families).
@@ -227,38 +231,56 @@ class _Elliptic:
                 math.sqrt(d1 / (J3 - J1) / J3),
             ]
         )
-        lam = math.sqrt((J3 - J2) / J1 * (d1 / J2) / J3)
-        # m and 1 - m, each from its own product: no subtraction near the separatrix.
-        m = (J1 - J2) / (J3 - J2) * (d3 / d1)
-        mc = (J3 - J1) / (J3 - J2) * (d2 / d1)
-        m, mc = min(max(m, 0.0), 1.0), min(max(mc, 0.0), 1.0)
-        self.par = elliptic.JacobiParameter.from_pair(m, mc)
+        # λ, m, 1 - m, K and the mean precession rate ν from the exact rationals of the data,
+        # at 45 digits: m and mc correctly rounded (no subtraction near the separatrix), λ, K
+        # and ν as double-double pairs so that the phases u = u0 + σ τ (mod 2K) and ν τ
+        # (mod 2π) stay exact to the rounding of τ itself over long runs (physics.precise).
+        lam2 = (F3 - F2) * e1 / (F1 * F2 * F3)
+        m_exact = (F1 - F2) * e3 / ((F3 - F2) * e1)
+        mc_exact = (F3 - F1) * e2 / ((F3 - F2) * e1)
+        N_exact = -F3 * (F2 - F1) / (F1 * (F3 - F2))
+        wf = [Fraction(float(x)) for x in w]
+        G2 = sum((Fk * wk) ** 2 for Fk, wk in zip((F1, F2, F3), wf, strict=True))
+        m, mc = float(m_exact), float(mc_exact)
+        with localcontext() as ctx:
+            ctx.prec = precise.DIGITS
+            K_dec = elliptic.ellipk_decimal(mc_exact)
+            pi_dec = elliptic.ellippi_complete_decimal(N_exact, mc_exact)
+            G_dec = precise.decimal(G2).sqrt()
+            c_dec = G_dec * precise.decimal((F3 - F1) / (F1 * F3))
+            nu_dec = G_dec / precise.decimal(F3) + c_dec * pi_dec / K_dec
+            lam, lam_lo = precise.double_double(precise.decimal(lam2).sqrt())
+            K_hi, K_lo = precise.double_double(K_dec)
+            nu = precise.double_double(nu_dec)
+            pi_complete = float(pi_dec)
+        self.par = dataclasses.replace(elliptic.JacobiParameter.from_pair(m, mc), K=K_hi)
         self.s = 1.0 if w[2] > 0.0 else -1.0
         direction = 1.0 if J3 > J1 else -1.0
         self.lam = lam
         self.sigma = direction * self.s * lam
-        K = self.par.K
+        K = K_hi
         # Initial phase u0 = F(φ0 | m), φ0 = atan2(sn0, cn0) (Landau after 37.10).
         sn0, cn0 = w[1] / self.A[1], w[0] / self.A[0]
         self.u0 = elliptic.ellipf_from_angle(sn0, cn0, m, mc)
-        # Precession rate (Landau 37.16): φ' = G/J3 + c / (1 - N sn²u), N < 0, c = G(J3-J1)/(J1 J3).
-        m_body = J * w
-        self.G = float(np.linalg.norm(m_body))
-        self.N = -J3 / J1 * ((J2 - J1) / (J3 - J2))
-        self.c = self.G * ((J3 - J1) / J1 / J3)
+        self.phase = precise.LinearPhase(
+            self.u0, self.sigma, direction * self.s * lam_lo, 2.0 * K_hi, 2.0 * K_lo
+        )
+        # Precession (Landau 37.16): φ' = G/J3 + c / (1 - N sn²u), N < 0, c = G(J3-J1)/(J1 J3).
         # Π(N; am u) = (Πc/K) u + P(u) with P 2K-periodic: the secular part joins G/J3 in the
-        # mean precession rate, the periodic part is evaluated on the reduced argument.
-        pi_complete = elliptic.ellippi_complete(self.N, m, mc)
+        # mean rate ν, the periodic part is evaluated on the reduced argument.
+        self.G = math.sqrt(float(G2))
+        self.N = float(N_exact)
+        self.c = self.G * ((J3 - J1) / J1 / J3)
         self.pi_slope = pi_complete / K
-        self.nu = self.G / J3 + self.c * self.pi_slope
+        self.nu = nu[0]
+        self.precession = precise.angle_phase(nu)
         self.period = 4.0 * K / lam
         self.phase_scale = self.c / self.sigma
         self.P0 = self._periodic_pi(np.array([self.u0]))[0]
         self.sine_series = _sine_series(lambda u: self.phase_scale * self._periodic_pi(u), K)
 
     def _reduced(self, tau: np.ndarray):
-        u = self.u0 + self.sigma * tau
-        r, j = elliptic.reduce_argument(u, self.par.K)
+        r, j = self.phase.reduce(tau)
         sn, cn, dn = elliptic.sncndn_reduced(r, self.par)
         sign = 1.0 - 2.0 * np.mod(j, 2.0)
         return r, sign, sn, cn, dn
@@ -278,7 +300,7 @@ class _Elliptic:
         A1, A2, A3 = self.A
         w = (A1 * sign * cn, A2 * sign * sn, (self.s * A3) * dn)
         J1, J2, J3 = self.J
-        phi = self.nu * tau + self.precession_wobble(r, sn, cn, dn)
+        phi = self.precession.reduce(tau)[0] + self.precession_wobble(r, sn, cn, dn)
         return w, _zxz_from_momentum(J1 * w[0], J2 * w[1], J3 * w[2], self.G, phi)
 
     def precession_wobble(self, r, sn, cn, dn) -> np.ndarray:
@@ -356,7 +378,7 @@ class _Separatrix:
 
     def __init__(self, J: np.ndarray, w: np.ndarray, delta: tuple[float, float, float]):
         J1, J2, J3 = (float(x) for x in J)
-        d1, _, d3 = delta
+        d1, d3 = float(delta[0]), float(delta[2])
         self.J = J
         self.A = np.array(
             [
@@ -376,7 +398,19 @@ class _Separatrix:
         N = -J3 / J1 * ((J2 - J1) / (J3 - J2))
         self.a = math.sqrt(-N)
         c = self.G * ((J3 - J1) / J1 / J3)
-        self.nu = self.G / J3 + c / (1.0 - N)
+        # The mean rate ν = G/J3 + c/(1 - N) to double-double, as in _Elliptic.
+        F1, F2, F3 = (Fraction(float(x)) for x in J)
+        G2 = sum((Fk * Fraction(float(wk))) ** 2 for Fk, wk in zip((F1, F2, F3), w, strict=True))
+        with localcontext() as ctx:
+            ctx.prec = precise.DIGITS
+            G_dec = precise.decimal(G2).sqrt()
+            N_dec = precise.decimal(-F3 * (F2 - F1) / (F1 * (F3 - F2)))
+            nu_dec = G_dec / precise.decimal(F3) + G_dec * precise.decimal(
+                (F3 - F1) / (F1 * F3)
+            ) / (1 - N_dec)
+            nu = precise.double_double(nu_dec)
+        self.nu = nu[0]
+        self.precession = precise.angle_phase(nu)
         self.amp = c * self.a / (self.sigma * (1.0 - N))
         self.period = math.inf
         self.atan0 = math.atan(self.a * math.tanh(self.u0))
@@ -390,7 +424,7 @@ class _Separatrix:
         th, sech = elliptic.tanh_sech(self.u0 + self.sigma * tau)
         A1, A2, A3 = self.A
         w = ((self.s1 * A1) * sech, A2 * th, (self.s3 * A3) * sech)
-        phi = self.nu * tau + self.amp * (np.arctan(self.a * th) - self.atan0)
+        phi = self.precession.reduce(tau)[0] + self.amp * (np.arctan(self.a * th) - self.atan0)
         J1, J2, J3 = self.J
         return w, _zxz_from_momentum(J1 * w[0], J2 * w[1], J3 * w[2], self.G, phi)
 
@@ -418,8 +452,17 @@ class _Circular:
         self.m0 = inertia * w
         self.G = float(np.linalg.norm(self.m0))
         w_axial = float(w @ axis)
-        self.p = self.G / I_t
-        self.spin = (I_t - J_a) / I_t * w_axial
+        # The two rates to double-double from the exact data, so that the angles p τ and s τ
+        # (reduced mod 2π) stay exact over long runs (physics.precise).
+        G2 = sum((Fraction(float(i)) * Fraction(float(x))) ** 2 for i, x in zip(inertia, w, strict=True))
+        It, Ja = Fraction(I_t), Fraction(J_a)
+        with localcontext() as ctx:
+            ctx.prec = precise.DIGITS
+            p = precise.double_double(precise.decimal(G2).sqrt() / precise.decimal(It))
+            spin = precise.double_double(precise.decimal((It - Ja) / It * Fraction(w_axial)))
+        self.p, self.spin = p[0], spin[0]
+        self.precession = precise.angle_phase(p)
+        self.spinning = precise.angle_phase(spin)
         w_perp = w - w_axial * axis
         moving = self.spin != 0.0 and np.any(w_perp != 0.0)
         self.period = 2.0 * math.pi / abs(self.spin) if moving else math.inf
@@ -436,7 +479,7 @@ class _Circular:
     def omega(self, tau: np.ndarray) -> tuple[np.ndarray, ...]:
         if self.spin == 0.0:
             return tuple(np.full(tau.shape, self.w0[k]) for k in range(3))
-        return self.omega_rotated(-self.spin * tau)
+        return self.omega_rotated(-self.spinning.reduce(tau)[0])
 
     def polhode(self, n: int) -> tuple[np.ndarray, ...]:
         if self.period == math.inf:
@@ -647,18 +690,14 @@ class FreeRigidBody:
     def _quat_block(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         solver = self._solver
         if isinstance(solver, _Circular):
-            q = _axis_angle_quat(self.plane_normal_internal(), solver.p * tau)
+            q = _axis_angle_quat(self.plane_normal, solver.precession.reduce(tau)[0])
             q = _qmul(q, self._q_space)
             if solver.spin != 0.0:
-                q = _qmul(q, _axis_angle_quat(solver.axis, solver.spin * tau))
+                q = _qmul(q, _axis_angle_quat(solver.axis, solver.spinning.reduce(tau)[0]))
             return self._omega_user(tau), q
         cols, q_int = solver.quat(tau)
         q = _qmul(self._q_space, _qmul(q_int, self._frame.quat))
         return self._frame.to_user_columns(cols) * self._w_ref, q
-
-    def plane_normal_internal(self) -> np.ndarray:
-        # _Circular rotates about L in the caller's space frame.
-        return self.plane_normal
 
     def attitude(self, t) -> Rotation:
         """Attitude R(t), body -> space, as a scipy Rotation (single, or a stack of N).
@@ -716,21 +755,22 @@ class FreeRigidBody:
         )
 
 
-def _deltas(J: np.ndarray, w: np.ndarray) -> tuple[float, float, float]:
-    """``Δi = G² - 2T·Ii = Σ_j Ij ωj² (Ij - Ii)`` (sorted axes, PHYSICS.md "Cancellation").
+def _deltas(J: np.ndarray, w: np.ndarray) -> tuple[Fraction, Fraction, Fraction]:
+    """``Δi = G² - 2T·Ii = Σ_j Ij ωj² (Ij - Ii)`` (sorted axes, PHYSICS.md "Cancellation"), exactly.
 
-    Δ1 and Δ3 are sums of same-signed terms, accurate in floating point. Δ2 is the small
-    difference that decides the regime and gives ``1 - m``; near the separatrix its two terms
-    cancel, so it is summed exactly in rational arithmetic (two products, once per body) and
-    rounded once: the classification ``Δ2 == 0`` and ``mc`` are then those of the exact data.
+    Δ2 is the small difference that decides the regime and gives ``1 - m``; near the separatrix
+    its two terms cancel. Summed in rational arithmetic (a few scalars, once per body), the
+    classification ``Δ2 == 0`` and every constant derived from the Δs are those of the exact
+    data, rounded once.
     """
-    J1, J2, J3 = (float(x) for x in J)
-    w1, w2, w3 = (float(x) for x in w)
-    d1 = J2 * w2 * w2 * (J2 - J1) + J3 * w3 * w3 * (J3 - J1)
-    d3 = J1 * w1 * w1 * (J1 - J3) + J2 * w2 * w2 * (J2 - J3)
-    F = Fraction
-    d2 = float(F(J1) * F(w1) ** 2 * (F(J1) - F(J2)) + F(J3) * F(w3) ** 2 * (F(J3) - F(J2)))
-    return d1, d2, d3
+    Jf = [Fraction(float(x)) for x in J]
+    wf = [Fraction(float(x)) for x in w]
+    sq = [Jf[j] * wf[j] * wf[j] for j in range(3)]
+    return (
+        sq[1] * (Jf[1] - Jf[0]) + sq[2] * (Jf[2] - Jf[0]),
+        sq[0] * (Jf[0] - Jf[1]) + sq[2] * (Jf[2] - Jf[1]),
+        sq[0] * (Jf[0] - Jf[2]) + sq[1] * (Jf[1] - Jf[2]),
+    )
 
 
 # ---------------------------------------------------------------------------------------------

@@ -6,7 +6,7 @@ import pathlib
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 ALLOWED = {"numpy", "scipy", "math", "enum", "dataclasses", "typing", "__future__",
            "functools", "time", "argparse", "sys", "collections", "warnings",
-           "fractions", "dataclasses"}
+           "fractions", "dataclasses", "decimal"}
 
 
 def _top_level_imports(path: pathlib.Path) -> set[str]:
