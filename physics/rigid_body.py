@@ -533,12 +533,13 @@ class FreeRigidBody:
         w = sort.to_internal(omega_s)
         self._classify_and_build(sort, J, w, inertia_s, omega_s)
 
-        # Invariants in the caller's units (they may overflow only if the physical values do).
-        m_user = self.inertia * self.omega0
-        self.angular_momentum = self.attitude0.apply(m_user)
-        self.energy = 0.5 * float(self.omega0 @ m_user)
-        G = float(np.linalg.norm(self.angular_momentum))
-        self._G = G
+        # Invariants: computed in the scaled units, then scaled back by exact powers of two, so
+        # they over/underflow only where the physical value itself is out of double range.
+        L_scaled = self.attitude0.apply(inertia_s * omega_s)
+        two_T_scaled = float(omega_s @ (inertia_s * omega_s))
+        G_scaled = float(np.linalg.norm(L_scaled))
+        self.angular_momentum = L_scaled * self._I_ref * self._w_ref
+        self.energy = 0.5 * two_T_scaled * self._I_ref * self._w_ref * self._w_ref
         if self.regime is Regime.REST:
             self.D = 0.0
             self.plane_distance = 0.0
@@ -546,7 +547,7 @@ class FreeRigidBody:
         else:
             self.D = self._scaled_D * self._I_ref
             self.plane_distance = self._scaled_h * self._w_ref
-            self.plane_normal = self.angular_momentum / G
+            self.plane_normal = L_scaled / G_scaled
 
     # -- construction ---------------------------------------------------------------------
 
