@@ -609,6 +609,10 @@ class FreeRigidBody:
         self.frequency = solver.lam * self._w_ref
         self.period = solver.period / self._w_ref
         self._finish_precession(solver.nu)
+        # Anchor ω at t = 0: the closed form reproduces ω0 only to O(eps · amplitude) (through
+        # u0 = F(φ0|m) and back through sn, cn, dn); adding the constant ω0 - f(0) makes
+        # omega(0) return ω0 exactly and changes no other value by more than that rounding.
+        self._anchor = omega_s - self._frame.to_user_columns(solver.omega(np.zeros(1)))[0]
         # R_user(t) = S · R_int(t) · C with S fixed so that R_user(0) = attitude0.
         _, q0 = solver.quat(np.zeros(1))
         conj = np.array([-1.0, -1.0, -1.0, 1.0])
@@ -658,7 +662,7 @@ class FreeRigidBody:
         cols = self._solver.omega(tau)
         if self._frame is None:
             return np.stack(cols, axis=-1) * self._w_ref
-        return self._frame.to_user_columns(cols) * self._w_ref
+        return (self._frame.to_user_columns(cols) + self._anchor) * self._w_ref
 
     def omega(self, t):
         """Body-frame angular velocity ω(t) in the caller's axes [rad per time unit].
@@ -698,7 +702,7 @@ class FreeRigidBody:
             return self._omega_user(tau), q
         cols, q_int = solver.quat(tau)
         q = _qmul(self._q_space, _qmul(q_int, self._frame.quat))
-        return self._frame.to_user_columns(cols) * self._w_ref, q
+        return (self._frame.to_user_columns(cols) + self._anchor) * self._w_ref, q
 
     def attitude(self, t) -> Rotation:
         """Attitude R(t), body -> space, as a scipy Rotation (single, or a stack of N).
