@@ -121,6 +121,7 @@ def test_reference_precision_is_what_it_claims(inertia, omega0) -> None:
             assert dw < MP_SELF_ATOL and dr < MP_SELF_ATOL, (t, dw, dr)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("inertia", "omega0"), [CASES[0], CASES[1], CASES[5], CASES[7]])
 def test_reference_precession_angle_matches_quadrature(inertia, omega0) -> None:
     """``phi`` from ``ellippi`` (or the separatrix atan form) vs quadrature of Landau 37.16."""
