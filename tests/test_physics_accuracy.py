@@ -73,7 +73,7 @@ def _attitude0(key: str) -> Rotation:
     return Rotation.from_rotvec(np.random.default_rng(seed).normal(size=3))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _reference(inertia: tuple, omega0: tuple, key: str) -> ReferenceBody:
     return ReferenceBody(inertia, omega0, _attitude0(key))
 
@@ -134,7 +134,7 @@ def test_generic_vs_dop853_three_periods(key: str) -> None:
     assert dr <= DOP853_FEW_PERIODS_ATOL, f"{key}: attitude vs DOP853 {dr:.3e} rad"
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _near_separatrix_omega0(inertia: tuple, mc: float, fam: str) -> tuple:
     return tuple(omega0_with_complementary_parameter(inertia, mc, fam))
 
@@ -283,8 +283,12 @@ def test_constants_against_exact(key: str) -> None:
     close("period", body.period, ref.period_float)
     close("energy", body.energy, ref.energy)
     close("D", body.D, ref.D)
-    close("precession_per_period", body.precession_per_period, float(ref.phi_per_period),
-          PRECESSION_RTOL)
+    close(
+        "precession_per_period",
+        body.precession_per_period,
+        float(ref.phi_per_period),
+        PRECESSION_RTOL,
+    )
     close(
         "second_period",
         body.second_period,

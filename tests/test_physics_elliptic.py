@@ -128,7 +128,7 @@ def test_sncndn_separatrix_limit() -> None:
 
 
 def test_sncndn_shapes_and_identities() -> None:
-    """Vectorised over any shape; sn^2 + cn^2 = 1 and dn^2 + m sn^2 = 1 (dn^2 - mc... ) hold."""
+    """Vectorised over any shape; sn^2 + cn^2 = 1 and dn^2 - cn^2 = mc sn^2 hold."""
     mc = 1e-12
     m = 1.0 - mc
     u = np.linspace(-60, 60, 24).reshape(4, 6)

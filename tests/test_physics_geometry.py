@@ -39,8 +39,16 @@ CASES = {
     "permanent": ((1.0, 2.0, 3.0), (0.0, 0.0, 2.0)),
     "sphere": ((2.0, 2.0, 2.0), (0.3, -0.2, 0.9)),
 }
-PERIODIC = ["major", "minor", "unsorted", "near-separatrix", "oblate", "prolate", "six-decades",
-            "no-triangle"]
+PERIODIC = [
+    "major",
+    "minor",
+    "unsorted",
+    "near-separatrix",
+    "oblate",
+    "prolate",
+    "six-decades",
+    "no-triangle",
+]
 
 
 @pytest.mark.parametrize("key", list(CASES))
@@ -111,8 +119,9 @@ def test_precession_per_period_is_what_the_attitude_does(key: str) -> None:
     assert np.max(dr) <= ATTITUDE_ATOL_GENERIC, dr
     assert body.precession_per_period == pytest.approx(float(ref.phi_per_period), rel=1e-12)
     assert body.precession_per_period > 0.0
-    assert body.second_period == pytest.approx(2 * np.pi * p / body.precession_per_period,
-                                               rel=1e-14)
+    assert body.second_period == pytest.approx(
+        2 * np.pi * p / body.precession_per_period, rel=1e-14
+    )
 
 
 def test_precession_zero_where_no_period() -> None:
@@ -137,12 +146,15 @@ def test_herpolhode_between_two_circles(key: str) -> None:
     rho = np.linalg.norm(p - foot, axis=1)
     # |omega|^2 = h^2 + rho^2 in space, and |omega| is a body-frame quantity
     w2 = np.sum(body.omega(t) ** 2, axis=1)
-    assert np.allclose(rho**2 + body.plane_distance**2, w2, rtol=0, atol=GEOMETRY_RTOL * 10 *
-                       scale**2)
+    assert np.allclose(
+        rho**2 + body.plane_distance**2, w2, rtol=0, atol=GEOMETRY_RTOL * 10 * scale**2
+    )
 
 
-@pytest.mark.parametrize("inertia", [(1.0, 2.0, 3.0), (3.0, 1.0, 2.0), (0.1, 10.0, 5.0),
-                                     (1.0, 1.0, 2.0), (2.0, 2.0, 2.0)])
+@pytest.mark.parametrize(
+    "inertia",
+    [(1.0, 2.0, 3.0), (3.0, 1.0, 2.0), (0.1, 10.0, 5.0), (1.0, 1.0, 2.0), (2.0, 2.0, 2.0)],
+)
 @pytest.mark.parametrize("frac", [0.0, 0.1, 0.5, 0.9, 1.0])
 @pytest.mark.parametrize("pole_sign", [1.0, -1.0])
 def test_omega_from_energy(inertia, frac: float, pole_sign: float) -> None:

@@ -155,11 +155,13 @@ def test_initial_state(case) -> None:
     assert np.array_equal(body.inertia, inertia)
     assert np.array_equal(body.omega0, omega0)
     m0 = inertia * omega0
-    assert np.allclose(body.angular_momentum, rot0.apply(m0), rtol=0, atol=4 * EPS *
-                       np.linalg.norm(m0))
-    assert body.energy == 0.5 * float(omega0 @ m0) or abs(
-        body.energy - 0.5 * float(omega0 @ m0)
-    ) <= 4 * EPS * body.energy
+    assert np.allclose(
+        body.angular_momentum, rot0.apply(m0), rtol=0, atol=4 * EPS * np.linalg.norm(m0)
+    )
+    assert (
+        body.energy == 0.5 * float(omega0 @ m0)
+        or abs(body.energy - 0.5 * float(omega0 @ m0)) <= 4 * EPS * body.energy
+    )
 
 
 @SETTINGS
@@ -213,8 +215,9 @@ def test_poinsot_geometry(case, taus) -> None:
     pl = p @ L
     assert np.all(np.abs(pl - two_t) <= GEOMETRY_RTOL * np.linalg.norm(p, axis=1) * g)
     # distance of the plane from the fixed point along its normal
-    assert np.all(np.abs(p @ n_hat - body.plane_distance) <= GEOMETRY_RTOL * np.linalg.norm(
-        p, axis=1))
+    assert np.all(
+        np.abs(p @ n_hat - body.plane_distance) <= GEOMETRY_RTOL * np.linalg.norm(p, axis=1)
+    )
     # the ellipsoid x.I.x = 2T has normal ~ I x at x = omega: in space R I omega, parallel to L
     normal = np.einsum("nij,nj->ni", r, inertia * w)
     cross = np.cross(normal, L)

@@ -86,17 +86,20 @@ def test_omega_scaling(key: str, c: float) -> None:
     )
     assert scaled.frequency == pytest.approx(base.frequency * c, rel=SCALAR_RTOL)
     assert scaled.parameter == pytest.approx(base.parameter, rel=SCALAR_RTOL, abs=1e-300)
-    assert scaled.complementary_parameter == pytest.approx(base.complementary_parameter,
-                                                           rel=SCALAR_RTOL, abs=1e-300)
+    assert scaled.complementary_parameter == pytest.approx(
+        base.complementary_parameter, rel=SCALAR_RTOL, abs=1e-300
+    )
     assert scaled.D == pytest.approx(base.D, rel=SCALAR_RTOL)
-    assert scaled.precession_per_period == pytest.approx(base.precession_per_period,
-                                                         rel=SCALAR_RTOL, abs=1e-300)
+    assert scaled.precession_per_period == pytest.approx(
+        base.precession_per_period, rel=SCALAR_RTOL, abs=1e-300
+    )
     assert scaled.plane_distance == pytest.approx(base.plane_distance * c, rel=SCALAR_RTOL)
     assert np.allclose(scaled.plane_normal, base.plane_normal, rtol=0, atol=1e-15)
-    assert np.allclose(scaled.angular_momentum / c, base.angular_momentum, rtol=SCALAR_RTOL,
-                       atol=0)
+    assert np.allclose(scaled.angular_momentum / c, base.angular_momentum, rtol=SCALAR_RTOL, atol=0)
     assert np.allclose(scaled.semi_axes / c, base.semi_axes, rtol=SCALAR_RTOL, atol=0), (
-        scaled.semi_axes, base.semi_axes * c)
+        scaled.semi_axes,
+        base.semi_axes * c,
+    )
     energy = base.energy * c * c  # may under/overflow in the test itself: then only finite
     assert np.isfinite(scaled.energy)
     if 1e-300 < energy < 1e300:
@@ -126,8 +129,7 @@ def test_inertia_scaling(key: str, c: float) -> None:
     assert scaled.energy == pytest.approx(base.energy * c, rel=SCALAR_RTOL)
     assert scaled.D == pytest.approx(base.D * c, rel=SCALAR_RTOL)
     assert scaled.plane_distance == pytest.approx(base.plane_distance, rel=SCALAR_RTOL)
-    assert np.allclose(scaled.angular_momentum / c, base.angular_momentum, rtol=SCALAR_RTOL,
-                       atol=0)
+    assert np.allclose(scaled.angular_momentum / c, base.angular_momentum, rtol=SCALAR_RTOL, atol=0)
     assert np.allclose(scaled.semi_axes, base.semi_axes, rtol=SCALAR_RTOL, atol=0)  # sqrt(2T/I)
 
 

@@ -192,7 +192,6 @@ def test_no_nan_in_corners(inertia, omega0) -> None:
 def test_no_nan_for_any_valid_input(logs, mags, signs, taus) -> None:
     """Components up to 320 decades apart, some exactly zero: finite everywhere."""
     inertia = 10.0 ** np.array(logs)
-    omega0 = np.array([0.0 if m is None else s * 10.0**m for m, s in zip(mags, signs,
-                                                                          strict=True)])
+    omega0 = np.array([0.0 if m is None else s * 10.0**m for m, s in zip(mags, signs, strict=True)])
     body = FreeRigidBody(inertia=inertia, omega0=omega0)
     _assert_no_nan(body, np.array([0.0, 10.0**taus, 1e3 * 10.0**taus]))
