@@ -39,6 +39,8 @@ _AGM_TOL = 2.0**-27
 # Maclaurin series sn = u - (1+m) u³/6, cn = 1 - u²/2, dn = 1 - m u²/2 is exact to rounding
 # there (the first neglected terms are O(u^4) < 1e-32).
 _SMALL_U = 1e-8
+# sech²(r) stays above the smallest normal double for |r| below this (e^-600 ~ 1e-261).
+_UNDERFLOW_REACH = 300.0
 
 
 @dataclass(frozen=True)
@@ -62,32 +64,42 @@ class JacobiParameter:
     agm_c: float
 
     @classmethod
-    def from_pair(cls, m: float, mc: float) -> JacobiParameter:
+    def from_pair(
+        cls, m: float, mc: float, sqrt_mc: float | None = None, K: float | None = None
+    ) -> JacobiParameter:
         """Precompute the AGM table for ``(m, mc)``; ``mc`` must be the accurate one.
 
+        Args:
+            m, mc: the parameter and its complement (``mc`` may underflow to 0.0 when
+                ``sqrt_mc`` is given).
+            sqrt_mc: ``sqrt(1 - m)`` if known to more range than ``mc`` itself (``1 - m``
+                below 1e-308 still has a representable square root, the AGM's first term).
+            K: the quarter period if already known more accurately.
+
         Raises:
-            ValueError: unless ``0 <= m < 1`` and ``0 < mc <= 1``.
+            ValueError: unless ``0 <= m <= 1``, ``0 <= mc <= 1`` and ``sqrt(1 - m) > 0``.
         """
         m, mc = float(m), float(mc)
-        # m itself may round to 1.0 when mc is tiny: mc is the one that must be positive.
-        if not (0.0 <= m <= 1.0 and 0.0 < mc <= 1.0):
+        b = math.sqrt(mc) if sqrt_mc is None else float(sqrt_mc)
+        # m itself may round to 1.0 when mc is tiny: sqrt(mc) is the one that must be positive.
+        if not (0.0 <= m <= 1.0 and 0.0 <= mc <= 1.0 and 0.0 < b <= 1.0):
             raise ValueError(f"elliptic parameter must satisfy 0 <= m < 1, got m={m}, 1-m={mc}")
-        a, emc = 1.0, mc
+        a = 1.0
         agm_a: list[float] = []
         agm_b: list[float] = []
         c = 1.0
-        for _ in range(16):  # quadratic convergence: 7 steps reach 1 - m = 1e-300
+        for _ in range(16):  # quadratic convergence: 7 steps reach 1 - m = 1e-600
             agm_a.append(a)
-            emc = math.sqrt(emc)
-            agm_b.append(emc)
-            c = 0.5 * (a + emc)
-            if abs(a - emc) <= _AGM_TOL * a:
+            agm_b.append(b)
+            c = 0.5 * (a + b)
+            if abs(a - b) <= _AGM_TOL * a:
                 break
-            emc *= a
+            b = math.sqrt(a * b)
             a = c
-        # K = R_F(0, mc, 1) (DLMF 19.25.1); never K(m) from m near 1.
-        K = float(special.elliprf(0.0, mc, 1.0))
-        return cls(m, mc, K, tuple(agm_a), tuple(agm_b), c)
+        if K is None:
+            # K = R_F(0, mc, 1) (DLMF 19.25.1); never K(m) from m near 1.
+            K = float(special.elliprf(0.0, mc, 1.0))
+        return cls(m, mc, float(K), tuple(agm_a), tuple(agm_b), c)
 
 
 def reduce_argument(u: np.ndarray, K: float) -> tuple[np.ndarray, np.ndarray]:
@@ -254,15 +266,76 @@ def ellippi_from_jacobi(n: float, sn: np.ndarray, cn: np.ndarray, dn: np.ndarray
     )
 
 
-def ellipf_from_angle(sin_phi: float, cos_phi: float, m: float, mc: float) -> float:
+def ellipf_from_angle(
+    sin_phi: float, cos_phi: float, par: JacobiParameter, sqrt_mc: float | None = None
+) -> float:
     """Incomplete ``F(φ|m)`` for ``φ = atan2(sin_phi, cos_phi)`` in ``(-π, π]``.
 
-    Uses ``F(φ) = sinφ R_F(cos²φ, cos²φ + mc sin²φ, 1)`` for ``|φ| <= π/2`` and
-    ``F(φ) = 2K - F(π - φ)`` beyond (DLMF 19.25.5, 19.2.10); inputs need not be normalised.
+    ``F(φ) = sinφ R_F(cos²φ, cos²φ + mc sin²φ, 1)`` for ``|φ| <= π/4``; for ``π/4 < |φ| <= π/2``
+    the complementary amplitude ``v = K - u`` is used (``sn v = cn u / dn u``,
+    ``cn v = sqrt(mc) sn u / dn u``, ``dn v = sqrt(mc) / dn u``), whose Carlson arguments stay
+    O(1) even when ``cos φ`` and ``1 - m`` are far below the square root of the smallest
+    double; beyond ``π/2``, ``F(φ) = 2K - F(π - φ)`` (DLMF 19.25.5, 19.2.10, 22.6.1).
+    Inputs need not be normalised.
     """
+    K = par.K
+    sq = math.sqrt(par.mc) if sqrt_mc is None else sqrt_mc
     h = math.hypot(sin_phi, cos_phi)
     s, c = sin_phi / h, abs(cos_phi) / h
-    f = s * float(special.elliprf(c * c, c * c + mc * s * s, 1.0))
+    if c >= abs(s):
+        f = s * float(special.elliprf(c * c, c * c + par.mc * s * s, 1.0))
+    else:
+        d = math.hypot(c, sq * abs(s))  # dn u
+        snv, cnv, dnv = c / d, sq * abs(s) / d, sq / d
+        fv = snv * float(special.elliprf(cnv * cnv, dnv * dnv, 1.0))
+        f = math.copysign(K - fv, s)
     if cos_phi >= 0.0:
         return f
-    return math.copysign(2.0 * ellipk(m, mc), s) - f
+    return math.copysign(2.0 * K, s) - f
+
+
+def periodic_third_kind(
+    n: float,
+    slope: float,
+    par: JacobiParameter,
+    r: np.ndarray,
+    sn: np.ndarray,
+    cn: np.ndarray,
+    dn: np.ndarray,
+) -> np.ndarray:
+    """``P(r) = Π(n; am r | m) - slope·r``, ``slope = Π(n|m)/K``, for reduced ``|r| <= K``, ``n < 0``.
+
+    For ``|r| <= K/2`` Carlson's form with ``(sn, cn, dn)`` of r (:func:`ellippi_from_jacobi`).
+    For ``|r| > K/2`` the complementary argument ``v = K - |r|``: with ``sn(K - v) = cd v``,
+    ``1/(1 - n cd²v) = [m/n' + (1 - m/n')/(1 - n' sn²v)]/(1 - n)``, ``n' = (m - n)/(1 - n)``,
+    so ``Π(n; am(K - v)) = Π(n) - m v/(m - n) + n mc Π(n'; am v)/((1 - n)(m - n))``. Its
+    Carlson arguments are O(1) where ``cn² r`` and ``dn² r`` would underflow near the
+    separatrix, and ``Π(n) - (Π(n)/K) K`` cancels exactly by construction.
+    Only when ``1 - m < 1e-500`` (K > 575) does a middle stretch remain where both forms would
+    underflow; there ``1 - m`` is invisible (``mc e^{2r} < e^{-600}``) and the m = 1 form
+    ``Π = (r + a atan(a tanh r))/(1 - n)``, ``a = sqrt(-n)``, is exact to rounding.
+    """
+    out = np.empty_like(r)
+    reach = min(0.5 * par.K, _UNDERFLOW_REACH)
+    near = np.abs(r) <= reach
+    if near.any():
+        out[near] = ellippi_from_jacobi(n, sn[near], cn[near], dn[near]) - slope * r[near]
+    middle = (np.abs(r) > reach) & (par.K - np.abs(r) > _UNDERFLOW_REACH)
+    if middle.any():
+        a = math.sqrt(-n)
+        rm = r[middle]
+        th, _ = tanh_sech(rm)
+        out[middle] = (rm + a * np.arctan(a * th)) / (1.0 - n) - slope * rm
+    far = ~(near | middle)
+    if far.any():
+        m, mc = par.m, par.mc
+        v = par.K - np.abs(r[far])
+        snv, cnv, dnv = sncndn_reduced(v, par)
+        n_prime = (m - n) / (1.0 - n)
+        c2, d2, s2 = cnv * cnv, dnv * dnv, snv * snv
+        pi_v = snv * special.elliprf(c2, d2, 1.0) + (n_prime / 3.0) * snv * s2 * special.elliprj(
+            c2, d2, 1.0, 1.0 - n_prime * s2
+        )
+        body = (slope - m / (m - n)) * v + (n * mc / ((1.0 - n) * (m - n))) * pi_v
+        out[far] = np.copysign(body, r[far])
+    return out

@@ -25,7 +25,6 @@ as in the caller's units.
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
 from decimal import localcontext
@@ -208,6 +207,25 @@ def _zxz_from_momentum(
 # ---------------------------------------------------------------------------------------------
 
 
+def _amplitudes(F: tuple[Fraction, ...], e1: Fraction, e3: Fraction) -> np.ndarray:
+    """``(A1, A2, A3)`` of Landau 37.10 from exact moments and Δ1, Δ3 (pole frame).
+
+    ``A1² = Δ3/(J1(J1-J3))``, ``A2² = Δ3/(J2(J2-J3))``, ``A3² = Δ1/(J3(J3-J1))``: each a quotient
+    of same-signed quantities in both families. Evaluated in decimal (call inside a
+    45-digit context) so that a spin a hair off an axis, with Δ ~ 1e-600, still gets its
+    representable amplitude ~1e-300 instead of 0/0.
+    """
+    F1, F2, F3 = F
+    dec = precise.decimal
+    return np.array(
+        [
+            float(dec(e3 / (F1 * (F1 - F3))).sqrt()),
+            float(dec(e3 / (F2 * (F2 - F3))).sqrt()),
+            float(dec(e1 / (F3 * (F3 - F1))).sqrt()),
+        ]
+    )
+
+
 class _Elliptic:
     """Major- or minor-axis family, in the pole frame (pole = axis 3), Landau 37.10.
 
@@ -220,17 +238,7 @@ class _Elliptic:
         J1, J2, J3 = (float(x) for x in J)
         F1, F2, F3 = (Fraction(x) for x in (J1, J2, J3))
         e1, e2, e3 = delta  # exact
-        d1, d3 = float(e1), float(e3)
         self.J = J
-        # Amplitudes and frequency (Landau 37.10, written with Δi = G² - 2T Ii so that each
-        # ratio is a quotient of same-signed quantities in both families).
-        self.A = np.array(
-            [
-                math.sqrt(d3 / (J1 - J3) / J1),
-                math.sqrt(d3 / (J2 - J3) / J2),
-                math.sqrt(d1 / (J3 - J1) / J3),
-            ]
-        )
         # λ, m, 1 - m, K and the mean precession rate ν from the exact rationals of the data,
         # at 45 digits: m and mc correctly rounded (no subtraction near the separatrix), λ, K
         # and ν as double-double pairs so that the phases u = u0 + σ τ (mod 2K) and ν τ
@@ -244,6 +252,12 @@ class _Elliptic:
         m, mc = float(m_exact), float(mc_exact)
         with localcontext() as ctx:
             ctx.prec = precise.DIGITS
+            dec = precise.decimal
+            # Amplitudes (Landau 37.10, with Δi = G² - 2T Ii so that each ratio is a quotient
+            # of same-signed quantities in both families); in decimal, so that a spin a hair
+            # off an axis (Δ ~ 1e-600) still gets its representable amplitude ~1e-300.
+            self.A = _amplitudes((F1, F2, F3), e1, e3)
+            sqrt_mc = float(dec(mc_exact).sqrt())
             K_dec = elliptic.ellipk_decimal(mc_exact)
             pi_dec = elliptic.ellippi_complete_decimal(N_exact, mc_exact)
             G_dec = precise.decimal(G2).sqrt()
@@ -253,7 +267,7 @@ class _Elliptic:
             K_hi, K_lo = precise.double_double(K_dec)
             nu = precise.double_double(nu_dec)
             pi_complete = float(pi_dec)
-        self.par = dataclasses.replace(elliptic.JacobiParameter.from_pair(m, mc), K=K_hi)
+        self.par = elliptic.JacobiParameter.from_pair(m, mc, sqrt_mc=sqrt_mc, K=K_hi)
         self.s = 1.0 if w[2] > 0.0 else -1.0
         direction = 1.0 if J3 > J1 else -1.0
         self.lam = lam
@@ -261,7 +275,7 @@ class _Elliptic:
         K = K_hi
         # Initial phase u0 = F(φ0 | m), φ0 = atan2(sn0, cn0) (Landau after 37.10).
         sn0, cn0 = w[1] / self.A[1], w[0] / self.A[0]
-        self.u0 = elliptic.ellipf_from_angle(sn0, cn0, m, mc)
+        self.u0 = elliptic.ellipf_from_angle(sn0, cn0, self.par, sqrt_mc)
         self.phase = precise.LinearPhase(
             self.u0, self.sigma, direction * self.s * lam_lo, 2.0 * K_hi, 2.0 * K_lo
         )
@@ -288,7 +302,7 @@ class _Elliptic:
     def _periodic_pi(self, u: np.ndarray) -> np.ndarray:
         r, _ = elliptic.reduce_argument(u, self.par.K)
         sn, cn, dn = elliptic.sncndn_reduced(r, self.par)
-        return elliptic.ellippi_from_jacobi(self.N, sn, cn, dn) - self.pi_slope * r
+        return elliptic.periodic_third_kind(self.N, self.pi_slope, self.par, r, sn, cn, dn)
 
     def omega(self, tau: np.ndarray) -> tuple[np.ndarray, ...]:
         _, sign, sn, cn, dn = self._reduced(tau)
@@ -313,7 +327,7 @@ class _Elliptic:
         evaluated directly per point.
         """
         if self.sine_series is None:
-            P = elliptic.ellippi_from_jacobi(self.N, sn, cn, dn) - self.pi_slope * r
+            P = elliptic.periodic_third_kind(self.N, self.pi_slope, self.par, r, sn, cn, dn)
             return self.phase_scale * (P - self.P0)
         theta = r * (math.pi / self.par.K)
         return _clenshaw_sine(self.sine_series, theta) - self.phase_scale * self.P0
@@ -378,15 +392,11 @@ class _Separatrix:
 
     def __init__(self, J: np.ndarray, w: np.ndarray, delta: tuple[float, float, float]):
         J1, J2, J3 = (float(x) for x in J)
-        d1, d3 = float(delta[0]), float(delta[2])
+        d1 = float(delta[0])
         self.J = J
-        self.A = np.array(
-            [
-                math.sqrt(d3 / (J1 - J3) / J1),
-                math.sqrt(d3 / (J2 - J3) / J2),
-                math.sqrt(d1 / (J3 - J1) / J3),
-            ]
-        )
+        with localcontext() as ctx:
+            ctx.prec = precise.DIGITS
+            self.A = _amplitudes(tuple(Fraction(float(x)) for x in J), delta[0], delta[2])
         lam = math.sqrt((J3 - J2) / J1 * (d1 / J2) / J3)
         self.s1 = 1.0 if w[0] > 0.0 else -1.0
         self.s3 = 1.0 if w[2] > 0.0 else -1.0
@@ -521,6 +531,11 @@ class FreeRigidBody:
             raise ValueError("attitude0 must be one scipy Rotation (body -> space) or None")
         self.attitude0 = attitude0
 
+        if self.inertia.max() / 1e300 > self.inertia.min():
+            raise ValueError(
+                "the moments of inertia span more than 300 decades "
+                f"({self.inertia.min():g} to {self.inertia.max():g}): beyond double precision"
+            )
         # Exact power-of-two scaling: moments and ω near 1 whatever the caller's units.
         self._I_ref = _pow2(float(self.inertia.max()))
         w_max = float(np.abs(self.omega0).max())
@@ -538,6 +553,7 @@ class FreeRigidBody:
         L_scaled = self.attitude0.apply(inertia_s * omega_s)
         two_T_scaled = float(omega_s @ (inertia_s * omega_s))
         G_scaled = float(np.linalg.norm(L_scaled))
+        self._two_T_scaled, self._inertia_scaled = two_T_scaled, inertia_s
         self.angular_momentum = L_scaled * self._I_ref * self._w_ref
         self.energy = 0.5 * two_T_scaled * self._I_ref * self._w_ref * self._w_ref
         if self.regime is Regime.REST:
@@ -751,7 +767,8 @@ class FreeRigidBody:
     @property
     def semi_axes(self) -> np.ndarray:
         """(3,) semi-axes ``sqrt(2T/Ii)`` of the energy ellipsoid ``x·I·x = 2T`` (caller order)."""
-        return np.sqrt(2.0 * self.energy / self.inertia)
+        # From the scaled state (2T/I_i = w_ref² · 2T_s/I_s,i): no underflow at ω ~ 1e-200.
+        return np.sqrt(self._two_T_scaled / self._inertia_scaled) * self._w_ref
 
     def __repr__(self) -> str:
         return (
@@ -830,9 +847,10 @@ def omega_from_energy(inertia, D: float, omega_norm: float = 1.0, pole_sign: flo
             m = np.array([sign * m1, 0.0, m3])
     w_sorted = m / np.array([J1, J2, J3])
     w_sorted *= omega_norm / np.linalg.norm(w_sorted)
-    # Back to the caller's axes: x_user[index[k]] = sign[k] * x_internal[k].
+    # Back to the caller's axes: a plain permutation (a vector needs no proper relabelling,
+    # and the sign flip would reverse the pole component the caller chose).
     out = np.empty(3)
-    out[sort.index] = sort.sign * w_sorted
+    out[sort.index] = w_sorted
     return out
 
 
