@@ -80,7 +80,8 @@ def main(argv: list[str] | None = None) -> int:
     print("-" * len(header))
     for r in rows:
         print(
-            f"{r['case']:28s} {r['ellipj_ns']:7.1f}ns {r['omega_ns']:7.1f}ns {r['omega_ratio']:5.2f}x "
+            f"{r['case']:28s} {r['ellipj_ns']:7.1f}ns {r['omega_ns']:7.1f}ns "
+            f"{r['omega_ratio']:5.2f}x "
             f"{r['attitude_ns']:7.1f}ns {r['attitude_ratio']:5.2f}x {r['construct_us']:7.1f}us"
         )
     print("targets: omega <= 1.5x ellipj, attitude <= 4x ellipj")

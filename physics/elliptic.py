@@ -163,7 +163,9 @@ def ellippi_complete_decimal(n: Fraction, mc: Fraction) -> Decimal:
         return precise.PI / (4 * a) * (2 + nd / (one - nd) * total)
 
 
-def sncndn_reduced(r: np.ndarray, par: JacobiParameter) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def sncndn_reduced(
+    r: np.ndarray, par: JacobiParameter
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``sn, cn, dn`` of an already reduced argument ``|r| <= K`` (Bulirsch's recurrence).
 
     Args:
@@ -303,7 +305,7 @@ def periodic_third_kind(
     cn: np.ndarray,
     dn: np.ndarray,
 ) -> np.ndarray:
-    """``P(r) = Π(n; am r | m) - slope·r``, ``slope = Π(n|m)/K``, for reduced ``|r| <= K``, ``n < 0``.
+    """``P(r) = Π(n; am r | m) - slope·r`` with ``slope = Π(n|m)/K``, ``|r| <= K``, ``n < 0``.
 
     For ``|r| <= K/2`` Carlson's form with ``(sn, cn, dn)`` of r (:func:`ellippi_from_jacobi`).
     For ``|r| > K/2`` the complementary argument ``v = K - |r|``: with ``sn(K - v) = cd v``,

@@ -61,7 +61,7 @@ def split(x):
 
 @dataclass(frozen=True)
 class LinearPhase:
-    """``u(τ) = offset + rate·τ`` reduced modulo ``period``: ``u = r + period·j``, ``|r| <= period/2``.
+    """``u(τ) = offset + rate·τ`` reduced modulo ``period``: ``u = r + period·j``.
 
     Attributes:
         offset: the phase at τ = 0 (a double; its rounding does not grow with τ).
@@ -80,7 +80,7 @@ class LinearPhase:
     period_lo: float = 0.0
 
     def reduce(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(r, j)`` for (N,) dimensionless times τ: r in ``[-period/2, period/2]``, j as floats."""
+        """``(r, j)`` for (N,) dimensionless times τ: ``|r| <= period/2``, j as floats."""
         p = self.rate_hi * tau
         j = np.round((p + self.offset) / self.period_hi)
         c1, c2 = split(self.period_hi)

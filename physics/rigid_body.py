@@ -128,13 +128,13 @@ class _AxisMap:
         )
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _axis_map(index: tuple[int, ...], sign: tuple[float, ...]) -> _AxisMap:
     return _AxisMap(index, sign)
 
 
 def _sorting_map(inertia: np.ndarray) -> _AxisMap:
-    """Proper relabelling that sorts the moments ascending (flip one sign if the permutation is odd)."""
+    """Proper relabelling that sorts the moments ascending (an odd permutation flips axis 1)."""
     order = tuple(int(i) for i in np.argsort(inertia, kind="stable"))
     inversions = sum(order[i] > order[j] for i in range(3) for j in range(i + 1, 3))
     parity = -1.0 if inversions % 2 else 1.0  # an odd permutation gets axis 1 reversed
@@ -456,7 +456,9 @@ class _Circular:
     rotation or a rest is the case ``I = J`` along the axis of ω.
     """
 
-    def __init__(self, w: np.ndarray, axis: np.ndarray, I_t: float, J_a: float, inertia: np.ndarray):
+    def __init__(
+        self, w: np.ndarray, axis: np.ndarray, I_t: float, J_a: float, inertia: np.ndarray
+    ):
         self.w0 = w
         self.axis = axis
         self.m0 = inertia * w
@@ -464,7 +466,9 @@ class _Circular:
         w_axial = float(w @ axis)
         # The two rates to double-double from the exact data, so that the angles p τ and s τ
         # (reduced mod 2π) stay exact over long runs (physics.precise).
-        G2 = sum((Fraction(float(i)) * Fraction(float(x))) ** 2 for i, x in zip(inertia, w, strict=True))
+        G2 = sum(
+            (Fraction(float(i)) * Fraction(float(x))) ** 2 for i, x in zip(inertia, w, strict=True)
+        )
         It, Ja = Fraction(I_t), Fraction(J_a)
         with localcontext() as ctx:
             ctx.prec = precise.DIGITS
@@ -632,7 +636,9 @@ class FreeRigidBody:
         # R_user(t) = S · R_int(t) · C with S fixed so that R_user(0) = attitude0.
         _, q0 = solver.quat(np.zeros(1))
         conj = np.array([-1.0, -1.0, -1.0, 1.0])
-        self._q_space = _qmul(_qmul(self.attitude0.as_quat(), self._frame.quat * conj), q0[0] * conj)
+        self._q_space = _qmul(
+            _qmul(self.attitude0.as_quat(), self._frame.quat * conj), q0[0] * conj
+        )
 
     def _circular_or_none(self, sort, J, w, zero, inertia_s, omega_s):
         """Permanent rotations and symmetric bodies: (regime, _Circular), else None."""
@@ -800,7 +806,9 @@ def _deltas(J: np.ndarray, w: np.ndarray) -> tuple[Fraction, Fraction, Fraction]
 # ---------------------------------------------------------------------------------------------
 
 
-def omega_from_energy(inertia, D: float, omega_norm: float = 1.0, pole_sign: float = 1.0) -> np.ndarray:
+def omega_from_energy(
+    inertia, D: float, omega_norm: float = 1.0, pole_sign: float = 1.0
+) -> np.ndarray:
     """An initial ω with ``|L|²/2T = D``, on the plane ``ω2 = 0`` of the sorted axes.
 
     Args:
@@ -831,7 +839,8 @@ def omega_from_energy(inertia, D: float, omega_norm: float = 1.0, pole_sign: flo
     lo, hi = float(inertia.min()), float(inertia.max())
     if not (lo <= D <= hi):
         raise ValueError(
-            f"D = |L|²/2T must lie between the smallest and largest moments [{lo:g}, {hi:g}], got {D:g}"
+            "D = |L|²/2T must lie between the smallest and largest moments "
+            f"[{lo:g}, {hi:g}], got {D:g}"
         )
     sort = _sorting_map(inertia)
     J1, J2, J3 = np.sort(inertia)
