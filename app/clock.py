@@ -1,0 +1,64 @@
+"""Simulation clock: monotonic wall time scaled by a speed, with pause, step and reset."""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+
+
+class SimClock:
+    """``now()`` = simulation time. Pausing freezes it; changing the speed re-anchors so that
+    the time is continuous. Thread-safe (GUI callbacks and the frame loop both use it)."""
+
+    def __init__(self, speed: float = 1.0, monotonic: Callable[[], float] = time.monotonic):
+        self._monotonic = monotonic
+        self._lock = threading.Lock()
+        self._speed = float(speed)
+        self._paused = False
+        self._t_anchor = 0.0
+        self._wall_anchor = monotonic()
+
+    def now(self) -> float:
+        with self._lock:
+            return self._now_locked()
+
+    def _now_locked(self) -> float:
+        if self._paused:
+            return self._t_anchor
+        return self._t_anchor + self._speed * (self._monotonic() - self._wall_anchor)
+
+    def _reanchor_locked(self) -> None:
+        self._t_anchor = self._now_locked()
+        self._wall_anchor = self._monotonic()
+
+    @property
+    def speed(self) -> float:
+        return self._speed
+
+    @speed.setter
+    def speed(self, speed: float) -> None:
+        with self._lock:
+            self._reanchor_locked()
+            self._speed = float(speed)
+
+    @property
+    def paused(self) -> bool:
+        return self._paused
+
+    @paused.setter
+    def paused(self, paused: bool) -> None:
+        with self._lock:
+            self._reanchor_locked()
+            self._paused = bool(paused)
+
+    def step(self, dt: float) -> None:
+        """Advance by ``dt`` simulation seconds (used while paused)."""
+        with self._lock:
+            self._reanchor_locked()
+            self._t_anchor += float(dt)
+
+    def reset(self, t: float = 0.0) -> None:
+        with self._lock:
+            self._t_anchor = float(t)
+            self._wall_anchor = self._monotonic()

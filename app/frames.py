@@ -1,0 +1,25 @@
+"""The one place where an attitude becomes a viser orientation.
+
+scipy's ``Rotation.as_quat()`` is scalar-last (x, y, z, w); viser's ``wxyz`` is scalar-first.
+Every pose the app sends goes through :func:`wxyz`; nothing else in ``app/`` touches a
+quaternion's component order.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+
+def wxyz(rotation: Rotation) -> np.ndarray:
+    """Viser orientation (w, x, y, z), w >= 0: shape (4,) for a single rotation, (N, 4) for a
+    stack."""
+    xyzw = np.asarray(rotation.as_quat(), dtype=np.float64)
+    q = np.roll(xyzw, 1, axis=-1)
+    return np.where(q[..., :1] < 0.0, -q, q)
+
+
+def rotation_from_wxyz(q: np.ndarray) -> Rotation:
+    """Inverse of :func:`wxyz` (used by tests and the export of issue 5)."""
+    w, x, y, z = np.asarray(q, dtype=np.float64)
+    return Rotation.from_quat([x, y, z, w])

@@ -1,0 +1,228 @@
+"""A headless viser client over a websocket, for the benchmark and the server-side tests.
+
+It speaks viser's wire protocol like the browser does (subprotocol ``viser-v<version>``, a
+camera message to be registered, msgpack messages out; zstd-compressed msgpack plus raw
+binary buffers in), counts the bytes it receives, decodes every message and keeps a model of
+the scene and the GUI *as sent*: what the browser would draw. Tests check the geometry on this
+model; the benchmark measures traffic and latency with it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+import msgspec
+import numpy as np
+import viser
+import websockets.sync.client
+import zstandard
+from viser import _messages
+
+
+@dataclasses.dataclass
+class Node:
+    """A scene node as the browser knows it."""
+
+    type: str
+    props: dict[str, Any]
+    wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    visible: bool = True
+
+
+@dataclasses.dataclass
+class Widget:
+    type: str
+    props: dict[str, Any]
+    value: Any = None
+    container: str = ""
+
+
+@dataclasses.dataclass
+class Batch:
+    """One websocket message (a window of viser messages)."""
+
+    received: float  # time.perf_counter() on arrival
+    nbytes: int
+    types: list[str]
+    names: list[str]
+
+
+def _decode_frame(frame: bytes) -> list[dict[str, Any]]:
+    inner_len = int.from_bytes(frame[0:8], "little")
+    compressed_len = int.from_bytes(frame[8:16], "little")
+    inner = zstandard.ZstdDecompressor().decompress(
+        frame[16 : 16 + compressed_len], max_output_size=inner_len
+    )
+    payload = msgspec.msgpack.decode(inner)
+    buffers: list[np.ndarray] = []
+    offset = 16 + compressed_len
+    for length in payload["binaryBufferLengths"]:
+        offset += (8 - offset % 8) % 8
+        buffers.append(memoryview(frame)[offset : offset + length])
+        offset += length
+
+    def resolve(value: Any) -> Any:
+        if isinstance(value, dict):
+            if "__binary_index" in value and "dtype" in value:
+                return np.frombuffer(buffers[value["__binary_index"]], dtype=value["dtype"])
+            return {k: resolve(v) for k, v in value.items()}
+        if isinstance(value, list):
+            return [resolve(v) for v in value]
+        return value
+
+    return [resolve(m) for m in payload["messages"]]
+
+
+class Probe:
+    """Connect to a viser server on ``port``; use as a context manager."""
+
+    def __init__(self, port: int, host: str = "127.0.0.1", *, keep_batches: bool = True):
+        self.uri = f"ws://{host}:{port}"
+        self.nodes: dict[str, Node] = {}
+        self.widgets: dict[str, Widget] = {}
+        self.batches: list[Batch] = []
+        self.keep_batches = keep_batches
+        self.bytes_received = 0
+        self.messages_received = 0
+        self._cond = threading.Condition()
+        self._listeners: list[Callable[[dict[str, Any], float], None]] = []
+        self._ws = websockets.sync.client.connect(
+            self.uri,
+            subprotocols=[websockets.Subprotocol(f"viser-v{viser.__version__}")],
+            max_size=None,
+            compression=None,
+            open_timeout=10,
+        )
+        self._closed = False
+        self._thread = threading.Thread(target=self._receive, daemon=True, name="viser-probe")
+        self._thread.start()
+        self.send(
+            _messages.ViewerCameraMessage(
+                wxyz=(1.0, 0.0, 0.0, 0.0), position=(3.0, -3.0, 2.0), fov=0.8, near=0.01,
+                far=100.0, image_height=720, image_width=1280, look_at=(0.0, 0.0, 0.0),
+                up_direction=(0.0, 0.0, 1.0),
+            )
+        )
+
+    def __enter__(self) -> Probe:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        if not self._closed:
+            self._closed = True
+            self._ws.close()
+            self._thread.join(5.0)
+
+    # -- sending -------------------------------------------------------------------------
+    def send(self, message: _messages.Message) -> None:
+        self._ws.send(msgspec.msgpack.encode(message.as_serializable_dict()))
+
+    def set_value(self, uuid: str, value: Any) -> None:
+        """What the browser sends when the user moves a slider, ticks a box, picks an option,
+        or clicks a button (``value=True``)."""
+        self.send(_messages.GuiUpdateMessage(uuid, {"value": value}))
+
+    # -- receiving -----------------------------------------------------------------------
+    def add_listener(self, listener: Callable[[dict[str, Any], float], None]) -> None:
+        """``listener(message, arrival_time)`` for every decoded message (receiver thread)."""
+        self._listeners.append(listener)
+
+    def _receive(self) -> None:
+        try:
+            for frame in self._ws:
+                now = time.perf_counter()
+                assert isinstance(frame, bytes)
+                messages = _decode_frame(frame)
+                with self._cond:
+                    self.bytes_received += len(frame)
+                    self.messages_received += len(messages)
+                    for message in messages:
+                        self._apply(message)
+                    if self.keep_batches:
+                        self.batches.append(
+                            Batch(now, len(frame), [m["type"] for m in messages],
+                                  [m.get("name", m.get("uuid", "")) for m in messages])
+                        )
+                    self._cond.notify_all()
+                for message in messages:
+                    for listener in self._listeners:
+                        listener(message, now)
+        except websockets.ConnectionClosed:
+            pass
+        finally:
+            with self._cond:
+                self._closed = True
+                self._cond.notify_all()
+
+    def _apply(self, m: dict[str, Any]) -> None:
+        kind = m["type"]
+        name = m.get("name")
+        if kind == "RemoveSceneNodeMessage":
+            self.nodes.pop(name, None)
+        elif kind == "SetOrientationMessage" and name in self.nodes:
+            self.nodes[name].wxyz = tuple(m["wxyz"])  # type: ignore[assignment]
+        elif kind == "SetPositionMessage" and name in self.nodes:
+            self.nodes[name].position = tuple(m["position"])  # type: ignore[assignment]
+        elif kind == "SetSceneNodeVisibilityMessage" and name in self.nodes:
+            self.nodes[name].visible = bool(m["visible"])
+        elif kind == "SceneNodeUpdateMessage" and name in self.nodes:
+            self.nodes[name].props.update(m["updates"])
+        elif name is not None and isinstance(m.get("props"), dict):
+            self.nodes[name] = Node(kind, dict(m["props"]))
+        elif kind == "GuiRemoveMessage":
+            self.widgets.pop(m["uuid"], None)
+        elif kind == "GuiUpdateMessage" and m["uuid"] in self.widgets:
+            widget = self.widgets[m["uuid"]]
+            for key, value in m["updates"].items():
+                if key == "value":
+                    widget.value = value
+                else:
+                    widget.props[key] = value
+        elif kind.startswith("Gui") and "uuid" in m and isinstance(m.get("props"), dict):
+            self.widgets[m["uuid"]] = Widget(
+                kind, dict(m["props"]), m.get("value"), m.get("container_uuid", "")
+            )
+
+    # -- queries -------------------------------------------------------------------------
+    def wait_for(self, predicate: Callable[[Probe], bool], timeout: float = 10.0) -> bool:
+        """Wait until ``predicate(self)`` holds (evaluated under the model lock)."""
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            while not predicate(self):
+                remaining = deadline - time.monotonic()
+                if remaining <= 0 or self._closed:
+                    return predicate(self)
+                self._cond.wait(remaining)
+            return True
+
+    def snapshot(self) -> tuple[dict[str, Node], dict[str, Widget]]:
+        """A consistent copy of the model."""
+        with self._cond:
+            nodes = {k: dataclasses.replace(v, props=dict(v.props)) for k, v in self.nodes.items()}
+            widgets = {
+                k: dataclasses.replace(v, props=dict(v.props)) for k, v in self.widgets.items()
+            }
+        return nodes, widgets
+
+    def widget(self, label: str) -> tuple[str, Widget]:
+        """The (uuid, widget) whose label is ``label``."""
+        with self._cond:
+            for uuid, widget in self.widgets.items():
+                if widget.props.get("label") == label:
+                    return uuid, widget
+        raise KeyError(f"no widget labelled {label!r}; have {self.labels()}")
+
+    def labels(self) -> list[str]:
+        with self._cond:
+            return [w.props.get("label") for w in self.widgets.values() if w.props.get("label")]
+
+    def has_widget(self, label: str) -> bool:
+        return label in self.labels()

@@ -1,0 +1,455 @@
+"""Poinsot's construction as a viser scene, built on any scene API (``server.scene`` or a
+``client.scene``), so that sessions, exports and tests share one construction.
+
+Node tree (names are paths; a child inherits its parent's pose in the browser)::
+
+    /space                  space frame, L along +z, the fixed point at the origin
+    /space/plane            invariable plane, a disc at z = h (its pose is its height)
+    /space/L, /space/L/label
+    /space/omega            omega, an arrow from the origin to the contact point
+    /space/tip              a frame at the contact point (the tip of omega on the plane):
+    /space/tip/contact, /space/tip/omega_label      its marker and the omega label
+    /space/herpolhode/c*    herpolhode trail (space frame)
+    /space/body             body frame: its wxyz is the attitude R(t)
+    /space/body/ellipsoid   energy ellipsoid: unit icosphere scaled by the semi-axes
+    /space/body/axis{1,2,3}, .../label     principal axes and their labels
+    /space/body/solid       the solid body (box, disc, rod, T-handle)
+    /space/body/polhode_full, /space/body/polhode/c*   polhode (whole curve, live trail)
+
+Sizes: everything is drawn in *display units*, the physical lengths times one factor
+``scale = DISPLAY_RADIUS / max(semi_axes)`` so that the picture is the same size for any
+|omega0| and any inertia scale. Scaling the whole construction by one factor keeps every
+incidence (the ellipsoid touches the plane at the tip of omega).
+
+Traffic: :meth:`PoinsotScene.load` (once per parameter change) sends meshes, scales and
+static curves; :meth:`PoinsotScene.advance` (per frame) sends the body pose, the contact point,
+the omega arrow's tip, and trail increments only.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import math
+from collections.abc import Callable
+from typing import ContextManager
+
+import numpy as np
+import trimesh
+import viser
+
+from app import palette, solids
+from app.frames import wxyz
+from app.presets import Element, Solid
+from app.trail import Trail
+from physics import FreeRigidBody, Regime
+
+#: Largest semi-axis of the ellipsoid on screen [display units].
+DISPLAY_RADIUS = 1.0
+#: Radius of the plane disc and spacing of its grid [display units].
+PLANE_RADIUS = 1.75
+GRID_SPACING = 0.25
+#: The L arrow reaches this far above the plane [display units].
+L_OVERSHOOT = 0.65
+#: Principal axes extend past the ellipsoid by this factor.
+AXES_OVERSHOOT = 1.22
+#: Trails are resampled so that no chord is longer than this [display units].
+MAX_CHORD = 0.02
+#: At most this many trail samples per frame (a very fast motion is drawn coarser).
+MAX_SAMPLES_PER_FRAME = 48
+#: Lift of the herpolhode above the plane and growth of the polhode off the ellipsoid,
+#: against z-fighting with the surfaces they lie on (drawing only; the contact point and
+#: the omega arrow are exact).
+HERPOLHODE_LIFT = 0.004
+POLHODE_INFLATE = 1.004
+#: Points of the whole closed polhode.
+POLHODE_FULL_POINTS = 384
+
+ROOT = "/space"
+
+
+class SceneDataError(ValueError):
+    """Physics returned something the scene must not draw (NaN or infinity)."""
+
+
+def _finite(name: str, value) -> np.ndarray:
+    arr = np.asarray(value, dtype=np.float64)
+    if not np.all(np.isfinite(arr)):
+        raise SceneDataError(f"{name} is not finite; the scene keeps the last valid state")
+    return arr
+
+
+@dataclasses.dataclass(frozen=True)
+class Geometry:
+    """Everything :meth:`PoinsotScene.load` sends, in display units, computed (and checked
+    finite) before anything is sent, so that a failure leaves the previous scene intact."""
+
+    scale: float
+    semi_axes: np.ndarray  # (3,) display units
+    plane_height: float  # h in display units
+    polhode: np.ndarray  # (n, 3) body frame, display units
+    polhode_closed: bool  # False on the separatrix: an open arc between the two poles
+    solid_mesh: trimesh.Trimesh | None
+
+    @classmethod
+    def from_body(cls, body: FreeRigidBody, solid: Solid | None) -> Geometry:
+        semi = _finite("the semi-axes", body.semi_axes)
+        if not np.all(semi > 0.0):
+            raise SceneDataError("the body is at rest: there is no ellipsoid to draw")
+        scale = DISPLAY_RADIUS / float(np.max(semi))
+        h = float(_finite("the plane distance", body.plane_distance))
+        normal = _finite("the plane normal", body.plane_normal)
+        if not np.allclose(normal, (0.0, 0.0, 1.0), atol=1e-9):
+            raise SceneDataError(f"L is not vertical (plane normal {normal}); use attitude0")
+        polhode = _finite("the polhode", body.polhode(POLHODE_FULL_POINTS)) * scale
+        mesh = None
+        if solid is not None:
+            raw = solids.solid_mesh(solid)
+            fit = solids.fit_scale(np.asarray(raw.vertices), semi * scale)
+            mesh = solids.textured_solid_mesh(solid, fit)
+        closed = body.regime is not Regime.SEPARATRIX
+        return cls(scale, semi * scale, h * scale, polhode, closed, mesh)
+
+
+@dataclasses.dataclass(frozen=True)
+class Frame:
+    """What one call of :meth:`PoinsotScene.advance` drew (for readouts, plots, tests)."""
+
+    t: float
+    omega: np.ndarray  # (3,) body frame, physical units
+    wxyz: np.ndarray  # (4,) attitude as sent
+    contact: np.ndarray  # (3,) space frame, display units, as sent
+    samples: int  # trail points appended
+
+
+def sample_motion(body: FreeRigidBody, t: np.ndarray):
+    """omega (N,3), attitude (stack of N), contact point (N,3) at times ``t`` (N,), all from
+    physics; the only place the scene evaluates the motion."""
+    omega, rotation = body.state(t)
+    contact = body.contact_point(t)
+    return omega, rotation, contact
+
+
+class PoinsotScene:
+    """The scene nodes of one view. Create with the elements to draw; then :meth:`load` a body
+    and call :meth:`advance` every frame. Not thread-safe: one thread drives a scene."""
+
+    def __init__(
+        self,
+        api: viser.SceneApi,
+        elements: frozenset[Element],
+        trail_points: int = 1200,
+        root: str = ROOT,
+        atomic: Callable[[], ContextManager[None]] = contextlib.nullcontext,
+    ) -> None:
+        """``atomic``: the owner's ``atomic`` (``client.atomic`` or ``server.atomic``), so
+        that one frame's messages reach the browser together."""
+        self.api = api
+        self._atomic = atomic
+        self.root = root
+        self._trail_points = int(trail_points)
+        self._elements: frozenset[Element] = frozenset()
+        self._hidden: set[Element] = set()
+        self._nodes: dict[Element, list[viser.SceneNodeHandle]] = {}
+        self._trails: dict[Element, Trail] = {}
+        self._body: FreeRigidBody | None = None
+        self._solid: Solid | None = None
+        self._geometry: Geometry | None = None
+        self._t_last: float | None = None
+        self._last_points: dict[Element, np.ndarray] = {}
+        self.space = api.add_frame(root, show_axes=False)
+        self.body_frame = api.add_frame(f"{root}/body", show_axes=False)
+        self.tip = api.add_frame(f"{root}/tip", show_axes=False)
+        self.declare(elements)
+
+    # -- declaration ---------------------------------------------------------------------
+    @property
+    def elements(self) -> frozenset[Element]:
+        return self._elements
+
+    def declare(self, elements: frozenset[Element]) -> None:
+        """Draw exactly ``elements``: remove the nodes of the others, build the new ones."""
+        elements = frozenset(elements)
+        for element in self._elements - elements:
+            self._destroy(element)
+        added = elements - self._elements
+        self._elements = elements
+        if self._geometry is not None:
+            for element in sorted(added):
+                self._build(element)
+                self._apply_geometry(element)
+
+    def set_visible(self, element: Element, visible: bool) -> None:
+        if visible:
+            self._hidden.discard(element)
+        else:
+            self._hidden.add(element)
+        for handle in self._nodes.get(element, ()):
+            handle.visible = visible
+        if element in self._trails:
+            self._trails[element].visible = visible
+
+    def is_visible(self, element: Element) -> bool:
+        return element in self._elements and element not in self._hidden
+
+    @property
+    def trail_points(self) -> int:
+        return self._trail_points
+
+    @trail_points.setter
+    def trail_points(self, n: int) -> None:
+        self._trail_points = int(n)
+        for trail in self._trails.values():
+            trail.max_points = self._trail_points
+
+    def trail(self, element: Element) -> Trail | None:
+        return self._trails.get(element)
+
+    # -- per parameter change ------------------------------------------------------------
+    @property
+    def geometry(self) -> Geometry | None:
+        return self._geometry
+
+    @property
+    def body(self) -> FreeRigidBody | None:
+        return self._body
+
+    def load(self, body: FreeRigidBody, solid: Solid | None, t: float = 0.0) -> Frame:
+        """Show ``body`` (and ``solid``) at time ``t``. Raises ValueError, with the previous
+        scene untouched, if physics gives anything non-finite."""
+        geometry = Geometry.from_body(body, solid)
+        omega, rotation, contact = sample_motion(body, np.array([float(t)]))
+        first = (_finite("omega", omega), _finite("the attitude", wxyz(rotation)),
+                 _finite("the contact point", contact))
+        with self._atomic():
+            self._body, self._solid, self._geometry = body, solid, geometry
+            for element in sorted(self._elements):
+                if not self._nodes.get(element) and element not in self._trails:
+                    self._build(element)
+                self._apply_geometry(element)
+            for trail in self._trails.values():
+                trail.clear()
+            self._t_last = None
+            self._last_points.clear()
+            return self._draw(float(t), *first)
+
+    # -- per frame -----------------------------------------------------------------------
+    def advance(self, t: float) -> Frame:
+        """Pose the body at time ``t`` and extend the traces (resampled so that no chord is
+        longer than MAX_CHORD). Going back in time (reset) restarts the traces."""
+        body, geometry = self._body, self._geometry
+        if body is None or geometry is None:
+            raise RuntimeError("load() a body before advance()")
+        t = float(t)
+        times = np.array([t])
+        if self._t_last is not None and t > self._t_last and self._last_points:
+            omega, rotation, contact = sample_motion(body, times)
+            gap = self._gap(omega[0] * geometry.scale, contact[0] * geometry.scale)
+            n = min(MAX_SAMPLES_PER_FRAME, max(1, math.ceil(gap / MAX_CHORD)))
+            if n > 1:
+                times = self._t_last + (t - self._t_last) * np.arange(1, n + 1) / n
+                omega, rotation, contact = sample_motion(body, times)
+        else:
+            omega, rotation, contact = sample_motion(body, times)
+        quaternions = wxyz(rotation)
+        _finite("omega", omega)
+        _finite("the contact point", contact)
+        _finite("the attitude", quaternions)
+        with self._atomic():
+            return self._draw(t, omega, quaternions, contact)
+
+    def _gap(self, polhode_point: np.ndarray, herpolhode_point: np.ndarray) -> float:
+        gaps = [0.0]
+        if Element.POLHODE in self._last_points:
+            gaps.append(float(np.linalg.norm(polhode_point - self._last_points[Element.POLHODE])))
+        if Element.HERPOLHODE in self._last_points:
+            gaps.append(
+                float(np.linalg.norm(herpolhode_point - self._last_points[Element.HERPOLHODE]))
+            )
+        return max(gaps)
+
+    def _draw(self, t: float, omega, quaternions, contact) -> Frame:
+        geometry = self._geometry
+        assert geometry is not None
+        s = geometry.scale
+        polhode_pts = (omega * s).astype(np.float32)
+        herpolhode_pts = (contact * s).astype(np.float32)
+        if self._t_last is not None and t < self._t_last:
+            for trail in self._trails.values():
+                trail.clear()
+            self._last_points.clear()
+        q = quaternions[-1]
+        tip = herpolhode_pts[-1]
+        self.body_frame.wxyz = q
+        self.tip.position = tip
+        if Element.OMEGA in self._nodes:
+            self._nodes[Element.OMEGA][0].points = np.array([[[0.0, 0.0, 0.0], tip]], np.float32)
+        appended = 0
+        if t != self._t_last:
+            for element, pts in (
+                (Element.POLHODE, polhode_pts),
+                (Element.HERPOLHODE, herpolhode_pts),
+            ):
+                trail = self._trails.get(element)
+                if trail is not None:
+                    trail.append(pts)
+                    appended = len(pts)
+                self._last_points[element] = pts[-1]
+        self._t_last = t
+        return Frame(t, np.asarray(omega[-1]), q, tip.astype(np.float64), appended)
+
+    # -- element construction ------------------------------------------------------------
+    def _destroy(self, element: Element) -> None:
+        for handle in self._nodes.pop(element, []):
+            handle.remove()
+        trail = self._trails.pop(element, None)
+        if trail is not None:
+            trail.clear()
+            trail.group.remove()
+        self._last_points.pop(element, None)
+
+    def _build(self, element: Element) -> None:
+        api, r = self.api, self.root
+        nodes: list[viser.SceneNodeHandle] = []
+        if element is Element.ELLIPSOID:
+            # Sent as a plain mesh (the browser computes smooth normals; a GLB with normals
+            # and a non-uniform node scale did not render in viser 1.1).
+            sphere = solids.ellipsoid_unit_mesh()
+            nodes.append(
+                api.add_mesh_simple(
+                    f"{r}/body/ellipsoid", sphere.vertices, sphere.faces,
+                    color=palette.ELLIPSOID, opacity=palette.ELLIPSOID_OPACITY,
+                    material="standard", side="front", cast_shadow=False, receive_shadow=False,
+                )
+            )
+        elif element is Element.AXES:
+            # One node per axis: a uniform colour is taken as sRGB by the browser, whereas
+            # per-vertex colours are taken as linear and come out washed out.
+            for i in range(3):
+                nodes.append(
+                    api.add_line_segments(
+                        f"{r}/body/axis{i + 1}", np.zeros((1, 2, 3), np.float32),
+                        palette.AXES[i], thickness=palette.AXIS_WIDTH_PX,
+                        thickness_units="screen",
+                    )
+                )
+            for i in range(3):
+                nodes.append(
+                    api.add_label(
+                        f"{r}/body/axis{i + 1}/label", f"{i + 1}", anchor="center-center",
+                        font_screen_scale=1.3,
+                    )
+                )
+            nodes.append(
+                api.add_icosphere(
+                    f"{r}/origin", radius=0.03, color=palette.ORIGIN, cast_shadow=False
+                )
+            )
+        elif element is Element.PLANE:
+            plane = api.add_frame(f"{r}/plane", show_axes=False)
+            vertices, faces = solids.disc_mesh(PLANE_RADIUS)
+            nodes += [
+                plane,
+                api.add_mesh_simple(
+                    f"{r}/plane/disc", vertices, faces, color=palette.PLANE,
+                    opacity=palette.PLANE_OPACITY, side="double", cast_shadow=False,
+                    receive_shadow=False,
+                ),
+                api.add_line_segments(
+                    f"{r}/plane/grid", solids.disc_grid_segments(PLANE_RADIUS, GRID_SPACING),
+                    palette.PLANE_GRID, thickness=palette.GRID_WIDTH_PX,
+                    thickness_units="screen",
+                ),
+                api.add_line_segments(
+                    f"{r}/plane/rim", solids.circle_segments(PLANE_RADIUS),
+                    palette.PLANE_RIM, thickness=2.0, thickness_units="screen",
+                ),
+            ]
+        elif element is Element.CONTACT:
+            nodes.append(
+                api.add_icosphere(
+                    f"{r}/tip/contact", radius=0.035, color=palette.CONTACT, cast_shadow=False
+                )
+            )
+        elif element is Element.OMEGA:
+            # The label rides on /space/tip, posed at the contact point: no message of its own.
+            nodes += [
+                api.add_arrows(
+                    f"{r}/omega", np.array([[[0, 0, 0], [0, 0, 1]]], np.float32),
+                    palette.OMEGA, shaft_radius=0.014, head_radius=0.04, head_length=0.11,
+                ),
+                api.add_label(f"{r}/tip/omega_label", "ω", anchor="bottom-right",
+                              font_screen_scale=1.4, position=(-0.03, 0.0, -0.04)),
+            ]
+        elif element is Element.L:
+            nodes += [
+                api.add_arrows(
+                    f"{r}/L", np.array([[[0, 0, 0], [0, 0, 1]]], np.float32),
+                    palette.ANGULAR_MOMENTUM, shaft_radius=0.016, head_radius=0.05,
+                    head_length=0.14,
+                ),
+                api.add_label(f"{r}/L_label", "L", anchor="bottom-left",
+                              font_screen_scale=1.4),
+            ]
+        elif element is Element.POLHODE_FULL:
+            nodes.append(
+                api.add_line_segments(
+                    f"{r}/body/polhode_full", np.zeros((1, 2, 3), np.float32),
+                    palette.POLHODE_FULL, thickness=palette.FULL_POLHODE_WIDTH_PX,
+                    thickness_units="screen", scale=POLHODE_INFLATE,
+                )
+            )
+        elif element is Element.POLHODE:
+            self._trails[element] = Trail(
+                api, f"{r}/body/polhode", palette.POLHODE, palette.TRACE_WIDTH_PX,
+                self._trail_points, scale=POLHODE_INFLATE,
+            )
+        elif element is Element.HERPOLHODE:
+            self._trails[element] = Trail(
+                api, f"{r}/herpolhode", palette.HERPOLHODE, palette.TRACE_WIDTH_PX,
+                self._trail_points, position=(0.0, 0.0, HERPOLHODE_LIFT),
+            )
+        elif element is Element.SOLID:
+            pass  # built in _apply_geometry: the mesh itself changes with the body
+        self._nodes[element] = nodes
+        if element in self._hidden:
+            self.set_visible(element, False)
+
+    def _apply_geometry(self, element: Element) -> None:
+        """Send the per-parameter-change state of one element (sizes, static curves)."""
+        g = self._geometry
+        assert g is not None
+        nodes = self._nodes.get(element, [])
+        if element is Element.ELLIPSOID:
+            nodes[0].scale = tuple(float(a) for a in g.semi_axes)
+        elif element is Element.AXES:
+            ends = np.diag(g.semi_axes * AXES_OVERSHOOT)
+            for i in range(3):
+                nodes[i].points = np.array([[-ends[i], ends[i]]], dtype=np.float32)
+                nodes[3 + i].position = ends[i] * 1.08
+        elif element is Element.PLANE:
+            nodes[0].position = (0.0, 0.0, g.plane_height)
+        elif element is Element.L:
+            top = g.plane_height + L_OVERSHOOT
+            nodes[0].points = np.array([[[0.0, 0.0, 0.0], [0.0, 0.0, top]]], np.float32)
+            nodes[1].position = (0.04, 0.0, top - 0.05)
+        elif element is Element.POLHODE_FULL:
+            curve = g.polhode
+            if g.polhode_closed:
+                curve = np.concatenate([curve, curve[:1]])
+            curve = curve.astype(np.float32)
+            nodes[0].points = np.stack([curve[:-1], curve[1:]], axis=1)
+        elif element is Element.SOLID:
+            for handle in nodes:
+                handle.remove()
+            nodes.clear()
+            if g.solid_mesh is not None:
+                nodes.append(
+                    self.api.add_mesh_trimesh(
+                        f"{self.root}/body/solid", g.solid_mesh, cast_shadow=False,
+                        receive_shadow=False,
+                    )
+                )
+                if element in self._hidden:
+                    nodes[0].visible = False
+            self._nodes[element] = nodes

@@ -1,0 +1,77 @@
+"""The viser server and its sessions: one :class:`~app.session.Session` per browser."""
+
+from __future__ import annotations
+
+import threading
+import warnings
+
+import viser
+
+from app.presets import DEFAULT_PRESET, Preset
+from app.session import MAX_FPS, Session
+
+
+class PoinsotApp:
+    """Serve the Poinsot scene: each connecting browser gets its own session."""
+
+    def __init__(
+        self,
+        host: str = "127.0.0.1",
+        port: int = 8080,
+        *,
+        preset: Preset = DEFAULT_PRESET,
+        max_fps: float = MAX_FPS,
+        verbose: bool = False,
+    ) -> None:
+        self.preset = preset
+        self.max_fps = max_fps
+        self._lock = threading.Lock()
+        self._sessions: dict[int, Session] = {}
+        self._connected = threading.Condition(self._lock)
+        self.server = viser.ViserServer(host=host, port=port, verbose=verbose)
+        self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
+        self.server.scene.world_axes.visible = False
+        # A session's frame thread may draw one last frame between the browser leaving and the
+        # disconnect callback stopping it; viser then warns once that the message is dropped.
+        # That is expected here, not a leak: the thread stops right after.
+        warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection")
+        self.server.on_client_connect(self._connect)
+        self.server.on_client_disconnect(self._disconnect)
+
+    @property
+    def port(self) -> int:
+        return self.server.get_port()
+
+    @property
+    def url(self) -> str:
+        host = self.server.get_host()
+        shown = "localhost" if host in ("0.0.0.0", "::") else host
+        return f"http://{shown}:{self.port}"
+
+    def sessions(self) -> dict[int, Session]:
+        with self._lock:
+            return dict(self._sessions)
+
+    def wait_for_sessions(self, count: int, timeout: float = 10.0) -> list[Session]:
+        """Block until at least ``count`` sessions exist (tests, benchmark)."""
+        with self._connected:
+            self._connected.wait_for(lambda: len(self._sessions) >= count, timeout)
+            return list(self._sessions.values())
+
+    def _connect(self, client: viser.ClientHandle) -> None:
+        session = Session(client, self.preset, max_fps=self.max_fps)
+        with self._connected:
+            self._sessions[client.client_id] = session
+            self._connected.notify_all()
+        session.start()
+
+    def _disconnect(self, client: viser.ClientHandle) -> None:
+        with self._lock:
+            session = self._sessions.pop(client.client_id, None)
+        if session is not None:
+            session.close()
+
+    def stop(self) -> None:
+        for session in self.sessions().values():
+            session.close(timeout=2.0)
+        self.server.stop()

@@ -1,0 +1,314 @@
+"""One browser's session: its parameters, clock, scene, control panel and frame thread.
+
+Threads: viser runs GUI callbacks on its thread pool; they only post small actions to this
+session's queue and wake its frame thread, which alone touches the scene and the body. So a
+callback never blocks and never raises into viser, a slider drag is coalesced into one rebuild
+per wake-up, and a slow or departed browser never stalls another (each session has its own
+thread; viser gives each client its own send buffer, where newer poses replace unsent ones).
+"""
+
+from __future__ import annotations
+
+import collections
+import dataclasses
+import logging
+import queue
+import threading
+import time
+from collections.abc import Callable
+
+import viser
+
+from app import readouts
+from app.clock import SimClock
+from app.panel import ControlPanel
+from app.parameters import Parameters
+from app.presets import ALL_ELEMENTS, CUSTOM, DEFAULT_PRESET, Element, Preset, Solid
+from app.scene import Frame, PoinsotScene
+from app.view import DEFAULT_VIEW, View, apply_theme
+from physics import FreeRigidBody
+
+log = logging.getLogger(__name__)
+
+#: The animation rate cap per client [frames per second].
+MAX_FPS = 60.0
+#: Plot and time-readout refresh rates [Hz]: the plot resends its whole window.
+PLOT_HZ = 10.0
+TIME_HZ = 5.0
+#: "Step" advances this many wall seconds' worth of simulation time.
+STEP_SECONDS = 0.1
+
+
+@dataclasses.dataclass
+class SessionStats:
+    """Timings for the benchmark and the tests (seconds)."""
+
+    frame_seconds: collections.deque = dataclasses.field(
+        default_factory=lambda: collections.deque(maxlen=2000)
+    )
+    rebuild_seconds: collections.deque = dataclasses.field(
+        default_factory=lambda: collections.deque(maxlen=500)
+    )
+    frames: int = 0
+    rebuilds: int = 0
+    errors: int = 0
+    last_error: str = ""
+
+
+class Session:
+    """Create on client connect (:meth:`start` launches the frame thread), :meth:`close` on
+    disconnect."""
+
+    def __init__(
+        self,
+        client: viser.ClientHandle,
+        preset: Preset = DEFAULT_PRESET,
+        *,
+        max_fps: float = MAX_FPS,
+        view: View = DEFAULT_VIEW,
+    ) -> None:
+        self.client = client
+        self.max_fps = float(max_fps)
+        self.stats = SessionStats()
+        self.clock = SimClock(speed=preset.speed)
+        self.preset = preset
+        self._base = preset  # the last named preset: it supplies the solid
+        self.params = Parameters.from_preset(preset)
+        self._desired = self.params
+        self._dirty = True
+        self.body: FreeRigidBody | None = None
+        self.frame: Frame | None = None
+        self.status = ""
+        self._actions: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        self._wake = threading.Event()
+        self._stop = threading.Event()
+        self._applied = threading.Condition()
+        self._generation = 0  # bumped after each rebuild (tests wait on it)
+        self._thread: threading.Thread | None = None
+
+        apply_theme(client)
+        view.apply(client.camera)
+        self.scene = PoinsotScene(
+            client.scene, preset.elements, preset.trail_points, atomic=client.atomic
+        )
+        self.panel = ControlPanel(client.gui, self, preset)
+        self._apply_preset(preset)
+        self._rebuild()
+
+    # -- lifecycle -----------------------------------------------------------------------
+    def start(self) -> Session:
+        self._thread = threading.Thread(
+            target=self._run, name=f"poinsot-session-{self.client.client_id}", daemon=True
+        )
+        self._thread.start()
+        return self
+
+    def close(self, timeout: float | None = None) -> None:
+        """Stop the frame thread (never called from it). Safe to call twice."""
+        self._stop.set()
+        self._wake.set()
+        if timeout is not None and self._thread is not None:
+            if self._thread is not threading.current_thread():
+                self._thread.join(timeout)
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    # -- actions (any thread; never block) -----------------------------------------------
+    def _post(self, action: Callable[[], None]) -> None:
+        self._actions.put(action)
+        self._wake.set()
+
+    def choose_preset(self, preset: Preset) -> None:
+        self._post(lambda: self._apply_preset(preset))
+
+    def edit(self, change: Callable[[Parameters], Parameters]) -> None:
+        self._post(lambda: self._edit(change))
+
+    def set_speed(self, speed: float) -> None:
+        self._post(lambda: setattr(self.clock, "speed", speed))
+
+    def toggle_pause(self) -> None:
+        self._post(self._toggle_pause)
+
+    def set_paused(self, paused: bool) -> None:
+        def action() -> None:
+            self.clock.paused = paused
+            self._show_playback()
+
+        self._post(action)
+
+    def step(self) -> None:
+        self._post(self._step)
+
+    def reset(self) -> None:
+        self._post(self._reset)
+
+    def set_trail(self, points: int) -> None:
+        def action() -> None:
+            self.scene.trail_points = points
+
+        self._post(action)
+
+    def set_visible(self, element: Element, visible: bool) -> None:
+        self._post(lambda: self.scene.set_visible(element, visible))
+
+    def wait_applied(self, generation: int, timeout: float = 5.0) -> int:
+        """Block (tests, benchmark) until a rebuild after ``generation`` was applied."""
+        with self._applied:
+            self._applied.wait_for(lambda: self._generation > generation, timeout)
+            return self._generation
+
+    @property
+    def generation(self) -> int:
+        return self._generation
+
+    # -- frame thread --------------------------------------------------------------------
+    def _run(self) -> None:
+        period = 1.0 / self.max_fps
+        next_frame = time.monotonic()
+        last_plot = last_time = 0.0
+        while not self._stop.is_set():
+            delay = next_frame - time.monotonic()
+            if delay > 0:
+                self._wake.wait(delay)
+                self._wake.clear()
+            if self._stop.is_set():
+                break
+            try:
+                self._drain()
+                if self._dirty:
+                    self._rebuild()
+                now = time.monotonic()
+                if now >= next_frame:
+                    next_frame = now + period
+                    self._advance()
+                    if now - last_plot >= 1.0 / PLOT_HZ:
+                        last_plot = now
+                        self.panel.send_plot()
+                    if now - last_time >= 1.0 / TIME_HZ:
+                        last_time = now
+                        self.panel.show_time(self.clock.now(), self.clock.paused)
+                        self.panel.collect(now)
+            except Exception as exc:  # the loop must survive anything; the user sees it
+                self._report(exc)
+                next_frame = time.monotonic() + period
+
+    def _drain(self) -> None:
+        while True:
+            try:
+                action = self._actions.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                action()
+            except Exception as exc:
+                self._report(exc)
+
+    def _advance(self) -> None:
+        if self.body is None:
+            return
+        start = time.perf_counter()
+        t = self.clock.now()
+        self.frame = self.scene.advance(t)
+        self.panel.record_plot(t, self.frame.omega)
+        self.stats.frame_seconds.append(time.perf_counter() - start)
+        self.stats.frames += 1
+
+    def _report(self, exc: BaseException) -> None:
+        self.stats.errors += 1
+        message = f"{type(exc).__name__}: {exc}"
+        if message != self.stats.last_error:
+            log.exception("session %s: %s", self.client.client_id, message, exc_info=exc)
+            self.stats.last_error = message
+        try:
+            self._set_status(f"Internal error ({message}); the last valid scene is kept.")
+        except Exception:  # the GUI itself may be gone (client left)
+            pass
+
+    # -- state changes (frame thread only) -----------------------------------------------
+    def _set_status(self, message: str) -> None:
+        self.status = message
+        self.panel.show_status(message)
+
+    def _apply_preset(self, preset: Preset) -> None:
+        self.preset = preset
+        if preset is not CUSTOM:
+            self._base = preset
+            self._desired = Parameters.from_preset(preset)
+            self.clock.speed = preset.speed
+            self.scene.trail_points = preset.trail_points
+            self._dirty = True
+        self.scene.declare(preset.elements)
+        self.panel.declare(
+            preset.controls, preset.plots, preset.elements, self._desired, self.clock.speed,
+            self.scene.trail_points, self.scene.is_visible,
+        )
+        self.panel.show_preset(preset)
+        self._show_playback()
+
+    def _edit(self, change: Callable[[Parameters], Parameters]) -> None:
+        new = change(self._desired)
+        if new == self._desired:
+            return
+        self._desired = new
+        self._dirty = True
+        if self.preset is not CUSTOM and not new.matches(self.preset):
+            # Edited by hand: the scene becomes "Custom", which declares everything. Only
+            # additions happen here, so the slider being dragged stays in place.
+            self.preset = CUSTOM
+            self.scene.declare(ALL_ELEMENTS)
+            self.panel.declare(
+                CUSTOM.controls, CUSTOM.plots, CUSTOM.elements, new, self.clock.speed,
+                self.scene.trail_points, self.scene.is_visible,
+            )
+            self.panel.show_preset(CUSTOM)
+
+    def _solid(self, params: Parameters) -> Solid | None:
+        """The base preset's solid while the moments are still the preset's."""
+        base = Parameters.from_preset(self._base)
+        if params.inertia == base.inertia:
+            return self._base.solid
+        return None
+
+    def _rebuild(self) -> None:
+        """Build the body for the desired parameters and load it; on a ValueError keep the
+        last valid scene and say why."""
+        start = time.perf_counter()
+        desired = self._desired
+        self._dirty = False
+        try:
+            body = desired.build()
+            self.clock.reset(0.0)
+            self.frame = self.scene.load(body, self._solid(desired), t=0.0)
+        except ValueError as exc:
+            self._set_status(f"{exc} Showing the last valid body.")
+        else:
+            self.body, self.params = body, desired
+            self.panel.show_parameters(desired)
+            self.panel.show_readouts(readouts.markdown(body))
+            self.panel.clear_plot()
+            self.panel.record_plot(0.0, self.frame.omega)
+            self._set_status("")
+        self.stats.rebuild_seconds.append(time.perf_counter() - start)
+        self.stats.rebuilds += 1
+        with self._applied:
+            self._generation += 1
+            self._applied.notify_all()
+
+    def _toggle_pause(self) -> None:
+        self.clock.paused = not self.clock.paused
+        self._show_playback()
+
+    def _step(self) -> None:
+        self.clock.paused = True
+        self.clock.step(STEP_SECONDS * self.clock.speed)
+        self._show_playback()
+
+    def _reset(self) -> None:
+        self.clock.reset(0.0)
+        self.panel.clear_plot()
+
+    def _show_playback(self) -> None:
+        self.panel.show_playback(self.clock.speed, self.clock.paused, self.scene.trail_points)

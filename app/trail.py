@@ -1,0 +1,141 @@
+"""A bounded trace that grows by increments: the polhode and the herpolhode.
+
+Viser resends a node's whole ``points`` array when it changes, so a single growing line would
+cost O(trail length) bytes per frame. Instead the trail is a ring of small line-segment nodes
+("chunks"): each frame only the head chunk (at most ``chunk`` segments) is resent; a full head
+is frozen and a new one started; the oldest chunks are removed once the trail is longer than
+its length. Bytes per frame are bounded by the chunk size, and the length by ``max_points``.
+"""
+
+from __future__ import annotations
+
+import collections
+
+import numpy as np
+import viser
+
+#: Segments per chunk: the most a frame resends (24 segments x 2 x 3 float32 = 576 bytes).
+CHUNK_SEGMENTS = 24
+
+
+class Trail:
+    """A polyline under scene node ``name`` (a group frame; its children are the chunks)."""
+
+    def __init__(
+        self,
+        api: viser.SceneApi,
+        name: str,
+        color: tuple[int, int, int],
+        width_px: float,
+        max_points: int,
+        *,
+        position: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        scale: float = 1.0,
+        chunk: int = CHUNK_SEGMENTS,
+    ) -> None:
+        self._api = api
+        self._name = name
+        self._color = np.asarray(color, dtype=np.uint8)
+        self._width = float(width_px)
+        self._scale = float(scale)
+        self._chunk = int(chunk)
+        self._max_points = max(int(max_points), 2 * self._chunk)
+        self.group = api.add_frame(name, show_axes=False, position=position)
+        self._frozen: collections.deque[tuple[viser.LineSegmentsHandle, int]] = (
+            collections.deque()
+        )
+        self._head: viser.LineSegmentsHandle | None = None
+        self._head_segments = np.zeros((0, 2, 3), dtype=np.float32)
+        self._last: np.ndarray | None = None
+        self._counter = 0
+
+    # -- state ---------------------------------------------------------------------------
+    @property
+    def segment_count(self) -> int:
+        return sum(n for _, n in self._frozen) + len(self._head_segments)
+
+    @property
+    def max_points(self) -> int:
+        return self._max_points
+
+    @max_points.setter
+    def max_points(self, n: int) -> None:
+        self._max_points = max(int(n), 2 * self._chunk)
+        self._trim()
+
+    @property
+    def visible(self) -> bool:
+        return self.group.visible
+
+    @visible.setter
+    def visible(self, visible: bool) -> None:
+        self.group.visible = visible
+
+    def points(self) -> np.ndarray:
+        """All points currently drawn, oldest first, shape (N, 3) (for tests and exports)."""
+        parts = [h.points for h, _ in self._frozen]
+        parts.append(self._head_segments)
+        segments = np.concatenate(parts) if parts else np.zeros((0, 2, 3), np.float32)
+        if len(segments) == 0:
+            return np.zeros((0, 3), dtype=np.float32)
+        return np.concatenate([segments[:, 0], segments[-1:, 1]])
+
+    # -- mutation ------------------------------------------------------------------------
+    def clear(self) -> None:
+        for handle, _ in self._frozen:
+            handle.remove()
+        self._frozen.clear()
+        if self._head is not None:
+            self._head.remove()
+        self._head = None
+        self._head_segments = np.zeros((0, 2, 3), dtype=np.float32)
+        self._last = None
+
+    def append(self, points: np.ndarray) -> None:
+        """Extend the polyline through ``points`` (N, 3); the first call only sets the start."""
+        points = np.asarray(points, dtype=np.float32).reshape(-1, 3)
+        if len(points) == 0:
+            return
+        if self._last is None:
+            self._last = points[0]
+            points = points[1:]
+            if len(points) == 0:
+                return
+        chain = np.concatenate([self._last[None], points])
+        new = np.stack([chain[:-1], chain[1:]], axis=1)
+        self._last = points[-1]
+        while len(new):
+            room = self._chunk - len(self._head_segments)
+            if room == 0:
+                self._freeze_head()
+                continue
+            take, new = new[:room], new[room:]
+            self._head_segments = np.concatenate([self._head_segments, take])
+            self._send_head()
+        self._trim()
+
+    # -- internals -----------------------------------------------------------------------
+    def _send_head(self) -> None:
+        if self._head is None:
+            self._counter += 1
+            self._head = self._api.add_line_segments(
+                f"{self._name}/c{self._counter}",
+                self._head_segments,
+                self._color,
+                thickness=self._width,
+                thickness_units="screen",
+                scale=self._scale,
+            )
+        else:
+            self._head.points = self._head_segments
+
+    def _freeze_head(self) -> None:
+        if self._head is not None:
+            self._frozen.append((self._head, len(self._head_segments)))
+        self._head = None
+        self._head_segments = np.zeros((0, 2, 3), dtype=np.float32)
+
+    def _trim(self) -> None:
+        while self._frozen and self.segment_count - self._frozen[0][1] >= self._max_points:
+            handle, _ = self._frozen.popleft()
+            handle.remove()

@@ -1,0 +1,56 @@
+"""Camera views and the look of the page (theme, lights)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import viser
+
+from app import palette
+
+
+@dataclasses.dataclass(frozen=True)
+class View:
+    """A camera pose in display units (the scene's largest semi-axis is 1, L is +z)."""
+
+    position: tuple[float, float, float]
+    look_at: tuple[float, float, float]
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    fov_degrees: float = 45.0
+
+    def apply(self, camera: viser.CameraHandle) -> None:
+        camera.up_direction = self.up
+        camera.position = self.position
+        camera.look_at = self.look_at
+        camera.fov = self.fov_degrees * 3.141592653589793 / 180.0
+
+
+#: Slightly above the plane, three-quarter view: the ellipsoid under the plane, the plane's
+#: herpolhode and the L arrow all in frame on a 16:9 projector.
+DEFAULT_VIEW = View(position=(2.6, -3.2, 1.55), look_at=(0.0, 0.0, 0.3))
+VIEWS: dict[str, View] = {
+    "default": DEFAULT_VIEW,
+    "top": View(position=(0.0, -0.01, 6.0), look_at=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0)),
+    "side": View(position=(0.0, -5.6, 0.9), look_at=(0.0, 0.0, 0.3)),
+}
+
+
+def apply_theme(client: viser.ClientHandle) -> None:
+    """Dark theme, no share button (it needs the internet), brand colour of the ellipsoid.
+
+    Lighting: viser's default lights without shadow maps (nothing here casts a useful shadow,
+    and re-rendering the shadow maps every frame tripled the frame time of a software-WebGL
+    browser), and a hemisphere fill light instead of an environment map (which halved it again)."""
+    client.gui.configure_theme(
+        dark_mode=True,
+        show_share_button=False,
+        show_logo=False,
+        brand_color=palette.BRAND,
+        control_width="medium",
+    )
+    client.gui.set_panel_label("Poinsot: free rigid body")
+    client.scene.configure_default_lights(enabled=True, cast_shadow=False)
+    client.scene.configure_environment_map(None)
+    client.scene.add_light_hemisphere(
+        "/lights/fill", sky_color=(200, 215, 255), ground_color=(70, 55, 40), intensity=1.2
+    )

@@ -1,0 +1,241 @@
+"""Shared fixtures: a live Poinsot server, websocket probes, and headless Chromium pages.
+
+Browser tests use Debian's Chromium through playwright (``executable_path``, no
+``playwright install``). If Chromium is missing they are skipped locally with the reason, but
+FAIL when ``CI`` is set: CI must never pass by silently skipping them.
+
+Reusable pieces (also for the screenshot/export tests of issue 5):
+- ``poinsot_app`` (factory ``make_app``): a :class:`app.server.PoinsotApp` on a free port;
+- ``probe`` (factory ``make_probe``): a headless websocket client (:mod:`app.probe`);
+- ``chromium`` (session scope): a launched playwright Browser;
+- ``open_page``: ``open_page(url, width=..., height=...) -> BrowserPage`` with the console
+  errors collected, the canvas ready and the software-WebGL notice dismissed;
+- ``BrowserPage`` helpers to drive viser's widgets by their label, and ``screenshot_rgb``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import os
+import re
+import shutil
+import time
+from collections.abc import Callable, Iterator
+
+import numpy as np
+import pytest
+
+from app.presets import DEFAULT_PRESET, Preset
+from app.probe import Probe
+from app.server import PoinsotApp
+from app.session import Session
+
+CHROMIUM = os.environ.get("POINSOT_CHROMIUM", "/usr/bin/chromium")
+#: Flags that work here: headless, root, closed network, SwiftShader WebGL.
+CHROMIUM_ARGS = (
+    "--no-sandbox",
+    "--disable-gpu",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+)
+#: Console messages that are not errors of ours (they are emitted at "warning" level anyway;
+#: listed so that a change of level in a later viser does not fail the suite silently).
+BENIGN_CONSOLE = ("GPU stall due to ReadPixels", "THREE.Clock: This module has been deprecated")
+
+
+def in_ci() -> bool:
+    return os.environ.get("CI", "").lower() not in ("", "0", "false", "no")
+
+
+def chromium_or_fail() -> str:
+    """The Chromium executable; skip (locally) or fail (CI) with instructions if missing."""
+    path = CHROMIUM if os.path.isabs(CHROMIUM) else shutil.which(CHROMIUM)
+    if path and os.access(path, os.X_OK):
+        return path
+    message = (
+        f"Chromium not found at {CHROMIUM!r}: run `make chromium` (Debian's chromium package) "
+        "or set POINSOT_CHROMIUM"
+    )
+    if in_ci():
+        pytest.fail(message + " [CI=true: browser tests must run]")
+    pytest.skip(message)
+
+
+# -- servers and probes ------------------------------------------------------------------
+@pytest.fixture
+def make_app() -> Iterator[Callable[..., PoinsotApp]]:
+    apps: list[PoinsotApp] = []
+
+    def make(preset: Preset = DEFAULT_PRESET, **kwargs) -> PoinsotApp:
+        app = PoinsotApp("127.0.0.1", 0, preset=preset, **kwargs)
+        apps.append(app)
+        return app
+
+    yield make
+    for app in apps:
+        app.stop()
+
+
+@pytest.fixture
+def poinsot_app(make_app) -> PoinsotApp:
+    return make_app()
+
+
+@pytest.fixture
+def make_probe() -> Iterator[Callable[..., Probe]]:
+    probes: list[Probe] = []
+
+    def make(app: PoinsotApp, **kwargs) -> Probe:
+        probe = Probe(app.port, **kwargs)
+        probes.append(probe)
+        return probe
+
+    yield make
+    for probe in probes:
+        probe.close()
+
+
+@pytest.fixture
+def probe(poinsot_app, make_probe) -> Probe:
+    """A probe connected to ``poinsot_app``, once its session has drawn the scene."""
+    p = make_probe(poinsot_app)
+    assert p.wait_for(lambda p: "/space/body/ellipsoid" in p.nodes, 15), "scene never arrived"
+    return p
+
+
+def session_of(app: PoinsotApp, count: int = 1, timeout: float = 10.0) -> Session:
+    """The newest session of ``app`` (waiting until ``count`` sessions exist)."""
+    sessions = app.wait_for_sessions(count, timeout)
+    assert len(sessions) >= count, f"only {len(sessions)} sessions"
+    return max(sessions, key=lambda s: s.client.client_id)
+
+
+def wait_until(predicate: Callable[[], bool], timeout: float = 10.0, poll: float = 0.02) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        time.sleep(poll)
+    return predicate()
+
+
+# -- browsers ------------------------------------------------------------------------------
+@pytest.fixture(scope="session")
+def chromium():
+    path = chromium_or_fail()
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=path, headless=True, args=CHROMIUM_ARGS)
+        yield browser
+        browser.close()
+
+
+@dataclasses.dataclass
+class BrowserPage:
+    """A page on the app with its console errors; helpers drive viser's widgets by label."""
+
+    page: object  # playwright.sync_api.Page
+    errors: list[str]
+
+    def widget_id(self, label: str) -> str:
+        exact = re.compile(f"^{re.escape(label)}$")
+        loc = self.page.locator("label").filter(has_text=exact)  # type: ignore[attr-defined]
+        return loc.first.get_attribute("for")
+
+    def press_slider(self, label: str, key: str, times: int = 1) -> None:
+        """Move a slider with the keyboard (each press = one step, like a user would)."""
+        thumb = self.page.locator(f"[id='{self.widget_id(label)}'] [role=slider]")  # type: ignore[attr-defined]
+        thumb.focus()
+        for _ in range(times):
+            thumb.press(key)
+
+    def slider_value(self, label: str) -> float:
+        thumb = self.page.locator(f"[id='{self.widget_id(label)}'] [role=slider]")  # type: ignore[attr-defined]
+        return float(thumb.get_attribute("aria-valuenow"))
+
+    def choose(self, label: str, option: str) -> None:
+        """Pick ``option`` in the dropdown labelled ``label``."""
+        self.page.locator(f"[id='{self.widget_id(label)}']").click()  # type: ignore[attr-defined]
+        self.page.get_by_role("option", name=option, exact=True).click()  # type: ignore[attr-defined]
+
+    def dropdown_value(self, label: str) -> str:
+        return self.page.locator(f"[id='{self.widget_id(label)}']").input_value()  # type: ignore[attr-defined]
+
+    def click_button(self, text: str) -> None:
+        self.page.get_by_role("button", name=text, exact=True).click()  # type: ignore[attr-defined]
+
+    def set_checkbox(self, label: str, checked: bool) -> None:
+        box = self.page.locator(f"[id='{self.widget_id(label)}']")  # type: ignore[attr-defined]
+        if box.is_checked() != checked:
+            box.click()
+
+    def screenshot_rgb(self) -> np.ndarray:
+        """The viewport as an (H, W, 3) uint8 array."""
+        from PIL import Image
+
+        png = self.page.screenshot(type="png")  # type: ignore[attr-defined]
+        return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
+
+    def canvas_box(self) -> dict[str, float]:
+        return self.page.locator("canvas").first.bounding_box()  # type: ignore[attr-defined]
+
+
+_CLOSE_NOTICE_JS = """() => {
+  const notice = document.getElementById('webgl-software-rendering');
+  if (!notice) return false;
+  const button = notice.querySelector('button.mantine-Notification-closeButton');
+  if (button) button.click();
+  return true;
+}"""
+
+
+def _dismiss_software_webgl_notice(page, timeout: float = 30.0) -> None:
+    """Close viser's "Software WebGL rendering detected" notice (SwiftShader) so that it does
+    not cover the canvas. Done in page JavaScript (no locator waits: the page's main thread is
+    busy rendering, so playwright's actionability checks can take seconds); repeated until the
+    notice has stayed away for a moment, since it can appear late. A GPU browser never shows it."""
+    deadline = time.monotonic() + timeout
+    seen = False
+    absent_since: float | None = None
+    while time.monotonic() < deadline:
+        if page.evaluate(_CLOSE_NOTICE_JS):
+            seen, absent_since = True, None
+        elif absent_since is None:
+            absent_since = time.monotonic()
+        elif time.monotonic() - absent_since > (1.0 if seen else 4.0):
+            return
+        page.wait_for_timeout(250)
+    raise AssertionError("the software-WebGL notice could not be dismissed")
+
+
+@pytest.fixture
+def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
+    contexts = []
+
+    def open_(url: str, width: int = 1280, height: int = 720) -> BrowserPage:
+        context = chromium.new_context(viewport={"width": width, "height": height})
+        contexts.append(context)
+        page = context.new_page()
+        errors: list[str] = []
+        page.on(
+            "console",
+            lambda m: errors.append(m.text)
+            if m.type == "error" and not any(b in m.text for b in BENIGN_CONSOLE)
+            else None,
+        )
+        page.on("pageerror", lambda e: errors.append(f"pageerror: {e}"))
+        page.goto(url)
+        page.locator("canvas").first.wait_for(state="visible", timeout=20000)
+        _dismiss_software_webgl_notice(page)
+        return BrowserPage(page, errors)
+
+    yield open_
+    for context in contexts:
+        context.close()
