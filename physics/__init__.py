@@ -11,5 +11,13 @@ regime, plus the geometry of Poinsot's construction (polhode, herpolhode, invari
 
 from physics.regime import Regime
 from physics.rigid_body import FreeRigidBody, attitude_with_L_along_z, omega_from_energy
+from physics.solids import box_dimensions, check_real_body
 
-__all__ = ["FreeRigidBody", "Regime", "attitude_with_L_along_z", "omega_from_energy"]
+__all__ = [
+    "FreeRigidBody",
+    "Regime",
+    "attitude_with_L_along_z",
+    "box_dimensions",
+    "check_real_body",
+    "omega_from_energy",
+]

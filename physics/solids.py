@@ -1,0 +1,67 @@
+"""Real bodies behind a set of principal moments: the triangle inequality and a box.
+
+The free-body mathematics holds for any positive moments, so :class:`~physics.FreeRigidBody`
+accepts them all. A *real* mass distribution also obeys ``I_i <= I_j + I_k`` for every axis
+(since ``I_j + I_k - I_i = 2 Σ m x_i² >= 0``); equality is a flat lamina in the plane normal to
+axis i. These helpers let a scene say so and show a homogeneous box with the same moments.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from physics.rigid_body import _check_inertia
+
+__all__ = ["check_real_body", "box_dimensions"]
+
+# Relative slack when testing I_i <= I_j + I_k: a lamina computed in floating point may exceed
+# the equality by a few ulps, which is rounding, not a violation.
+_TRIANGLE_RTOL = 8.0 * np.finfo(float).eps
+
+
+def check_real_body(inertia) -> None:
+    """Raise ``ValueError`` unless some real body has these principal moments.
+
+    Args:
+        inertia: (3,) principal moments (any order, positive, finite).
+
+    Raises:
+        ValueError: bad moments (as :class:`FreeRigidBody`), or a moment larger than the sum of
+            the other two, with a message naming the offending axis.
+    """
+    moments = _check_inertia(inertia)
+    total = float(moments.sum())
+    for i in range(3):
+        others = total - moments[i]
+        if moments[i] > others * (1.0 + _TRIANGLE_RTOL):
+            j, k = (x for x in range(3) if x != i)
+            raise ValueError(
+                f"no real body has these moments: I{i + 1} = {moments[i]:g} is larger than "
+                f"I{j + 1} + I{k + 1} = {others:g} (every moment must be at most the sum of the "
+                "other two; equality is a flat plate)"
+            )
+
+
+def box_dimensions(inertia, mass: float = 1.0) -> np.ndarray:
+    """Side lengths of the homogeneous box with these principal moments about its centre.
+
+    ``I1 = m (a2² + a3²)/12`` and cyclic, hence ``a1² = 6 (I2 + I3 - I1)/m``.
+
+    Args:
+        inertia: (3,) principal moments in the caller's order [mass · length²].
+        mass: the box's mass (> 0), in the same mass unit.
+
+    Returns:
+        (3,) full side lengths ``(a1, a2, a3)`` along the caller's axes [length]; a flat lamina
+        has a zero side.
+
+    Raises:
+        ValueError: if no real body has these moments (see :func:`check_real_body`), or the
+            mass is not positive and finite.
+    """
+    check_real_body(inertia)
+    if not (np.isfinite(mass) and mass > 0.0):
+        raise ValueError(f"the mass must be positive and finite, got {mass}")
+    moments = np.asarray(inertia, dtype=float)
+    excess = moments.sum() - 2.0 * moments  # I_j + I_k - I_i, >= 0 up to rounding
+    return np.sqrt(6.0 * np.maximum(excess, 0.0) / mass)
