@@ -14,8 +14,13 @@ from scipy.spatial.transform import Rotation
 def wxyz(rotation: Rotation) -> np.ndarray:
     """Viser orientation (w, x, y, z), w >= 0: shape (4,) for a single rotation, (N, 4) for a
     stack."""
-    xyzw = np.asarray(rotation.as_quat(), dtype=np.float64)
-    q = np.roll(xyzw, 1, axis=-1)
+    return wxyz_from_xyzw(rotation.as_quat())
+
+
+def wxyz_from_xyzw(xyzw: np.ndarray) -> np.ndarray:
+    """The same for quaternions already taken out of scipy (``Rotation.as_quat()``, scalar
+    last), (4,) or (N, 4)."""
+    q = np.roll(np.asarray(xyzw, dtype=np.float64), 1, axis=-1)
     return np.where(q[..., :1] < 0.0, -q, q)
 
 

@@ -42,7 +42,7 @@ ELEMENT_LABELS: dict[Element, str] = {
 SIDE_OPTIONS = ("minor axis", "major axis")
 POLE_OPTIONS = ("+ pole", "− pole")
 
-#: Number of plot samples kept (10 per second of wall time: 30 s).
+#: Number of plot samples kept (one per plot refresh, 10 per second: the last 30 s).
 PLOT_SAMPLES = 300
 #: Delay between hiding a removed widget and deleting it [s].
 RETIRE_SECONDS = 1.5
@@ -397,7 +397,7 @@ class ControlPanel:
         self._plot_t, self._plot_w = [], []
 
     def record_plot(self, t: float, omega: np.ndarray) -> None:
-        """Add a sample; the caller sends with :meth:`send_plot` at its own (low) rate."""
+        """Add a sample (the session does, at the plot's refresh rate, then sends)."""
         if "plot" not in self.handles:
             return
         if self._plot_t and t < self._plot_t[-1]:

@@ -99,6 +99,8 @@ class Probe:
             open_timeout=10,
         )
         self._closed = False
+        self._reading = threading.Event()
+        self._reading.set()
         self._thread = threading.Thread(target=self._receive, daemon=True, name="viser-probe")
         self._thread.start()
         self.send(
@@ -118,8 +120,16 @@ class Probe:
     def close(self) -> None:
         if not self._closed:
             self._closed = True
+            self._reading.set()
             self._ws.close()
             self._thread.join(5.0)
+
+    def stall(self, stalled: bool = True) -> None:
+        """Stop (or resume) reading from the socket: a frozen or very slow browser."""
+        if stalled:
+            self._reading.clear()
+        else:
+            self._reading.set()
 
     # -- sending -------------------------------------------------------------------------
     def send(self, message: _messages.Message) -> None:
@@ -137,7 +147,11 @@ class Probe:
 
     def _receive(self) -> None:
         try:
-            for frame in self._ws:
+            while True:
+                self._reading.wait()
+                if self._closed:
+                    break
+                frame = self._ws.recv()
                 now = time.perf_counter()
                 assert isinstance(frame, bytes)
                 messages = _decode_frame(frame)

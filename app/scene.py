@@ -39,7 +39,8 @@ import trimesh
 import viser
 
 from app import palette, solids
-from app.frames import wxyz
+from app.frames import wxyz_from_xyzw
+from app.motion import MotionSampler, Samples, trace_speed
 from app.presets import Element, Solid
 from app.trail import Trail
 from physics import FreeRigidBody, Regime
@@ -53,10 +54,13 @@ GRID_SPACING = 0.25
 L_OVERSHOOT = 0.65
 #: Principal axes extend past the ellipsoid by this factor.
 AXES_OVERSHOOT = 1.22
-#: Trails are resampled so that no chord is longer than this [display units].
+#: Trace points are at most this far apart [display units] (see app/motion.py).
 MAX_CHORD = 0.02
-#: At most this many trail samples per frame (a very fast motion is drawn coarser).
-MAX_SAMPLES_PER_FRAME = 48
+#: At most this many grid samples per frame (after a long stall the trace takes a chord).
+MAX_SAMPLES_PER_FRAME = 64
+#: The traces are sent every TRAIL_EVERY frames (30 Hz at 60 frames per second): half the
+#: messages, and the trace's end trails the contact point by at most one frame.
+TRAIL_EVERY = 2
 #: Lift of the herpolhode above the plane and growth of the polhode off the ellipsoid,
 #: against z-fighting with the surfaces they lie on (drawing only; the contact point and
 #: the omega arrow are exact).
@@ -90,6 +94,7 @@ class Geometry:
     polhode: np.ndarray  # (n, 3) body frame, display units
     polhode_closed: bool  # False on the separatrix: an open arc between the two poles
     solid_mesh: trimesh.Trimesh | None
+    trace_speed: float  # fastest trace point [display units per time unit]
 
     @classmethod
     def from_body(cls, body: FreeRigidBody, solid: Solid | None) -> Geometry:
@@ -108,7 +113,8 @@ class Geometry:
             fit = solids.fit_scale(np.asarray(raw.vertices), semi * scale)
             mesh = solids.textured_solid_mesh(solid, fit)
         closed = body.regime is not Regime.SEPARATRIX
-        return cls(scale, semi * scale, h * scale, polhode, closed, mesh)
+        speed = _finite("the trace speed", trace_speed(body, scale))
+        return cls(scale, semi * scale, h * scale, polhode, closed, mesh, float(speed))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -119,15 +125,7 @@ class Frame:
     omega: np.ndarray  # (3,) body frame, physical units
     wxyz: np.ndarray  # (4,) attitude as sent
     contact: np.ndarray  # (3,) space frame, display units, as sent
-    samples: int  # trail points appended
-
-
-def sample_motion(body: FreeRigidBody, t: np.ndarray):
-    """omega (N,3), attitude (stack of N), contact point (N,3) at times ``t`` (N,), all from
-    physics; the only place the scene evaluates the motion."""
-    omega, rotation = body.state(t)
-    contact = body.contact_point(t)
-    return omega, rotation, contact
+    samples: int  # trace samples evaluated for this frame
 
 
 class PoinsotScene:
@@ -155,8 +153,11 @@ class PoinsotScene:
         self._body: FreeRigidBody | None = None
         self._solid: Solid | None = None
         self._geometry: Geometry | None = None
-        self._t_last: float | None = None
-        self._last_points: dict[Element, np.ndarray] = {}
+        self._sampler: MotionSampler | None = None
+        self._k_last: int | None = None
+        self._frame: Frame | None = None
+        self._pending: dict[Element, list[np.ndarray]] = {}
+        self._frames_since_flush = 0
         self.space = api.add_frame(root, show_axes=False)
         self.body_frame = api.add_frame(f"{root}/body", show_axes=False)
         self.tip = api.add_frame(f"{root}/tip", show_axes=False)
@@ -178,6 +179,8 @@ class PoinsotScene:
             for element in sorted(added):
                 self._build(element)
                 self._apply_geometry(element)
+            if added:
+                self._frame = None  # the next advance() draws even if time stands still
 
     def set_visible(self, element: Element, visible: bool) -> None:
         if visible:
@@ -214,89 +217,113 @@ class PoinsotScene:
     def body(self) -> FreeRigidBody | None:
         return self._body
 
-    def load(self, body: FreeRigidBody, solid: Solid | None, t: float = 0.0) -> Frame:
-        """Show ``body`` (and ``solid``) at time ``t``. Raises ValueError, with the previous
-        scene untouched, if physics gives anything non-finite."""
+    def load(
+        self, body: FreeRigidBody, solid: Solid | None, t: float = 0.0,
+        frame_time: float = 1.0 / 60.0,
+    ) -> Frame:
+        """Show ``body`` (and ``solid``) at time ``t``; ``frame_time`` is the simulation time one
+        frame advances (speed / frame rate). Raises ValueError, with the previous scene
+        untouched, if physics gives anything non-finite."""
         geometry = Geometry.from_body(body, solid)
-        omega, rotation, contact = sample_motion(body, np.array([float(t)]))
-        first = (_finite("omega", omega), _finite("the attitude", wxyz(rotation)),
-                 _finite("the contact point", contact))
+        sampler = MotionSampler.for_body(body, geometry.trace_speed, frame_time, MAX_CHORD, t)
+        k = sampler.index(t)
+        first = self._checked(sampler.samples(k, k))
         with self._atomic():
             self._body, self._solid, self._geometry = body, solid, geometry
+            self._sampler = sampler
             for element in sorted(self._elements):
                 if not self._nodes.get(element) and element not in self._trails:
                     self._build(element)
                 self._apply_geometry(element)
-            for trail in self._trails.values():
-                trail.clear()
-            self._t_last = None
-            self._last_points.clear()
-            return self._draw(float(t), *first)
+            self._k_last = None
+            self._frame = None
+            return self._draw(first, restart=True)
+
+    def set_frame_time(self, frame_time: float) -> None:
+        """The clock's speed changed: re-grid the motion from the time now shown."""
+        if self._body is None or self._geometry is None or self._frame is None:
+            return
+        self._sampler = MotionSampler.for_body(
+            self._body, self._geometry.trace_speed, frame_time, MAX_CHORD, self._frame.t
+        )
+        self._k_last = 0
+
+    def shown_time(self, t: float) -> float:
+        """The grid time drawn for clock time ``t``."""
+        return self._sampler.time(self._sampler.index(t)) if self._sampler else float(t)
+
+    @property
+    def sampler(self) -> MotionSampler | None:
+        return self._sampler
 
     # -- per frame -----------------------------------------------------------------------
     def advance(self, t: float) -> Frame:
-        """Pose the body at time ``t`` and extend the traces (resampled so that no chord is
-        longer than MAX_CHORD). Going back in time (reset) restarts the traces."""
-        body, geometry = self._body, self._geometry
-        if body is None or geometry is None:
+        """Pose the body at clock time ``t`` (the grid time just before it) and extend the
+        traces with the grid samples since the last frame. Going back in time restarts the
+        traces; the same grid time again (paused) costs nothing and sends nothing."""
+        sampler = self._sampler
+        if sampler is None or self._geometry is None:
             raise RuntimeError("load() a body before advance()")
-        t = float(t)
-        times = np.array([t])
-        if self._t_last is not None and t > self._t_last and self._last_points:
-            omega, rotation, contact = sample_motion(body, times)
-            gap = self._gap(omega[0] * geometry.scale, contact[0] * geometry.scale)
-            n = min(MAX_SAMPLES_PER_FRAME, max(1, math.ceil(gap / MAX_CHORD)))
-            if n > 1:
-                times = self._t_last + (t - self._t_last) * np.arange(1, n + 1) / n
-                omega, rotation, contact = sample_motion(body, times)
+        k = sampler.index(float(t))
+        if k == self._k_last and self._frame is not None:
+            return self._frame
+        restart = self._k_last is None or k < self._k_last
+        if restart or k == self._k_last:  # k == k_last: a redraw (new elements), same time
+            k_first = k
         else:
-            omega, rotation, contact = sample_motion(body, times)
-        quaternions = wxyz(rotation)
-        _finite("omega", omega)
-        _finite("the contact point", contact)
-        _finite("the attitude", quaternions)
+            k_first = max(self._k_last + 1, k - MAX_SAMPLES_PER_FRAME + 1)
+        samples = self._checked(sampler.samples(k_first, k))
         with self._atomic():
-            return self._draw(t, omega, quaternions, contact)
+            return self._draw(samples, restart)
 
-    def _gap(self, polhode_point: np.ndarray, herpolhode_point: np.ndarray) -> float:
-        gaps = [0.0]
-        if Element.POLHODE in self._last_points:
-            gaps.append(float(np.linalg.norm(polhode_point - self._last_points[Element.POLHODE])))
-        if Element.HERPOLHODE in self._last_points:
-            gaps.append(
-                float(np.linalg.norm(herpolhode_point - self._last_points[Element.HERPOLHODE]))
-            )
-        return max(gaps)
+    @staticmethod
+    def _checked(samples: Samples) -> Samples:
+        _finite("omega", samples.omega)
+        _finite("the contact point", samples.contact)
+        _finite("the attitude", samples.quat_xyzw)
+        return samples
 
-    def _draw(self, t: float, omega, quaternions, contact) -> Frame:
-        geometry = self._geometry
-        assert geometry is not None
+    def _draw(self, samples: Samples, restart: bool) -> Frame:
+        geometry, sampler = self._geometry, self._sampler
+        assert geometry is not None and sampler is not None
         s = geometry.scale
-        polhode_pts = (omega * s).astype(np.float32)
-        herpolhode_pts = (contact * s).astype(np.float32)
-        if self._t_last is not None and t < self._t_last:
+        if restart:
             for trail in self._trails.values():
                 trail.clear()
-            self._last_points.clear()
-        q = quaternions[-1]
-        tip = herpolhode_pts[-1]
+            self._pending.clear()
+        q = wxyz_from_xyzw(samples.quat_xyzw[-1])
+        tip = samples.contact[-1] * s  # poses travel as float64
         self.body_frame.wxyz = q
         self.tip.position = tip
         if Element.OMEGA in self._nodes:
             self._nodes[Element.OMEGA][0].points = np.array([[[0.0, 0.0, 0.0], tip]], np.float32)
-        appended = 0
-        if t != self._t_last:
-            for element, pts in (
-                (Element.POLHODE, polhode_pts),
-                (Element.HERPOLHODE, herpolhode_pts),
-            ):
-                trail = self._trails.get(element)
-                if trail is not None:
-                    trail.append(pts)
-                    appended = len(pts)
-                self._last_points[element] = pts[-1]
-        self._t_last = t
-        return Frame(t, np.asarray(omega[-1]), q, tip.astype(np.float64), appended)
+        # Trace samples: every stride-th grid time (and the first point of a new trace).
+        keep = samples.k % sampler.stride == 0
+        if restart:
+            keep[-1] = True
+        if keep.any():
+            for element, points in ((Element.POLHODE, samples.omega),
+                                    (Element.HERPOLHODE, samples.contact)):
+                if element in self._trails:
+                    self._pending.setdefault(element, []).append(
+                        (points[keep] * s).astype(np.float32)
+                    )
+        self._frames_since_flush += 1
+        if restart or self._frames_since_flush >= TRAIL_EVERY:
+            self.flush_trails()
+        self._k_last = int(samples.k[-1])
+        self._frame = Frame(float(samples.t[-1]), samples.omega[-1].copy(), q, tip,
+                            len(samples.k))
+        return self._frame
+
+    def flush_trails(self) -> None:
+        """Send the trace points gathered since the last flush."""
+        for element, parts in self._pending.items():
+            trail = self._trails.get(element)
+            if trail is not None and parts:
+                trail.append(np.concatenate(parts))
+        self._pending.clear()
+        self._frames_since_flush = 0
 
     # -- element construction ------------------------------------------------------------
     def _destroy(self, element: Element) -> None:
@@ -306,7 +333,7 @@ class PoinsotScene:
         if trail is not None:
             trail.clear()
             trail.group.remove()
-        self._last_points.pop(element, None)
+        self._pending.pop(element, None)
 
     def _build(self, element: Element) -> None:
         api, r = self.api, self.root

@@ -7,6 +7,7 @@ import warnings
 
 import viser
 
+from app.budget import FrameBudget
 from app.presets import DEFAULT_PRESET, Preset
 from app.session import MAX_FPS, Session
 
@@ -28,6 +29,7 @@ class PoinsotApp:
         self._lock = threading.Lock()
         self._sessions: dict[int, Session] = {}
         self._connected = threading.Condition(self._lock)
+        self.budget = FrameBudget(max_fps=max_fps)
         self.server = viser.ViserServer(host=host, port=port, verbose=verbose)
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
         self.server.scene.world_axes.visible = False
@@ -59,15 +61,17 @@ class PoinsotApp:
             return list(self._sessions.values())
 
     def _connect(self, client: viser.ClientHandle) -> None:
-        session = Session(client, self.preset, max_fps=self.max_fps)
+        session = Session(client, self.preset, max_fps=self.max_fps, budget=self.budget)
         with self._connected:
             self._sessions[client.client_id] = session
+            self.budget.set_sessions(len(self._sessions))
             self._connected.notify_all()
         session.start()
 
     def _disconnect(self, client: viser.ClientHandle) -> None:
         with self._lock:
             session = self._sessions.pop(client.client_id, None)
+            self.budget.set_sessions(len(self._sessions))
         if session is not None:
             session.close()
 

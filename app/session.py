@@ -20,6 +20,7 @@ from collections.abc import Callable
 import viser
 
 from app import readouts
+from app.budget import FrameBudget
 from app.clock import SimClock
 from app.panel import ControlPanel
 from app.parameters import Parameters
@@ -66,9 +67,12 @@ class Session:
         *,
         max_fps: float = MAX_FPS,
         view: View = DEFAULT_VIEW,
+        budget: FrameBudget | None = None,
     ) -> None:
+        """``budget``: the server's shared frame-rate governor (one per session if None)."""
         self.client = client
         self.max_fps = float(max_fps)
+        self.budget = budget if budget is not None else FrameBudget(max_fps=max_fps)
         self.stats = SessionStats()
         self.clock = SimClock(speed=preset.speed)
         self.preset = preset
@@ -127,7 +131,16 @@ class Session:
         self._post(lambda: self._edit(change))
 
     def set_speed(self, speed: float) -> None:
-        self._post(lambda: setattr(self.clock, "speed", speed))
+        def action() -> None:
+            self.clock.speed = speed
+            self.scene.set_frame_time(self.frame_time)
+
+        self._post(action)
+
+    @property
+    def frame_time(self) -> float:
+        """Simulation time one frame advances at full frame rate."""
+        return self.clock.speed / self.max_fps
 
     def toggle_pause(self) -> None:
         self._post(self._toggle_pause)
@@ -166,7 +179,6 @@ class Session:
 
     # -- frame thread --------------------------------------------------------------------
     def _run(self) -> None:
-        period = 1.0 / self.max_fps
         next_frame = time.monotonic()
         last_plot = last_time = 0.0
         while not self._stop.is_set():
@@ -182,18 +194,20 @@ class Session:
                     self._rebuild()
                 now = time.monotonic()
                 if now >= next_frame:
-                    next_frame = now + period
+                    next_frame = now + 1.0 / min(self.max_fps, self.budget.fps)
                     self._advance()
-                    if now - last_plot >= 1.0 / PLOT_HZ:
+                    if now - last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
                         last_plot = now
+                        self.panel.record_plot(self.frame.t, self.frame.omega)
                         self.panel.send_plot()
                     if now - last_time >= 1.0 / TIME_HZ:
                         last_time = now
-                        self.panel.show_time(self.clock.now(), self.clock.paused)
+                        shown = self.frame.t if self.frame is not None else 0.0
+                        self.panel.show_time(shown, self.clock.paused)
                         self.panel.collect(now)
             except Exception as exc:  # the loop must survive anything; the user sees it
                 self._report(exc)
-                next_frame = time.monotonic() + period
+                next_frame = time.monotonic() + 1.0 / self.max_fps
 
     def _drain(self) -> None:
         while True:
@@ -210,11 +224,10 @@ class Session:
         if self.body is None:
             return
         start = time.perf_counter()
-        t = self.clock.now()
-        self.frame = self.scene.advance(t)
-        self.panel.record_plot(t, self.frame.omega)
+        self.frame = self.scene.advance(self.clock.now())
         self.stats.frame_seconds.append(time.perf_counter() - start)
         self.stats.frames += 1
+        self.budget.frame_done()
 
     def _report(self, exc: BaseException) -> None:
         self.stats.errors += 1
@@ -281,7 +294,9 @@ class Session:
         try:
             body = desired.build()
             self.clock.reset(0.0)
-            self.frame = self.scene.load(body, self._solid(desired), t=0.0)
+            self.frame = self.scene.load(
+                body, self._solid(desired), t=0.0, frame_time=self.frame_time
+            )
         except ValueError as exc:
             self._set_status(f"{exc} Showing the last valid body.")
         else:
@@ -291,6 +306,8 @@ class Session:
             self.panel.clear_plot()
             self.panel.record_plot(0.0, self.frame.omega)
             self._set_status("")
+            # Send now: viser otherwise batches outgoing messages for up to a frame (1/60 s).
+            self.client.flush()
         self.stats.rebuild_seconds.append(time.perf_counter() - start)
         self.stats.rebuilds += 1
         with self._applied:

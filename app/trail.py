@@ -4,7 +4,8 @@ Viser resends a node's whole ``points`` array when it changes, so a single growi
 cost O(trail length) bytes per frame. Instead the trail is a ring of small line-segment nodes
 ("chunks"): each frame only the head chunk (at most ``chunk`` segments) is resent; a full head
 is frozen and a new one started; the oldest chunks are removed once the trail is longer than
-its length. Bytes per frame are bounded by the chunk size, and the length by ``max_points``.
+its length. Bytes per frame are bounded by the chunk size; the length stays within one chunk
+below ``max_points``.
 """
 
 from __future__ import annotations
@@ -136,6 +137,6 @@ class Trail:
         self._head_segments = np.zeros((0, 2, 3), dtype=np.float32)
 
     def _trim(self) -> None:
-        while self._frozen and self.segment_count - self._frozen[0][1] >= self._max_points:
+        while self._frozen and self.segment_count > self._max_points:
             handle, _ = self._frozen.popleft()
             handle.remove()

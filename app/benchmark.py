@@ -1,0 +1,200 @@
+"""Benchmark of the live app: ``python -m app.benchmark [--clients 1 20] [--seconds 5]``.
+
+For each number of connected clients it starts a real Poinsot server in this process and the
+clients in a *separate* process (so that their decoding does not count as server time). The
+clients are :class:`app.probe.Probe` websockets speaking viser's protocol like a browser. It
+prints:
+
+- server time per client-frame: the server process's CPU time (physics, scene updates,
+  viser's serialisation and websocket sends, everything) divided by the frames drawn for all
+  clients; and the wall time of one frame in a session's thread (median, p95);
+- bytes sent per frame: what one client receives per frame, scene traffic (poses and trail
+  increments) and the GUI's (the plot at 10 Hz and the time readout) separately;
+- slider-to-redraw time: from a client sending a slider value to that client receiving the new
+  ellipsoid (the scale of ``/space/body/ellipsoid``), median and p95, and the server's
+  rebuild time alone.
+
+Targets (issue 3): <= 1 ms per client-frame, <= 30 ms per redraw.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import multiprocessing as mp
+import statistics
+import sys
+import time
+from typing import Any
+
+#: Values the benchmark's slider alternates between (I2 of the default preset: valid bodies).
+SLIDER_LABEL = "I₂"
+SLIDER_VALUES = (1.7, 1.9)
+
+
+def _percentile(values: list[float], q: float) -> float:
+    ordered = sorted(values)
+    if not ordered:
+        return float("nan")
+    k = min(len(ordered) - 1, max(0, round(q * (len(ordered) - 1))))
+    return ordered[k]
+
+
+# -- the client process ----------------------------------------------------------------------
+def _clients_main(port: int, count: int, seconds: float, redraws: int, conn) -> None:
+    """Runs in a child process: connect, measure traffic, then measure slider round trips."""
+    from app.probe import Probe
+
+    probes = [Probe(port, keep_batches=True) for _ in range(count)]
+    for probe in probes:
+        if not probe.wait_for(lambda p: "/space/body/ellipsoid" in p.nodes and
+                              p.has_widget(SLIDER_LABEL), 60):
+            conn.send(("error", "a client never received the scene"))
+            return
+    conn.send(("ready", None))
+    assert conn.recv() == "go"
+    start = [(len(p.batches), p.bytes_received) for p in probes]
+    time.sleep(seconds)
+    traffic = []
+    for probe, (n0, _) in zip(probes, start, strict=True):
+        batches = probe.batches[n0:]
+        gui = sum(b.nbytes for b in batches if "GuiUpdateMessage" in b.types)
+        total = sum(b.nbytes for b in batches)
+        traffic.append((total - gui, gui, len(batches)))
+    conn.send(("traffic", traffic))
+    assert conn.recv() == "redraw"
+
+    latencies: list[float] = []
+    arrivals: dict[int, float] = {}
+
+    def listener_for(index: int):
+        def listener(message: dict[str, Any], arrived: float) -> None:
+            if (message["type"] == "SceneNodeUpdateMessage"
+                    and message.get("name") == "/space/body/ellipsoid"
+                    and "scale" in message.get("updates", {})):
+                arrivals.setdefault(index, arrived)
+        return listener
+
+    for i, probe in enumerate(probes):
+        probe.add_listener(listener_for(i))
+    for k in range(redraws):
+        index = k % count  # the clients take turns at the slider
+        probe = probes[index]
+        uuid, _ = probe.widget(SLIDER_LABEL)
+        value = SLIDER_VALUES[k % 2] if count == 1 else SLIDER_VALUES[(k // count) % 2]
+        arrivals.pop(index, None)
+        sent = time.perf_counter()
+        probe.set_value(uuid, value)
+        deadline = sent + 5.0
+        while index not in arrivals and time.perf_counter() < deadline:
+            time.sleep(0.0005)
+        if index in arrivals:
+            latencies.append(arrivals[index] - sent)
+        time.sleep(0.12)
+    conn.send(("latencies", latencies))
+    for probe in probes:
+        probe.close()
+
+
+# -- the server side ---------------------------------------------------------------------------
+@dataclasses.dataclass
+class Result:
+    clients: int
+    cpu_per_client_frame_ms: float
+    frame_wall_median_ms: float
+    frame_wall_p95_ms: float
+    frames_per_second_per_client: float
+    scene_bytes_per_frame: float
+    gui_bytes_per_second: float
+    redraw_median_ms: float
+    redraw_p95_ms: float
+    rebuild_median_ms: float
+    rebuild_p95_ms: float
+
+
+def run(clients: int, seconds: float = 5.0, redraws: int = 30) -> Result:
+    from app.server import PoinsotApp
+
+    app = PoinsotApp("127.0.0.1", 0)
+    ctx = mp.get_context("spawn")
+    parent, child = ctx.Pipe()
+    proc = ctx.Process(target=_clients_main, args=(app.port, clients, seconds, redraws, child))
+    proc.start()
+    try:
+        kind, payload = parent.recv()
+        if kind == "error":
+            raise RuntimeError(payload)
+        sessions = app.wait_for_sessions(clients, 30)
+        time.sleep(1.0)  # past the connection burst
+        for s in sessions:
+            s.stats.frame_seconds.clear()
+        frames0 = {id(s): s.stats.frames for s in sessions}
+        cpu0, wall0 = time.process_time(), time.perf_counter()
+        parent.send("go")
+        kind, traffic = parent.recv()
+        cpu1, wall1 = time.process_time(), time.perf_counter()
+        frames = {id(s): s.stats.frames - frames0[id(s)] for s in sessions}
+        total_frames = sum(frames.values())
+        frame_walls = [x for s in sessions for x in s.stats.frame_seconds]
+        for s in sessions:
+            s.stats.rebuild_seconds.clear()
+        parent.send("redraw")
+        kind, latencies = parent.recv()
+        rebuilds = [x for s in sessions for x in s.stats.rebuild_seconds]
+        proc.join(30)
+    finally:
+        if proc.is_alive():
+            proc.terminate()
+        app.stop()
+    per_client_frames = total_frames / clients
+    elapsed = wall1 - wall0
+    scene_bytes = [t[0] for t in traffic]
+    gui_bytes = [t[1] for t in traffic]
+    return Result(
+        clients=clients,
+        cpu_per_client_frame_ms=1e3 * (cpu1 - cpu0) / max(total_frames, 1),
+        frame_wall_median_ms=1e3 * statistics.median(frame_walls),
+        frame_wall_p95_ms=1e3 * _percentile(frame_walls, 0.95),
+        frames_per_second_per_client=per_client_frames / elapsed,
+        scene_bytes_per_frame=statistics.mean(scene_bytes) / max(per_client_frames, 1),
+        gui_bytes_per_second=statistics.mean(gui_bytes) / elapsed,
+        redraw_median_ms=1e3 * statistics.median(latencies) if latencies else float("nan"),
+        redraw_p95_ms=1e3 * _percentile(latencies, 0.95),
+        rebuild_median_ms=1e3 * statistics.median(rebuilds) if rebuilds else float("nan"),
+        rebuild_p95_ms=1e3 * _percentile(rebuilds, 0.95),
+    )
+
+
+def format_result(r: Result) -> str:
+    return "\n".join([
+        f"clients: {r.clients}",
+        f"  server CPU per client-frame : {r.cpu_per_client_frame_ms:7.3f} ms   (target <= 1 ms)",
+        f"  frame in session thread     : median {r.frame_wall_median_ms:.3f} ms, "
+        f"p95 {r.frame_wall_p95_ms:.3f} ms (wall)",
+        f"  frames per second per client: {r.frames_per_second_per_client:7.1f}        (cap 60)",
+        f"  bytes sent per frame        : {r.scene_bytes_per_frame:7.0f} B  (poses + trail "
+        f"increments) + GUI {r.gui_bytes_per_second / 1e3:.1f} kB/s (plot 10 Hz, time 5 Hz)",
+        f"  slider-to-redraw            : median {r.redraw_median_ms:.1f} ms, "
+        f"p95 {r.redraw_p95_ms:.1f} ms   (target <= 30 ms)",
+        f"  server rebuild alone        : median {r.rebuild_median_ms:.2f} ms, "
+        f"p95 {r.rebuild_p95_ms:.2f} ms",
+    ])
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m app.benchmark", description=__doc__.split("\n")[0])
+    parser.add_argument("--clients", type=int, nargs="+", default=[1, 20])
+    parser.add_argument("--seconds", type=float, default=5.0, help="steady-state window")
+    parser.add_argument("--redraws", type=int, default=30, help="slider moves per run")
+    args = parser.parse_args(argv)
+    import os
+
+    print(f"Poinsot app benchmark (python {sys.version.split()[0]}, {os.cpu_count()} CPUs, "
+          f"load average {os.getloadavg()[0]:.1f})")
+    for n in args.clients:
+        print(format_result(run(n, args.seconds, args.redraws)), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,243 @@
+"""The app's parts on their own: presets (data and sources), parameters, clock, the one
+quaternion conversion, the chunked trail, and the command line."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import time
+import urllib.request
+
+import numpy as np
+import pytest
+from conftest import wait_until
+from scipy.spatial.transform import Rotation
+
+from app import cli
+from app.clock import SimClock
+from app.frames import rotation_from_wxyz, wxyz
+from app.parameters import Parameters
+from app.presets import ALL_ELEMENTS, CUSTOM, PRESETS, Element, preset_by_key, preset_by_label
+from app.solids import solid_mesh
+from app.trail import Trail
+from physics import Regime
+
+EXPECTED_REGIME = {
+    "major": Regime.MAJOR_AXIS,
+    "minor": Regime.MINOR_AXIS,
+    "t_handle": Regime.MAJOR_AXIS,
+    "near_separatrix": Regime.MAJOR_AXIS,
+    "separatrix": Regime.SEPARATRIX,
+    "oblate": Regime.SYMMETRIC,
+    "prolate": Regime.SYMMETRIC,
+    "sphere": Regime.SPHERE,
+}
+
+
+# -- presets ---------------------------------------------------------------------------
+def test_the_issue_s_presets_are_all_there():
+    assert [p.key for p in PRESETS] == list(EXPECTED_REGIME)
+    assert len({p.label for p in (*PRESETS, CUSTOM)}) == len(PRESETS) + 1
+    assert CUSTOM.elements == ALL_ELEMENTS
+
+
+@pytest.mark.parametrize("preset", PRESETS, ids=[p.key for p in PRESETS])
+def test_each_preset_is_a_real_body_with_a_source(preset):
+    assert len(preset.source) > 40 and re.search(r"[A-Z][a-z]+", preset.source)
+    params = Parameters.from_preset(preset)
+    params.check()  # triangle inequality: a real body
+    body = params.build()
+    assert body.D == pytest.approx(preset.D, rel=1e-12)
+    assert np.linalg.norm(body.omega0) == pytest.approx(preset.omega_norm)
+    assert np.allclose(body.plane_normal, (0, 0, 1), atol=1e-12)  # L vertical
+    assert body.regime is EXPECTED_REGIME[preset.key], body.regime
+    assert params.matches(preset)
+
+
+@pytest.mark.parametrize("preset", PRESETS, ids=[p.key for p in PRESETS])
+def test_a_preset_s_solid_has_the_preset_s_moments(preset):
+    """The drawn solid is the body: trimesh's mass properties of the exact mesh the app sends
+    (centre of mass at the origin, principal axes = body axes) give the preset's moments."""
+    mesh = solid_mesh(preset.solid)
+    assert mesh.is_watertight
+    assert np.allclose(mesh.center_mass, 0.0, atol=2e-4 * mesh.scale)
+    tensor = mesh.moment_inertia
+    assert np.allclose(tensor - np.diag(np.diag(tensor)), 0.0, atol=1e-9 * np.trace(tensor))
+    moments = np.diag(tensor)
+    # Ratios (the mass is a free scale); polygonal cylinders differ from circles by ~0.2 %.
+    assert np.allclose(moments / moments.max(), np.divide(preset.inertia, max(preset.inertia)),
+                       rtol=5e-3)
+
+
+def test_presets_are_found_by_key_and_label():
+    assert preset_by_key("t_handle").label == "Intermediate-axis flip (T-handle)"
+    assert preset_by_label(CUSTOM.label) is CUSTOM
+    with pytest.raises(KeyError, match="no preset named"):
+        preset_by_key("nope")
+
+
+# -- parameters ------------------------------------------------------------------------
+def test_an_impossible_body_is_named_in_the_message():
+    bad = Parameters((1.0, 1.0, 2.5), 1.5)
+    with pytest.raises(ValueError, match=r"No real body .* I₃ = 2\.50 > I₁ \+ I₂ = 2\.00"):
+        bad.check()
+    with pytest.raises(ValueError, match="No real body"):
+        bad.build()
+    Parameters((1.0, 1.0, 2.0), 1.5).check()  # a flat lamina is a real body
+
+
+def test_editing_a_moment_keeps_D_in_range_and_sides_mirror():
+    p = Parameters((1.0, 2.0, 2.6), 2.45)
+    q = p.with_inertia(2, 2.2)
+    assert q.D == 2.2 and q.inertia == (1.0, 2.0, 2.2)
+    assert p.side() == "major"
+    m = p.mirrored("minor")
+    assert m.side() == "minor" and 1.0 <= m.D < 2.0
+    assert m.mirrored("major").D == pytest.approx(p.D)
+    assert p.mirrored("major") == p
+
+
+# -- clock -----------------------------------------------------------------------------
+class FakeTime:
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_clock_speed_pause_step_reset():
+    wall = FakeTime()
+    clock = SimClock(speed=2.0, monotonic=wall)
+    wall.now += 1.5
+    assert clock.now() == pytest.approx(3.0)
+    clock.speed = 0.5  # continuous across the change
+    assert clock.now() == pytest.approx(3.0)
+    wall.now += 2.0
+    assert clock.now() == pytest.approx(4.0)
+    clock.paused = True
+    wall.now += 10.0
+    assert clock.now() == pytest.approx(4.0)
+    clock.step(0.25)
+    assert clock.now() == pytest.approx(4.25)
+    clock.paused = False
+    wall.now += 1.0
+    assert clock.now() == pytest.approx(4.75)
+    clock.reset()
+    assert clock.now() == 0.0
+
+
+# -- the one quaternion conversion -----------------------------------------------------
+def test_wxyz_is_scalar_first_and_round_trips():
+    rotations = Rotation.random(50, random_state=3)
+    q = wxyz(rotations)
+    assert q.shape == (50, 4) and np.all(q[:, 0] >= 0)
+    assert np.allclose(np.abs(q[:, 0]), np.abs(rotations.as_quat()[:, 3]))
+    for r, qi in zip(rotations, q, strict=True):
+        assert (rotation_from_wxyz(qi) * r.inv()).magnitude() < 1e-12
+    single = wxyz(Rotation.from_rotvec([0.0, 0.0, np.pi / 2]))
+    assert np.allclose(single, [np.cos(np.pi / 4), 0, 0, np.sin(np.pi / 4)])
+
+
+# -- trail -----------------------------------------------------------------------------
+class FakeHandle:
+    def __init__(self, api, name, points) -> None:
+        self.api, self.name, self._points = api, name, np.array(points)
+        self.visible = True
+        api.sent_bytes += self._points.nbytes
+
+    @property
+    def points(self):
+        return self._points
+
+    @points.setter
+    def points(self, value) -> None:
+        self._points = np.array(value)
+        self.api.sent_bytes += self._points.nbytes
+
+    def remove(self) -> None:
+        self.api.live.discard(self.name)
+
+
+class FakeApi:
+    """Records what a Trail sends, in place of a viser SceneApi."""
+
+    def __init__(self) -> None:
+        self.live: set[str] = set()
+        self.sent_bytes = 0
+
+    def add_frame(self, name, **kwargs):
+        return FakeHandle(self, name, np.zeros((0, 3)))
+
+    def add_line_segments(self, name, points, color, **kwargs):
+        self.live.add(name)
+        return FakeHandle(self, name, points)
+
+
+def test_trail_is_bounded_and_sends_increments_only():
+    api = FakeApi()
+    trail = Trail(api, "/t", (255, 0, 0), 2.0, max_points=200, chunk=16)
+    points = np.cumsum(np.ones((1000, 3)), axis=0).astype(np.float32)
+    worst = 0
+    for p in points:
+        before = api.sent_bytes
+        trail.append(p[None])
+        worst = max(worst, api.sent_bytes - before)
+    assert worst <= 16 * 2 * 3 * 4  # at most one chunk per frame
+    assert 200 - 16 <= trail.segment_count <= 200
+    drawn = trail.points()
+    assert np.array_equal(drawn, points[-len(drawn):])  # contiguous, oldest first
+    assert len(api.live) <= 200 // 16 + 1
+    trail.max_points = 50
+    assert trail.segment_count <= 50
+    trail.clear()
+    assert trail.segment_count == 0 and api.live == set()
+    trail.append(points[:5])
+    assert np.array_equal(trail.points(), points[:5])
+
+
+# -- command line ----------------------------------------------------------------------
+def test_cli_serve_forms_parse_alike():
+    parser = cli.build_parser()
+    bare = parser.parse_args([])
+    assert (bare.host, bare.port, bare.func) == ("127.0.0.1", 8080, cli.serve)
+    flags = parser.parse_args(["--host", "0.0.0.0", "--port", "9000"])
+    assert (flags.host, flags.port, flags.func) == ("0.0.0.0", 9000, cli.serve)
+    sub = parser.parse_args(["serve", "--host", "0.0.0.0", "--port", "9001", "--preset", "sphere"])
+    assert (sub.command, sub.host, sub.port, sub.preset) == ("serve", "0.0.0.0", 9001, "sphere")
+
+
+@pytest.mark.parametrize("argv", [["-m", "app", "serve"], ["-m", "app"]])
+def test_cli_serves_the_page_and_prints_the_url(argv):
+    proc = subprocess.Popen(
+        [sys.executable, *argv, "--port", "0", "--preset", "minor"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+    try:
+        url = None
+        deadline = time.monotonic() + 30
+        while url is None and time.monotonic() < deadline:
+            line = proc.stdout.readline()
+            match = re.search(r"Poinsot is running at (http://\S+)", line)
+            url = match.group(1) if match else None
+        assert url, "no URL printed"
+        with urllib.request.urlopen(url, timeout=10) as response:
+            assert response.status == 200 and b"<html" in response.read().lower()
+    finally:
+        proc.terminate()
+        proc.wait(10)
+    assert wait_until(lambda: proc.poll() is not None, 5)
+
+
+def test_console_script_is_installed():
+    scripts = [p for p in (sys.prefix + "/bin/poinsot",)]
+    out = subprocess.run([scripts[0], "serve", "--help"], capture_output=True, text=True,
+                         timeout=30)
+    assert out.returncode == 0 and "--host" in out.stdout and "--port" in out.stdout
+
+
+def test_element_enum_matches_labels():
+    from app.panel import ELEMENT_LABELS
+
+    assert set(ELEMENT_LABELS) == set(Element)
