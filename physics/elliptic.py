@@ -333,11 +333,15 @@ def periodic_third_kind(
         m, mc = par.m, par.mc
         v = par.K - np.abs(r[far])
         snv, cnv, dnv = sncndn_reduced(v, par)
-        n_prime = (m - n) / (1.0 - n)
-        c2, d2, s2 = cnv * cnv, dnv * dnv, snv * snv
-        pi_v = snv * special.elliprf(c2, d2, 1.0) + (n_prime / 3.0) * snv * s2 * special.elliprj(
-            c2, d2, 1.0, 1.0 - n_prime * s2
-        )
-        body = (slope - m / (m - n)) * v + (n * mc / ((1.0 - n) * (m - n))) * pi_v
+        body = (slope - m / (m - n)) * v
+        if mc > 0.0:  # the Π(n') term carries a factor 1 - m: exactly nothing when it underflows
+            n_prime = (m - n) / (1.0 - n)
+            c2, d2, s2 = cnv * cnv, dnv * dnv, snv * snv
+            # 1 - n' sn² = (1 - n') + n' cn² with 1 - n' = mc/(1 - n): no cancellation.
+            p = mc / (1.0 - n) + n_prime * c2
+            pi_v = snv * special.elliprf(c2, d2, 1.0) + (
+                n_prime / 3.0
+            ) * snv * s2 * special.elliprj(c2, d2, 1.0, p)
+            body = body + (n * mc / ((1.0 - n) * (m - n))) * pi_v
         out[far] = np.copysign(body, r[far])
     return out

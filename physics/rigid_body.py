@@ -304,7 +304,18 @@ class _Elliptic:
         self.period = 4.0 * K / lam
         self.phase_scale = self.c / self.sigma
         self.P0 = self._periodic_pi(np.array([self.u0]))[0]
-        self.sine_series = _sine_series(lambda u: self.phase_scale * self._periodic_pi(u), K)
+        self._series: np.ndarray | None | bool = False  # built on first long evaluation
+
+    @property
+    def sine_series(self) -> np.ndarray | None:
+        """Sine coefficients of the precession wobble, or None where they converge too slowly.
+
+        Built lazily (512 samples, ~0.2 ms): a body evaluated only at a few times never pays it.
+        """
+        if self._series is False:
+            K = self.par.K
+            self._series = _sine_series(lambda u: self.phase_scale * self._periodic_pi(u), K)
+        return self._series
 
     def _reduced(self, tau: np.ndarray):
         r, j = self.phase.reduce(tau)
@@ -341,7 +352,7 @@ class _Elliptic:
         """
         # A handful of times (a renderer's frame) is cheaper through two Carlson calls than
         # through a Clenshaw sum of ~25 tiny-array steps; both agree to rounding.
-        if self.sine_series is None or r.shape[0] < _SERIES_MIN_POINTS:
+        if r.shape[0] < _SERIES_MIN_POINTS or self.sine_series is None:
             P = elliptic.periodic_third_kind(self.N, self.pi_slope, self.par, r, sn, cn, dn)
             return self.phase_scale * (P - self.P0)
         theta = r * (math.pi / self.par.K)
@@ -648,9 +659,9 @@ class FreeRigidBody:
         # Anchor ω at t = 0: the closed form reproduces ω0 only to O(eps · amplitude) (through
         # u0 = F(φ0|m) and back through sn, cn, dn); adding the constant ω0 - f(0) makes
         # omega(0) return ω0 exactly and changes no other value by more than that rounding.
-        self._anchor = omega_s - self._frame.to_user_columns(solver.omega(np.zeros(1)))[0]
+        cols0, q0 = solver.quat(np.zeros(1))
+        self._anchor = omega_s - self._frame.to_user_columns(cols0)[0]
         # R_user(t) = S · R_int(t) · C with S fixed so that R_user(0) = attitude0.
-        _, q0 = solver.quat(np.zeros(1))
         conj = np.array([-1.0, -1.0, -1.0, 1.0])
         self._q_space = _qmul(
             _qmul(self.attitude0.as_quat(), self._frame.quat * conj), q0[0] * conj
@@ -823,14 +834,26 @@ def _deltas(J: np.ndarray, w: np.ndarray) -> tuple[Fraction, Fraction, Fraction]
     classification ``Δ2 == 0`` and every constant derived from the Δs are those of the exact
     data, rounded once.
     """
-    Jf = [Fraction(float(x)) for x in J]
-    wf = [Fraction(float(x)) for x in w]
-    sq = [Jf[j] * wf[j] * wf[j] for j in range(3)]
+    # Every double is an integer multiple of 2^-1074: scaled by 2^_EXACT_SHIFT they become
+    # Python integers, and sums of products of integers are exact (and cheaper than Fractions).
+    Ji = [_exact_int(x) for x in J]
+    wi = [_exact_int(x) for x in w]
+    sq = [Ji[j] * wi[j] * wi[j] for j in range(3)]
+    scale = 1 << (4 * _EXACT_SHIFT)
     return (
-        sq[1] * (Jf[1] - Jf[0]) + sq[2] * (Jf[2] - Jf[0]),
-        sq[0] * (Jf[0] - Jf[1]) + sq[2] * (Jf[2] - Jf[1]),
-        sq[0] * (Jf[0] - Jf[2]) + sq[1] * (Jf[1] - Jf[2]),
+        Fraction(sq[1] * (Ji[1] - Ji[0]) + sq[2] * (Ji[2] - Ji[0]), scale),
+        Fraction(sq[0] * (Ji[0] - Ji[1]) + sq[2] * (Ji[2] - Ji[1]), scale),
+        Fraction(sq[0] * (Ji[0] - Ji[2]) + sq[1] * (Ji[1] - Ji[2]), scale),
     )
+
+
+_EXACT_SHIFT = 1100
+
+
+def _exact_int(x: float) -> int:
+    """``x · 2^_EXACT_SHIFT`` as an exact integer (finite doubles are multiples of 2^-1074)."""
+    n, d = float(x).as_integer_ratio()
+    return n * ((1 << _EXACT_SHIFT) // d)
 
 
 # ---------------------------------------------------------------------------------------------
