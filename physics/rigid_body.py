@@ -166,7 +166,7 @@ def _qmul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 
 def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Rotate vectors v (N, 3) by unit quaternions q (N, 4), scalar-last: ``v + 2 q×(q×v + w v)``."""
+    """Rotate vectors v (N, 3) by unit quaternions q (N, 4), scalar-last: v + 2 q×(q×v + w v)."""
     x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
     vx, vy, vz = v[:, 0], v[:, 1], v[:, 2]
     tx = y * vz - z * vy + w * vx  # t = q×v + w v (explicit: np.cross costs ~50 µs per call)
