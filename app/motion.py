@@ -25,7 +25,7 @@ BATCH = 128
 #: Grid steps per frame when the motion is slow (the display lags the clock by < 1/4 frame).
 STEPS_PER_FRAME = 4
 #: Samples of the one-period survey that measures how fast the traces move.
-SURVEY_SAMPLES = 512
+SURVEY_SAMPLES = 256
 
 
 @dataclasses.dataclass(frozen=True)
@@ -43,8 +43,7 @@ class Samples:
 def evaluate(body: FreeRigidBody, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """omega, attitude quaternions (scalar-last) and contact point at times ``t``: the only
     place the app evaluates the motion."""
-    omega, rotation = body.state(t)
-    contact = body.contact_point(t)
+    omega, rotation, contact = body.sample(t)
     return omega, rotation.as_quat(), contact
 
 

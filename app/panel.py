@@ -46,6 +46,8 @@ POLE_OPTIONS = ("+ pole", "− pole")
 PLOT_SAMPLES = 300
 #: Delay between hiding a removed widget and deleting it [s].
 RETIRE_SECONDS = 1.5
+#: Width of the floating readout window [CSS px].
+DATA_WINDOW_WIDTH = 360
 
 # Layout: top-level order of the folders and the plot.
 _ORDER = {
@@ -95,6 +97,8 @@ class ControlPanel:
         self._plot_t: list[float] = []
         self._plot_w: list[np.ndarray] = []
         self._retired: list[tuple[float, Any]] = []
+        self._data_window: Any = None
+        self._data_tab: Any = None
 
         with gui.add_folder("Scene", order=_ORDER["scene"]) as folder:
             self._folders["scene"] = folder
@@ -137,15 +141,25 @@ class ControlPanel:
             Control.VISIBILITY: lambda: self._build_visibility(elements, visible),
             Plot.OMEGA: self._build_plot,
         }
+        if self._data_tab is None:
+            self._build_data_window()
         for key in sorted(wanted, key=lambda k: _ORDER.get(k, 25.0)):
             if key not in self._groups:
                 self._groups[key] = builders[key]()
-        if "readouts" not in self._folders:
-            with self.gui.add_folder("Readouts", order=_ORDER["readouts"]) as folder:
-                self._folders["readouts"] = folder
-                self.handles["time"] = self.gui.add_markdown(readouts.time_markdown(0.0, False))
-                self.handles["readouts"] = self.gui.add_markdown("")
         self._prune_folders()
+
+    def _build_data_window(self) -> None:
+        """Readouts and the plot float at the bottom left of the 3D view, so that a lecture
+        sees them beside the scene without scrolling the control panel."""
+        window = self.gui.add_panel(order=_ORDER["readouts"])
+        self._data_window = window
+        self._data_tab = window.add_tab("Motion", viser.Icon.CHART_LINE)
+        with self._data_tab:
+            self.handles["time"] = self.gui.add_markdown(
+                readouts.time_markdown(0.0, False), order=0.0
+            )
+            self.handles["readouts"] = self.gui.add_markdown("", order=1.0)
+        window.float(x=16, y=-16, width=DATA_WINDOW_WIDTH)
 
     @property
     def groups(self) -> frozenset[Any]:
@@ -175,13 +189,15 @@ class ControlPanel:
         self._retired = keep
         return len(keep)
 
-    def _folder(self, name: str, label: str) -> viser.GuiFolderHandle:
+    def _folder(self, name: str, label: str, expand: bool = True) -> viser.GuiFolderHandle:
         if name not in self._folders:
-            self._folders[name] = self.gui.add_folder(label, order=_ORDER[name])
+            self._folders[name] = self.gui.add_folder(
+                label, order=_ORDER[name], expand_by_default=expand
+            )
         return self._folders[name]
 
     def _prune_folders(self) -> None:
-        used = {"scene", "readouts"}
+        used = {"scene"}
         if self._groups.keys() & {Control.ENERGY, Control.SIDE, Control.OMEGA_NORM}:
             used.add("motion")
         if self._groups.keys() & {Control.SPEED, Control.PLAYBACK, Control.TRAIL}:
@@ -309,7 +325,7 @@ class ControlPanel:
         self, elements: frozenset[Element], visible: Callable[[Element], bool]
     ) -> list[Any]:
         boxes = {}
-        with self._folder(Control.VISIBILITY, "Show"):
+        with self._folder(Control.VISIBILITY, "Show", expand=False):
             for n, element in enumerate(e for e in Element if e in elements):
                 box = self.gui.add_checkbox(
                     ELEMENT_LABELS[element], visible(element), order=float(n)
@@ -328,17 +344,21 @@ class ControlPanel:
         axis = {"stroke": "#c8d0da", "grid": {"stroke": "#3a4048", "width": 1},
                 "ticks": {"stroke": "#3a4048"}}
         empty = np.zeros(0)
-        plot = self.gui.add_uplot(
+        with self._data_tab:
+            plot = self._add_plot(series, axis, empty)
+        self._plot_t, self._plot_w = [], []
+        return self._tag(Plot.OMEGA, plot=plot)
+
+    def _add_plot(self, series, axis, empty):
+        return self.gui.add_uplot(
             data=(empty, empty, empty, empty),
             series=tuple(series),
             title="ω in the body frame",
             scales={"x": {"time": False, "auto": True}, "y": {"auto": True}},
             axes=(axis, axis),  # type: ignore[arg-type]
-            aspect=1.6,
-            order=_ORDER[Plot.OMEGA],
+            aspect=1.7,
+            order=2.0,
         )
-        self._plot_t, self._plot_w = [], []
-        return self._tag(Plot.OMEGA, plot=plot)
 
     # -- mirroring the session's state ---------------------------------------------------
     def show_preset(self, preset: Preset) -> None:

@@ -11,16 +11,13 @@ import dataclasses
 import math
 
 from app.presets import Preset
-from physics import FreeRigidBody, attitude_with_L_along_z, omega_from_energy
+from physics import FreeRigidBody, attitude_with_L_along_z, check_real_body, omega_from_energy
 
 #: Slider ranges.
 INERTIA_RANGE = (0.1, 5.0)
 OMEGA_NORM_RANGE = (0.2, 4.0)
 SPEED_RANGE = (0.05, 4.0)
 TRAIL_RANGE = (100, 6000)
-
-_SUBSCRIPT = "₁₂₃"
-
 
 @dataclasses.dataclass(frozen=True)
 class Parameters:
@@ -70,22 +67,9 @@ class Parameters:
         return "major" if self.D >= self.intermediate else "minor"
 
     def check(self) -> None:
-        """Raise ValueError, with a message for the GUI, if no real body has these values.
-
-        Physics accepts any positive moments (the mathematics holds); a real mass
-        distribution also obeys the triangle inequality I_i <= I_j + I_k.
-        """
-        inertia = self.inertia
-        if not all(math.isfinite(i) and i > 0 for i in inertia):
-            raise ValueError("the moments of inertia must be positive numbers")
-        for i in range(3):
-            j, k = [n for n in range(3) if n != i]
-            if inertia[i] > inertia[j] + inertia[k]:
-                raise ValueError(
-                    f"No real body has these moments: I{_SUBSCRIPT[i]} = {inertia[i]:.2f} > "
-                    f"I{_SUBSCRIPT[j]} + I{_SUBSCRIPT[k]} = {inertia[j] + inertia[k]:.2f} "
-                    "(each moment is at most the sum of the other two)."
-                )
+        """Raise ValueError, with a message for the GUI, if no real body has these values
+        (:func:`physics.check_real_body`: the triangle inequality I_i <= I_j + I_k)."""
+        check_real_body(self.inertia)
         if not (math.isfinite(self.omega_norm) and self.omega_norm > 0):
             raise ValueError("|ω₀| must be positive")
 

@@ -10,9 +10,9 @@ import math
 from physics import FreeRigidBody, Regime
 
 REGIME_TEXT: dict[Regime, str] = {
-    Regime.MAJOR_AXIS: "about the major axis (stable)",
-    Regime.MINOR_AXIS: "about the minor axis (stable)",
-    Regime.SEPARATRIX: "on the separatrix",
+    Regime.MAJOR_AXIS: "polhode around the major axis",
+    Regime.MINOR_AXIS: "polhode around the minor axis",
+    Regime.SEPARATRIX: "on the separatrix (unstable)",
     Regime.SYMMETRIC: "symmetric top: regular precession",
     Regime.SPHERE: "sphere: ω constant",
     Regime.PERMANENT_ROTATION: "permanent rotation",
@@ -48,8 +48,12 @@ def rows(body: FreeRigidBody) -> list[tuple[str, str]]:
 
 
 def markdown(body: FreeRigidBody) -> str:
+    """The readouts as a markdown table (a "|" inside a cell is escaped)."""
     lines = ["| quantity | value |", "|:--|--:|"]
-    lines += [f"| {label} | {value} |" for label, value in rows(body)]
+    lines += [
+        f"| {label.replace('|', chr(92) + '|')} | {value.replace('|', chr(92) + '|')} |"
+        for label, value in rows(body)
+    ]
     return "\n".join(lines)
 
 

@@ -93,7 +93,9 @@ class Geometry:
     plane_height: float  # h in display units
     polhode: np.ndarray  # (n, 3) body frame, display units
     polhode_closed: bool  # False on the separatrix: an open arc between the two poles
-    solid_mesh: trimesh.Trimesh | None
+    solid_key: tuple | None  # equal keys share the mesh already sent
+    solid_base: trimesh.Trimesh | None  # the mesh sent for the solid (a unit cube for boxes)
+    solid_scale: np.ndarray | None  # node scale (3,) that makes solid_base the displayed solid
     trace_speed: float  # fastest trace point [display units per time unit]
 
     @classmethod
@@ -107,14 +109,24 @@ class Geometry:
         if not np.allclose(normal, (0.0, 0.0, 1.0), atol=1e-9):
             raise SceneDataError(f"L is not vertical (plane normal {normal}); use attitude0")
         polhode = _finite("the polhode", body.polhode(POLHODE_FULL_POINTS)) * scale
-        mesh = None
+        key = mesh = solid_scale = None
         if solid is not None:
-            raw = solids.solid_mesh(solid)
-            fit = solids.fit_scale(np.asarray(raw.vertices), semi * scale)
-            mesh = solids.textured_solid_mesh(solid, fit)
+            key, mesh, shape_scale = solids.solid_shape(solid)
+            vertices = np.asarray(mesh.vertices) * shape_scale
+            solid_scale = shape_scale * solids.fit_scale(vertices, semi * scale)
         closed = body.regime is not Regime.SEPARATRIX
         speed = _finite("the trace speed", trace_speed(body, scale))
-        return cls(scale, semi * scale, h * scale, polhode, closed, mesh, float(speed))
+        return cls(scale, semi * scale, h * scale, polhode, closed, key, mesh, solid_scale,
+                   float(speed))
+
+    @property
+    def solid_mesh(self) -> trimesh.Trimesh | None:
+        """The solid as displayed, in body coordinates and display units (for exports)."""
+        if self.solid_base is None or self.solid_scale is None:
+            return None
+        mesh = self.solid_base.copy()
+        mesh.apply_scale(self.solid_scale)
+        return mesh
 
 
 @dataclasses.dataclass(frozen=True)
@@ -154,6 +166,7 @@ class PoinsotScene:
         self._solid: Solid | None = None
         self._geometry: Geometry | None = None
         self._sampler: MotionSampler | None = None
+        self._solid_key: tuple | None = None
         self._k_last: int | None = None
         self._frame: Frame | None = None
         self._pending: dict[Element, list[np.ndarray]] = {}
@@ -329,6 +342,8 @@ class PoinsotScene:
     def _destroy(self, element: Element) -> None:
         for handle in self._nodes.pop(element, []):
             handle.remove()
+        if element is Element.SOLID:
+            self._solid_key = None
         trail = self._trails.pop(element, None)
         if trail is not None:
             trail.clear()
@@ -467,16 +482,21 @@ class PoinsotScene:
             curve = curve.astype(np.float32)
             nodes[0].points = np.stack([curve[:-1], curve[1:]], axis=1)
         elif element is Element.SOLID:
-            for handle in nodes:
-                handle.remove()
-            nodes.clear()
-            if g.solid_mesh is not None:
-                nodes.append(
-                    self.api.add_mesh_trimesh(
-                        f"{self.root}/body/solid", g.solid_mesh, cast_shadow=False,
-                        receive_shadow=False,
+            if g.solid_base is None or g.solid_key != self._solid_key:
+                for handle in nodes:
+                    handle.remove()
+                nodes.clear()
+                self._solid_key = None
+            if g.solid_base is not None:
+                if not nodes:
+                    nodes.append(
+                        self.api.add_mesh_simple(
+                            f"{self.root}/body/solid", g.solid_base.vertices, g.solid_base.faces,
+                            color=palette.SOLID, material="standard", flat_shading=True,
+                            cast_shadow=False, receive_shadow=False,
+                            visible=element not in self._hidden,
+                        )
                     )
-                )
-                if element in self._hidden:
-                    nodes[0].visible = False
+                    self._solid_key = g.solid_key
+                nodes[0].scale = tuple(float(x) for x in g.solid_scale)
             self._nodes[element] = nodes

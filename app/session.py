@@ -27,7 +27,7 @@ from app.parameters import Parameters
 from app.presets import ALL_ELEMENTS, CUSTOM, DEFAULT_PRESET, Element, Preset, Solid
 from app.scene import Frame, PoinsotScene
 from app.view import DEFAULT_VIEW, View, apply_theme
-from physics import FreeRigidBody
+from physics import FreeRigidBody, box_dimensions
 
 log = logging.getLogger(__name__)
 
@@ -279,11 +279,14 @@ class Session:
             self.panel.show_preset(CUSTOM)
 
     def _solid(self, params: Parameters) -> Solid | None:
-        """The base preset's solid while the moments are still the preset's."""
+        """The base preset's solid while the moments are still the preset's, otherwise the
+        homogeneous box with the same moments (:func:`physics.box_dimensions`); a flat lamina
+        is drawn with a thin (2 %) side."""
         base = Parameters.from_preset(self._base)
-        if params.inertia == base.inertia:
+        if params.inertia == base.inertia and self._base.solid is not None:
             return self._base.solid
-        return None
+        sides = box_dimensions(params.inertia)
+        return Solid("box", tuple(float(max(a, 0.02 * sides.max())) for a in sides))
 
     def _rebuild(self) -> None:
         """Build the body for the desired parameters and load it; on a ValueError keep the
@@ -298,7 +301,8 @@ class Session:
                 body, self._solid(desired), t=0.0, frame_time=self.frame_time
             )
         except ValueError as exc:
-            self._set_status(f"{exc} Showing the last valid body.")
+            reason = str(exc)
+            self._set_status(f"{reason[:1].upper()}{reason[1:]}. Showing the last valid body.")
         else:
             self.body, self.params = body, desired
             self.panel.show_parameters(desired)

@@ -8,33 +8,11 @@ import functools
 
 import numpy as np
 import trimesh
-import trimesh.visual.material
 
-from app import palette
 from app.presets import Solid
 
 #: Icosphere subdivisions of the ellipsoid mesh: 2562 vertices, chord error ~ 2e-3.
 ELLIPSOID_SUBDIVISIONS = 4
-
-
-def _material(
-    rgb: palette.RGB, opacity: float = 1.0, metallic: float = 0.05, roughness: float = 0.45
-) -> trimesh.visual.material.PBRMaterial:
-    return trimesh.visual.material.PBRMaterial(
-        baseColorFactor=[*(c / 255.0 for c in rgb), opacity],
-        metallicFactor=metallic,
-        roughnessFactor=roughness,
-        alphaMode="BLEND" if opacity < 1.0 else "OPAQUE",
-        doubleSided=False,
-    )
-
-
-def _with_material(mesh: trimesh.Trimesh, material) -> trimesh.Trimesh:
-    mesh.visual = trimesh.visual.TextureVisuals(material=material)
-    # The GLB export includes vertex normals only if they are cached; without them the browser
-    # shades every facet flat.
-    _ = mesh.vertex_normals
-    return mesh
 
 
 @functools.cache
@@ -109,11 +87,14 @@ def solid_mesh(solid: Solid) -> trimesh.Trimesh:
     return mesh
 
 
-def textured_solid_mesh(solid: Solid, scale: float) -> trimesh.Trimesh:
-    """The solid scaled for display, with its material."""
-    mesh = solid_mesh(solid)
-    mesh.apply_scale(scale)
-    return _with_material(mesh, _material(palette.SOLID, 1.0, metallic=0.3, roughness=0.5))
+def solid_shape(solid: Solid) -> tuple[tuple, trimesh.Trimesh, np.ndarray]:
+    """``(key, mesh, scale)``: the mesh to send for ``solid`` and the node scale that turns it
+    into the solid. Boxes share one unit cube scaled by their sides, so a box that changes
+    with a slider costs a scale update, not a new mesh; other solids are sent as they are.
+    ``key`` is equal for solids that share a mesh."""
+    if solid.kind == "box":
+        return ("box",), trimesh.creation.box(extents=(1.0, 1.0, 1.0)), np.asarray(solid.dims)
+    return (solid.kind, solid.dims, solid.axis, solid.offset), solid_mesh(solid), np.ones(3)
 
 
 def fit_scale(vertices: np.ndarray, semi_axes: np.ndarray, fill: float = 0.62) -> float:

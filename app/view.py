@@ -27,7 +27,7 @@ class View:
 
 #: Slightly above the plane, three-quarter view: the ellipsoid under the plane, the plane's
 #: herpolhode and the L arrow all in frame on a 16:9 projector.
-DEFAULT_VIEW = View(position=(2.6, -3.2, 1.55), look_at=(0.0, 0.0, 0.3))
+DEFAULT_VIEW = View(position=(2.55, -3.1, 1.55), look_at=(0.0, 0.0, 0.22))
 VIEWS: dict[str, View] = {
     "default": DEFAULT_VIEW,
     "top": View(position=(0.0, -0.01, 6.0), look_at=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0)),

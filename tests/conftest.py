@@ -149,6 +149,11 @@ class BrowserPage:
         loc = self.page.locator("label").filter(has_text=exact)  # type: ignore[attr-defined]
         return loc.first.get_attribute("for")
 
+    def control_count(self, label: str) -> int:
+        """How many input widgets carry this label (0 once a control is removed)."""
+        exact = re.compile(f"^{re.escape(label)}$")
+        return self.page.locator("label").filter(has_text=exact).count()  # type: ignore[attr-defined]
+
     def press_slider(self, label: str, key: str, times: int = 1) -> None:
         """Move a slider with the keyboard (each press = one step, like a user would)."""
         thumb = self.page.locator(f"[id='{self.widget_id(label)}'] [role=slider]")  # type: ignore[attr-defined]
@@ -170,6 +175,10 @@ class BrowserPage:
 
     def click_button(self, text: str) -> None:
         self.page.get_by_role("button", name=text, exact=True).click()  # type: ignore[attr-defined]
+
+    def open_folder(self, title: str) -> None:
+        """Expand a collapsed folder of the control panel by clicking its title."""
+        self.page.get_by_text(title, exact=True).first.click()  # type: ignore[attr-defined]
 
     def set_checkbox(self, label: str, checked: bool) -> None:
         box = self.page.locator(f"[id='{self.widget_id(label)}']")  # type: ignore[attr-defined]

@@ -60,6 +60,7 @@ def test_canvas_shows_the_ellipsoid(poinsot_app, open_page):
     pause(page, session)
     page.page.wait_for_timeout(500)
     shown = canvas_pixels(page)
+    page.open_folder("Show")  # collapsed by default
     page.set_checkbox("energy ellipsoid", False)
     assert wait_until(lambda: not session.scene.is_visible(Element.ELLIPSOID), 5)
     page.page.wait_for_timeout(500)
@@ -104,7 +105,8 @@ def test_choosing_a_preset_changes_the_scene(poinsot_app, open_page):
     # The sphere declares no traces and no energy control: they are gone from scene and panel.
     assert session.scene.elements == sphere.elements
     for gone in ("polhode (live)", "D = |L|²/2T", "Trail length"):
-        assert wait_until(lambda g=gone: page.page.get_by_text(g, exact=True).count() == 0, 15)
+        assert wait_until(lambda g=gone: page.control_count(g) == 0, 15), gone
+    assert page.control_count("|ω₀|") == 1  # declared by the sphere: still there
     assert np.allclose(session.scene.geometry.semi_axes, 1.0)
     page.page.wait_for_timeout(500)
     after = canvas_pixels(page)
