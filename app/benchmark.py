@@ -47,8 +47,9 @@ def _clients_main(port: int, count: int, seconds: float, redraws: int, conn) -> 
 
     probes = [Probe(port, keep_batches=True) for _ in range(count)]
     for probe in probes:
-        if not probe.wait_for(lambda p: "/space/body/ellipsoid" in p.nodes and
-                              p.has_widget(SLIDER_LABEL), 60):
+        if not probe.wait_for(
+            lambda p: "/space/body/ellipsoid" in p.nodes and p.has_widget(SLIDER_LABEL), 60
+        ):
             conn.send(("error", "a client never received the scene"))
             return
     conn.send(("ready", None))
@@ -69,10 +70,13 @@ def _clients_main(port: int, count: int, seconds: float, redraws: int, conn) -> 
 
     def listener_for(index: int):
         def listener(message: dict[str, Any], arrived: float) -> None:
-            if (message["type"] == "SceneNodeUpdateMessage"
-                    and message.get("name") == "/space/body/ellipsoid"
-                    and "scale" in message.get("updates", {})):
+            if (
+                message["type"] == "SceneNodeUpdateMessage"
+                and message.get("name") == "/space/body/ellipsoid"
+                and "scale" in message.get("updates", {})
+            ):
                 arrivals.setdefault(index, arrived)
+
         return listener
 
     for i, probe in enumerate(probes):
@@ -166,31 +170,39 @@ def run(clients: int, seconds: float = 5.0, redraws: int = 30) -> Result:
 
 
 def format_result(r: Result) -> str:
-    return "\n".join([
-        f"clients: {r.clients}",
-        f"  server CPU per client-frame : {r.cpu_per_client_frame_ms:7.3f} ms   (target <= 1 ms)",
-        f"  frame in session thread     : median {r.frame_wall_median_ms:.3f} ms, "
-        f"p95 {r.frame_wall_p95_ms:.3f} ms (wall)",
-        f"  frames per second per client: {r.frames_per_second_per_client:7.1f}        (cap 60)",
-        f"  bytes sent per frame        : {r.scene_bytes_per_frame:7.0f} B  (poses + trail "
-        f"increments) + GUI {r.gui_bytes_per_second / 1e3:.1f} kB/s (plot 10 Hz, time 5 Hz)",
-        f"  slider-to-redraw            : median {r.redraw_median_ms:.1f} ms, "
-        f"p95 {r.redraw_p95_ms:.1f} ms   (target <= 30 ms)",
-        f"  server rebuild alone        : median {r.rebuild_median_ms:.2f} ms, "
-        f"p95 {r.rebuild_p95_ms:.2f} ms",
-    ])
+    return "\n".join(
+        [
+            f"clients: {r.clients}",
+            f"  server CPU per client-frame : {r.cpu_per_client_frame_ms:7.3f} ms"
+            "   (target <= 1 ms)",
+            f"  frame in session thread     : median {r.frame_wall_median_ms:.3f} ms, "
+            f"p95 {r.frame_wall_p95_ms:.3f} ms (wall)",
+            f"  frames per second per client: {r.frames_per_second_per_client:7.1f}"
+            "        (cap 60)",
+            f"  bytes sent per frame        : {r.scene_bytes_per_frame:7.0f} B  (poses + trail "
+            f"increments) + GUI {r.gui_bytes_per_second / 1e3:.1f} kB/s (plot 10 Hz, time 5 Hz)",
+            f"  slider-to-redraw            : median {r.redraw_median_ms:.1f} ms, "
+            f"p95 {r.redraw_p95_ms:.1f} ms   (target <= 30 ms)",
+            f"  server rebuild alone        : median {r.rebuild_median_ms:.2f} ms, "
+            f"p95 {r.rebuild_p95_ms:.2f} ms",
+        ]
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m app.benchmark", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m app.benchmark", description=__doc__.split("\n")[0]
+    )
     parser.add_argument("--clients", type=int, nargs="+", default=[1, 20])
     parser.add_argument("--seconds", type=float, default=5.0, help="steady-state window")
     parser.add_argument("--redraws", type=int, default=30, help="slider moves per run")
     args = parser.parse_args(argv)
     import os
 
-    print(f"Poinsot app benchmark (python {sys.version.split()[0]}, {os.cpu_count()} CPUs, "
-          f"load average {os.getloadavg()[0]:.1f})")
+    print(
+        f"Poinsot app benchmark (python {sys.version.split()[0]}, {os.cpu_count()} CPUs, "
+        f"load average {os.getloadavg()[0]:.1f})"
+    )
     for n in args.clients:
         print(format_result(run(n, args.seconds, args.redraws)), flush=True)
     return 0

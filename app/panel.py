@@ -72,20 +72,24 @@ class Actions(Protocol):
     def reset(self) -> None: ...
     def set_trail(self, points: int) -> None: ...
     def set_visible(self, element: Element, visible: bool) -> None: ...
-
-
-def _user_only(callback: Callable[[Any], None]) -> Callable[[viser.GuiEvent], None]:
-    """Run ``callback(handle)`` for changes made in the browser only."""
-
-    def wrapped(event: viser.GuiEvent) -> None:
-        if event.client is None:
-            return
-        callback(event.target)
-
-    return wrapped
+    def report(self, error: BaseException) -> None: ...
 
 
 class ControlPanel:
+    def _user_only(self, callback: Callable[[Any], None]) -> Callable[[viser.GuiEvent], None]:
+        """Run ``callback(handle)`` for changes made in the browser only (a value set by the
+        server fires the same callbacks, with no client); never let it raise into viser."""
+
+        def wrapped(event: viser.GuiEvent) -> None:
+            if event.client is None:
+                return
+            try:
+                callback(event.target)
+            except Exception as exc:
+                self.actions.report(exc)
+
+        return wrapped
+
     def __init__(self, gui: viser.GuiApi, actions: Actions, preset: Preset) -> None:
         self.gui = gui
         self.actions = actions
@@ -104,14 +108,16 @@ class ControlPanel:
             self._folders["scene"] = folder
             labels = [p.label for p in PRESETS] + [CUSTOM.label]
             self.handles["preset"] = preset_dd = gui.add_dropdown(
-                "Preset", labels, initial_value=preset.label,
+                "Preset",
+                labels,
+                initial_value=preset.label,
                 hint="Start from a classical case; editing a slider turns it into 'Custom'.",
             )
             self.handles["source"] = gui.add_markdown(self._source_text(preset))
             self.handles["status"] = gui.add_markdown("")
 
         @preset_dd.on_update
-        @_user_only
+        @self._user_only
         def _(handle) -> None:
             for p in (*PRESETS, CUSTOM):
                 if p.label == handle.value:
@@ -119,8 +125,14 @@ class ControlPanel:
 
     # -- declaration ---------------------------------------------------------------------
     def declare(
-        self, controls: frozenset[Control], plots: frozenset[Plot], elements: frozenset[Element],
-        params: Parameters, speed: float, trail: int, visible: Callable[[Element], bool],
+        self,
+        controls: frozenset[Control],
+        plots: frozenset[Plot],
+        elements: frozenset[Element],
+        params: Parameters,
+        speed: float,
+        trail: int,
+        visible: Callable[[Element], bool],
     ) -> None:
         """Create exactly the declared groups (keeping existing ones), remove the others."""
         wanted: set[Any] = set(controls) | set(plots)
@@ -220,11 +232,15 @@ class ControlPanel:
         with folder:
             for i in range(3):
                 slider = self.gui.add_slider(
-                    f"I{'₁₂₃'[i]}", INERTIA_RANGE[0], INERTIA_RANGE[1], 0.01,
-                    float(params.inertia[i]), order=float(i),
+                    f"I{'₁₂₃'[i]}",
+                    INERTIA_RANGE[0],
+                    INERTIA_RANGE[1],
+                    0.01,
+                    float(params.inertia[i]),
+                    order=float(i),
                     hint="A principal moment of inertia (mass × length²).",
                 )
-                slider.on_update(_user_only(self._inertia_cb(i)))
+                slider.on_update(self._user_only(self._inertia_cb(i)))
                 sliders[f"I{i + 1}"] = slider
         return self._tag(Control.INERTIA, **sliders)
 
@@ -239,13 +255,18 @@ class ControlPanel:
         lo, hi = params.D_range
         with self._folder("motion", "Motion"):
             slider = self.gui.add_slider(
-                "D = |L|²/2T", lo, hi, 0.001, float(params.D), order=0.0,
+                "D = |L|²/2T",
+                lo,
+                hi,
+                0.001,
+                float(params.D),
+                order=0.0,
                 marks=self._energy_marks(params),
                 hint="Energy parameter in [I_min, I_max]; D = I₂ is the separatrix.",
             )
 
         @slider.on_update
-        @_user_only
+        @self._user_only
         def _(handle) -> None:
             value = float(handle.value)
             self.actions.edit(lambda p: _with_D(p, value))
@@ -266,27 +287,33 @@ class ControlPanel:
             side = self.gui.add_button_group("Side of separatrix", SIDE_OPTIONS, order=1.0)
             pole = self.gui.add_button_group("Polhode", POLE_OPTIONS, order=2.0)
 
-        @side.on_click
-        def _(event: viser.GuiEvent) -> None:
-            choice = "major" if event.target.value == SIDE_OPTIONS[1] else "minor"
+        def choose_side(handle) -> None:
+            choice = "major" if handle.value == SIDE_OPTIONS[1] else "minor"
             self.actions.edit(lambda p: p.mirrored(choice))
 
-        @pole.on_click
-        def _(event: viser.GuiEvent) -> None:
-            sign = 1 if event.target.value == POLE_OPTIONS[0] else -1
+        def choose_pole(handle) -> None:
+            sign = 1 if handle.value == POLE_OPTIONS[0] else -1
             self.actions.edit(lambda p: _with_pole(p, sign))
+
+        side.on_click(self._user_only(choose_side))
+        pole.on_click(self._user_only(choose_pole))
 
         return self._tag(Control.SIDE, side=side, pole=pole)
 
     def _build_omega_norm(self, params: Parameters) -> list[Any]:
         with self._folder("motion", "Motion"):
             slider = self.gui.add_slider(
-                "|ω₀|", OMEGA_NORM_RANGE[0], OMEGA_NORM_RANGE[1], 0.05, float(params.omega_norm),
-                order=3.0, hint="Initial angular speed (rad per time unit).",
+                "|ω₀|",
+                OMEGA_NORM_RANGE[0],
+                OMEGA_NORM_RANGE[1],
+                0.05,
+                float(params.omega_norm),
+                order=3.0,
+                hint="Initial angular speed (rad per time unit).",
             )
 
         @slider.on_update
-        @_user_only
+        @self._user_only
         def _(handle) -> None:
             value = float(handle.value)
             self.actions.edit(lambda p: _with_omega_norm(p, value))
@@ -296,10 +323,15 @@ class ControlPanel:
     def _build_speed(self, speed: float) -> list[Any]:
         with self._folder("playback", "Playback"):
             slider = self.gui.add_slider(
-                "Speed", SPEED_RANGE[0], SPEED_RANGE[1], 0.05, float(speed), order=0.0,
+                "Speed",
+                SPEED_RANGE[0],
+                SPEED_RANGE[1],
+                0.05,
+                float(speed),
+                order=0.0,
                 hint="Simulation time units per second.",
             )
-        slider.on_update(_user_only(lambda h: self.actions.set_speed(float(h.value))))
+        slider.on_update(self._user_only(lambda h: self.actions.set_speed(float(h.value))))
         return self._tag(Control.SPEED, speed=slider)
 
     def _build_playback(self) -> list[Any]:
@@ -307,18 +339,23 @@ class ControlPanel:
             pause = self.gui.add_button("Pause", icon=viser.Icon.PLAYER_PAUSE, order=1.0)
             step = self.gui.add_button("Step", icon=viser.Icon.PLAYER_TRACK_NEXT, order=2.0)
             reset = self.gui.add_button("Reset", icon=viser.Icon.REFRESH, order=3.0)
-        pause.on_click(lambda _: self.actions.toggle_pause())
-        step.on_click(lambda _: self.actions.step())
-        reset.on_click(lambda _: self.actions.reset())
+        pause.on_click(self._user_only(lambda _: self.actions.toggle_pause()))
+        step.on_click(self._user_only(lambda _: self.actions.step()))
+        reset.on_click(self._user_only(lambda _: self.actions.reset()))
         return self._tag(Control.PLAYBACK, pause=pause, step=step, reset=reset)
 
     def _build_trail(self, trail: int) -> list[Any]:
         with self._folder("playback", "Playback"):
             slider = self.gui.add_slider(
-                "Trail length", TRAIL_RANGE[0], TRAIL_RANGE[1], 100, int(trail), order=4.0,
+                "Trail length",
+                TRAIL_RANGE[0],
+                TRAIL_RANGE[1],
+                100,
+                int(trail),
+                order=4.0,
                 hint="Points kept in the polhode and herpolhode traces.",
             )
-        slider.on_update(_user_only(lambda h: self.actions.set_trail(int(h.value))))
+        slider.on_update(self._user_only(lambda h: self.actions.set_trail(int(h.value))))
         return self._tag(Control.TRAIL, trail=slider)
 
     def _build_visibility(
@@ -330,7 +367,7 @@ class ControlPanel:
                 box = self.gui.add_checkbox(
                     ELEMENT_LABELS[element], visible(element), order=float(n)
                 )
-                box.on_update(_user_only(self._visible_cb(element)))
+                box.on_update(self._user_only(self._visible_cb(element)))
                 boxes[f"show_{element.value}"] = box
         return self._tag(Control.VISIBILITY, **boxes)
 
@@ -341,8 +378,11 @@ class ControlPanel:
         series = [viser.uplot.Series(label="t")]
         for i, color in enumerate(palette.PLOT_SERIES):
             series.append(viser.uplot.Series(label=f"ω{'₁₂₃'[i]}", stroke=color, width=2))
-        axis = {"stroke": "#c8d0da", "grid": {"stroke": "#3a4048", "width": 1},
-                "ticks": {"stroke": "#3a4048"}}
+        axis = {
+            "stroke": "#c8d0da",
+            "grid": {"stroke": "#3a4048", "width": 1},
+            "ticks": {"stroke": "#3a4048"},
+        }
         empty = np.zeros(0)
         with self._data_tab:
             plot = self._add_plot(series, axis, empty)

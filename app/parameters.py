@@ -19,6 +19,7 @@ OMEGA_NORM_RANGE = (0.2, 4.0)
 SPEED_RANGE = (0.05, 4.0)
 TRAIL_RANGE = (100, 6000)
 
+
 @dataclasses.dataclass(frozen=True)
 class Parameters:
     """Moments (caller order), D = |L|²/2T, which polhode, and |omega0|."""
@@ -30,8 +31,12 @@ class Parameters:
 
     @classmethod
     def from_preset(cls, preset: Preset) -> Parameters:
-        return cls(tuple(float(i) for i in preset.inertia), float(preset.D),  # type: ignore[arg-type]
-                   int(preset.pole_sign), float(preset.omega_norm))
+        return cls(
+            tuple(float(i) for i in preset.inertia),
+            float(preset.D),  # type: ignore[arg-type]
+            int(preset.pole_sign),
+            float(preset.omega_norm),
+        )
 
     @property
     def D_range(self) -> tuple[float, float]:
@@ -47,7 +52,9 @@ class Parameters:
         inertia[index] = float(value)
         lo, hi = min(inertia), max(inertia)
         return dataclasses.replace(
-            self, inertia=tuple(inertia), D=min(max(self.D, lo), hi)  # type: ignore[arg-type]
+            self,
+            inertia=tuple(inertia),
+            D=min(max(self.D, lo), hi),  # type: ignore[arg-type]
         )
 
     def mirrored(self, side: str) -> Parameters:
@@ -84,7 +91,10 @@ class Parameters:
         """True while these are still the preset's values (within slider rounding)."""
         other = Parameters.from_preset(preset)
         return (
-            all(math.isclose(a, b, rel_tol=rel) for a, b in zip(self.inertia, other.inertia, strict=True))
+            all(
+                math.isclose(a, b, rel_tol=rel)
+                for a, b in zip(self.inertia, other.inertia, strict=True)
+            )
             and math.isclose(self.D, other.D, rel_tol=rel)
             and self.pole_sign == other.pole_sign
             and math.isclose(self.omega_norm, other.omega_norm, rel_tol=rel)

@@ -30,9 +30,8 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import math
 from collections.abc import Callable
-from typing import ContextManager
+from contextlib import AbstractContextManager
 
 import numpy as np
 import trimesh
@@ -116,8 +115,9 @@ class Geometry:
             solid_scale = shape_scale * solids.fit_scale(vertices, semi * scale)
         closed = body.regime is not Regime.SEPARATRIX
         speed = _finite("the trace speed", trace_speed(body, scale))
-        return cls(scale, semi * scale, h * scale, polhode, closed, key, mesh, solid_scale,
-                   float(speed))
+        return cls(
+            scale, semi * scale, h * scale, polhode, closed, key, mesh, solid_scale, float(speed)
+        )
 
     @property
     def solid_mesh(self) -> trimesh.Trimesh | None:
@@ -150,7 +150,7 @@ class PoinsotScene:
         elements: frozenset[Element],
         trail_points: int = 1200,
         root: str = ROOT,
-        atomic: Callable[[], ContextManager[None]] = contextlib.nullcontext,
+        atomic: Callable[[], AbstractContextManager[None]] = contextlib.nullcontext,
     ) -> None:
         """``atomic``: the owner's ``atomic`` (``client.atomic`` or ``server.atomic``), so
         that one frame's messages reach the browser together."""
@@ -231,7 +231,10 @@ class PoinsotScene:
         return self._body
 
     def load(
-        self, body: FreeRigidBody, solid: Solid | None, t: float = 0.0,
+        self,
+        body: FreeRigidBody,
+        solid: Solid | None,
+        t: float = 0.0,
         frame_time: float = 1.0 / 60.0,
     ) -> Frame:
         """Show ``body`` (and ``solid``) at time ``t``; ``frame_time`` is the simulation time one
@@ -315,8 +318,10 @@ class PoinsotScene:
         if restart:
             keep[-1] = True
         if keep.any():
-            for element, points in ((Element.POLHODE, samples.omega),
-                                    (Element.HERPOLHODE, samples.contact)):
+            for element, points in (
+                (Element.POLHODE, samples.omega),
+                (Element.HERPOLHODE, samples.contact),
+            ):
                 if element in self._trails:
                     self._pending.setdefault(element, []).append(
                         (points[keep] * s).astype(np.float32)
@@ -325,8 +330,7 @@ class PoinsotScene:
         if restart or self._frames_since_flush >= TRAIL_EVERY:
             self.flush_trails()
         self._k_last = int(samples.k[-1])
-        self._frame = Frame(float(samples.t[-1]), samples.omega[-1].copy(), q, tip,
-                            len(samples.k))
+        self._frame = Frame(float(samples.t[-1]), samples.omega[-1].copy(), q, tip, len(samples.k))
         return self._frame
 
     def flush_trails(self) -> None:
@@ -359,9 +363,15 @@ class PoinsotScene:
             sphere = solids.ellipsoid_unit_mesh()
             nodes.append(
                 api.add_mesh_simple(
-                    f"{r}/body/ellipsoid", sphere.vertices, sphere.faces,
-                    color=palette.ELLIPSOID, opacity=palette.ELLIPSOID_OPACITY,
-                    material="standard", side="front", cast_shadow=False, receive_shadow=False,
+                    f"{r}/body/ellipsoid",
+                    sphere.vertices,
+                    sphere.faces,
+                    color=palette.ELLIPSOID,
+                    opacity=palette.ELLIPSOID_OPACITY,
+                    material="standard",
+                    side="front",
+                    cast_shadow=False,
+                    receive_shadow=False,
                 )
             )
         elif element is Element.AXES:
@@ -370,15 +380,19 @@ class PoinsotScene:
             for i in range(3):
                 nodes.append(
                     api.add_line_segments(
-                        f"{r}/body/axis{i + 1}", np.zeros((1, 2, 3), np.float32),
-                        palette.AXES[i], thickness=palette.AXIS_WIDTH_PX,
+                        f"{r}/body/axis{i + 1}",
+                        np.zeros((1, 2, 3), np.float32),
+                        palette.AXES[i],
+                        thickness=palette.AXIS_WIDTH_PX,
                         thickness_units="screen",
                     )
                 )
             for i in range(3):
                 nodes.append(
                     api.add_label(
-                        f"{r}/body/axis{i + 1}/label", f"{i + 1}", anchor="center-center",
+                        f"{r}/body/axis{i + 1}/label",
+                        f"{i + 1}",
+                        anchor="center-center",
                         font_screen_scale=1.3,
                     )
                 )
@@ -393,18 +407,28 @@ class PoinsotScene:
             nodes += [
                 plane,
                 api.add_mesh_simple(
-                    f"{r}/plane/disc", vertices, faces, color=palette.PLANE,
-                    opacity=palette.PLANE_OPACITY, side="double", cast_shadow=False,
+                    f"{r}/plane/disc",
+                    vertices,
+                    faces,
+                    color=palette.PLANE,
+                    opacity=palette.PLANE_OPACITY,
+                    side="double",
+                    cast_shadow=False,
                     receive_shadow=False,
                 ),
                 api.add_line_segments(
-                    f"{r}/plane/grid", solids.disc_grid_segments(PLANE_RADIUS, GRID_SPACING),
-                    palette.PLANE_GRID, thickness=palette.GRID_WIDTH_PX,
+                    f"{r}/plane/grid",
+                    solids.disc_grid_segments(PLANE_RADIUS, GRID_SPACING),
+                    palette.PLANE_GRID,
+                    thickness=palette.GRID_WIDTH_PX,
                     thickness_units="screen",
                 ),
                 api.add_line_segments(
-                    f"{r}/plane/rim", solids.circle_segments(PLANE_RADIUS),
-                    palette.PLANE_RIM, thickness=2.0, thickness_units="screen",
+                    f"{r}/plane/rim",
+                    solids.circle_segments(PLANE_RADIUS),
+                    palette.PLANE_RIM,
+                    thickness=2.0,
+                    thickness_units="screen",
                 ),
             ]
         elif element is Element.CONTACT:
@@ -417,39 +441,61 @@ class PoinsotScene:
             # The label rides on /space/tip, posed at the contact point: no message of its own.
             nodes += [
                 api.add_arrows(
-                    f"{r}/omega", np.array([[[0, 0, 0], [0, 0, 1]]], np.float32),
-                    palette.OMEGA, shaft_radius=0.014, head_radius=0.04, head_length=0.11,
+                    f"{r}/omega",
+                    np.array([[[0, 0, 0], [0, 0, 1]]], np.float32),
+                    palette.OMEGA,
+                    shaft_radius=0.014,
+                    head_radius=0.04,
+                    head_length=0.11,
                 ),
-                api.add_label(f"{r}/tip/omega_label", "ω", anchor="bottom-right",
-                              font_screen_scale=1.4, position=(-0.03, 0.0, -0.04)),
+                api.add_label(
+                    f"{r}/tip/omega_label",
+                    "ω",
+                    anchor="bottom-right",
+                    font_screen_scale=1.4,
+                    position=(-0.03, 0.0, -0.04),
+                ),
             ]
         elif element is Element.L:
             nodes += [
                 api.add_arrows(
-                    f"{r}/L", np.array([[[0, 0, 0], [0, 0, 1]]], np.float32),
-                    palette.ANGULAR_MOMENTUM, shaft_radius=0.016, head_radius=0.05,
+                    f"{r}/L",
+                    np.array([[[0, 0, 0], [0, 0, 1]]], np.float32),
+                    palette.ANGULAR_MOMENTUM,
+                    shaft_radius=0.016,
+                    head_radius=0.05,
                     head_length=0.14,
                 ),
-                api.add_label(f"{r}/L_label", "L", anchor="bottom-left",
-                              font_screen_scale=1.4),
+                api.add_label(f"{r}/L_label", "L", anchor="bottom-left", font_screen_scale=1.4),
             ]
         elif element is Element.POLHODE_FULL:
             nodes.append(
                 api.add_line_segments(
-                    f"{r}/body/polhode_full", np.zeros((1, 2, 3), np.float32),
-                    palette.POLHODE_FULL, thickness=palette.FULL_POLHODE_WIDTH_PX,
-                    thickness_units="screen", scale=POLHODE_INFLATE,
+                    f"{r}/body/polhode_full",
+                    np.zeros((1, 2, 3), np.float32),
+                    palette.POLHODE_FULL,
+                    thickness=palette.FULL_POLHODE_WIDTH_PX,
+                    thickness_units="screen",
+                    scale=POLHODE_INFLATE,
                 )
             )
         elif element is Element.POLHODE:
             self._trails[element] = Trail(
-                api, f"{r}/body/polhode", palette.POLHODE, palette.TRACE_WIDTH_PX,
-                self._trail_points, scale=POLHODE_INFLATE,
+                api,
+                f"{r}/body/polhode",
+                palette.POLHODE,
+                palette.TRACE_WIDTH_PX,
+                self._trail_points,
+                scale=POLHODE_INFLATE,
             )
         elif element is Element.HERPOLHODE:
             self._trails[element] = Trail(
-                api, f"{r}/herpolhode", palette.HERPOLHODE, palette.TRACE_WIDTH_PX,
-                self._trail_points, position=(0.0, 0.0, HERPOLHODE_LIFT),
+                api,
+                f"{r}/herpolhode",
+                palette.HERPOLHODE,
+                palette.TRACE_WIDTH_PX,
+                self._trail_points,
+                position=(0.0, 0.0, HERPOLHODE_LIFT),
             )
         elif element is Element.SOLID:
             pass  # built in _apply_geometry: the mesh itself changes with the body
@@ -491,9 +537,14 @@ class PoinsotScene:
                 if not nodes:
                     nodes.append(
                         self.api.add_mesh_simple(
-                            f"{self.root}/body/solid", g.solid_base.vertices, g.solid_base.faces,
-                            color=palette.SOLID, material="standard", flat_shading=True,
-                            cast_shadow=False, receive_shadow=False,
+                            f"{self.root}/body/solid",
+                            g.solid_base.vertices,
+                            g.solid_base.faces,
+                            color=palette.SOLID,
+                            material="standard",
+                            flat_shading=True,
+                            cast_shadow=False,
+                            receive_shadow=False,
                             visible=element not in self._hidden,
                         )
                     )

@@ -22,8 +22,9 @@ import viser
 from app import readouts
 from app.budget import FrameBudget
 from app.clock import SimClock
+from app.lecture import add_lecture_controls
 from app.panel import ControlPanel
-from app.parameters import Parameters
+from app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters
 from app.presets import ALL_ELEMENTS, CUSTOM, DEFAULT_PRESET, Element, Preset, Solid
 from app.scene import Frame, PoinsotScene
 from app.view import DEFAULT_VIEW, View, apply_theme
@@ -98,6 +99,8 @@ class Session:
         self.panel = ControlPanel(client.gui, self, preset)
         self._apply_preset(preset)
         self._rebuild()
+        # Exports, camera views, theme and hotkeys (issue 5) mount on the session's panel.
+        self.lecture = add_lecture_controls(self)
 
     # -- lifecycle -----------------------------------------------------------------------
     def start(self) -> Session:
@@ -131,6 +134,8 @@ class Session:
         self._post(lambda: self._edit(change))
 
     def set_speed(self, speed: float) -> None:
+        speed = min(max(float(speed), SPEED_RANGE[0]), SPEED_RANGE[1])
+
         def action() -> None:
             self.clock.speed = speed
             self.scene.set_frame_time(self.frame_time)
@@ -159,6 +164,8 @@ class Session:
         self._post(self._reset)
 
     def set_trail(self, points: int) -> None:
+        points = min(max(int(points), TRAIL_RANGE[0]), TRAIL_RANGE[1])
+
         def action() -> None:
             self.scene.trail_points = points
 
@@ -166,6 +173,10 @@ class Session:
 
     def set_visible(self, element: Element, visible: bool) -> None:
         self._post(lambda: self.scene.set_visible(element, visible))
+
+    def report(self, error: BaseException) -> None:
+        """Show an error raised outside the frame thread (a GUI callback)."""
+        self._post(lambda: self._report(error))
 
     def wait_applied(self, generation: int, timeout: float = 5.0) -> int:
         """Block (tests, benchmark) until a rebuild after ``generation`` was applied."""
@@ -225,6 +236,7 @@ class Session:
             return
         start = time.perf_counter()
         self.frame = self.scene.advance(self.clock.now())
+        self.lecture.on_frame(self.frame)
         self.stats.frame_seconds.append(time.perf_counter() - start)
         self.stats.frames += 1
         self.budget.frame_done()
@@ -255,8 +267,13 @@ class Session:
             self._dirty = True
         self.scene.declare(preset.elements)
         self.panel.declare(
-            preset.controls, preset.plots, preset.elements, self._desired, self.clock.speed,
-            self.scene.trail_points, self.scene.is_visible,
+            preset.controls,
+            preset.plots,
+            preset.elements,
+            self._desired,
+            self.clock.speed,
+            self.scene.trail_points,
+            self.scene.is_visible,
         )
         self.panel.show_preset(preset)
         self._show_playback()
@@ -273,8 +290,13 @@ class Session:
             self.preset = CUSTOM
             self.scene.declare(ALL_ELEMENTS)
             self.panel.declare(
-                CUSTOM.controls, CUSTOM.plots, CUSTOM.elements, new, self.clock.speed,
-                self.scene.trail_points, self.scene.is_visible,
+                CUSTOM.controls,
+                CUSTOM.plots,
+                CUSTOM.elements,
+                new,
+                self.clock.speed,
+                self.scene.trail_points,
+                self.scene.is_visible,
             )
             self.panel.show_preset(CUSTOM)
 

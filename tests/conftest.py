@@ -235,9 +235,11 @@ def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
         errors: list[str] = []
         page.on(
             "console",
-            lambda m: errors.append(m.text)
-            if m.type == "error" and not any(b in m.text for b in BENIGN_CONSOLE)
-            else None,
+            lambda m: (
+                errors.append(m.text)
+                if m.type == "error" and not any(b in m.text for b in BENIGN_CONSOLE)
+                else None
+            ),
         )
         page.on("pageerror", lambda e: errors.append(f"pageerror: {e}"))
         page.goto(url)

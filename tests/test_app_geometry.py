@@ -47,7 +47,8 @@ def check_finite(probe: Probe) -> None:
 def sent_geometry(probe: Probe) -> dict[str, np.ndarray | float]:
     nodes, _ = probe.snapshot()
     for parent in ("/space",):
-        assert np.allclose(nodes[parent].wxyz, (1, 0, 0, 0)) and np.allclose(nodes[parent].position, 0)
+        assert np.allclose(nodes[parent].wxyz, (1, 0, 0, 0))
+        assert np.allclose(nodes[parent].position, 0)
     ellipsoid = nodes["/space/body/ellipsoid"]
     assert np.allclose(ellipsoid.wxyz, (1, 0, 0, 0)) and np.allclose(ellipsoid.position, 0)
     arrow = np.asarray(nodes["/space/omega"].props["points"], dtype=np.float64).reshape(-1, 2, 3)

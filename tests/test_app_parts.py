@@ -66,8 +66,9 @@ def test_a_preset_s_solid_has_the_preset_s_moments(preset):
     assert np.allclose(tensor - np.diag(np.diag(tensor)), 0.0, atol=1e-9 * np.trace(tensor))
     moments = np.diag(tensor)
     # Ratios (the mass is a free scale); polygonal cylinders differ from circles by ~0.2 %.
-    assert np.allclose(moments / moments.max(), np.divide(preset.inertia, max(preset.inertia)),
-                       rtol=5e-3)
+    assert np.allclose(
+        moments / moments.max(), np.divide(preset.inertia, max(preset.inertia)), rtol=5e-3
+    )
 
 
 def test_presets_are_found_by_key_and_label():
@@ -187,7 +188,7 @@ def test_trail_is_bounded_and_sends_increments_only():
     assert worst <= 16 * 2 * 3 * 4  # at most one chunk per frame
     assert 200 - 16 <= trail.segment_count <= 200
     drawn = trail.points()
-    assert np.array_equal(drawn, points[-len(drawn):])  # contiguous, oldest first
+    assert np.array_equal(drawn, points[-len(drawn) :])  # contiguous, oldest first
     assert len(api.live) <= 200 // 16 + 1
     trail.max_points = 50
     assert trail.segment_count <= 50
@@ -212,7 +213,9 @@ def test_cli_serve_forms_parse_alike():
 def test_cli_serves_the_page_and_prints_the_url(argv):
     proc = subprocess.Popen(
         [sys.executable, *argv, "--port", "0", "--preset", "minor"],
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
     )
     try:
         url = None
@@ -232,8 +235,9 @@ def test_cli_serves_the_page_and_prints_the_url(argv):
 
 def test_console_script_is_installed():
     scripts = [p for p in (sys.prefix + "/bin/poinsot",)]
-    out = subprocess.run([scripts[0], "serve", "--help"], capture_output=True, text=True,
-                         timeout=30)
+    out = subprocess.run(
+        [scripts[0], "serve", "--help"], capture_output=True, text=True, timeout=30
+    )
     assert out.returncode == 0 and "--host" in out.stdout and "--port" in out.stdout
 
 
@@ -241,3 +245,58 @@ def test_element_enum_matches_labels():
     from app.panel import ELEMENT_LABELS
 
     assert set(ELEMENT_LABELS) == set(Element)
+
+
+# -- motion sampling and the frame budget ------------------------------------------------
+def test_motion_sampler_gives_the_exact_solution_at_grid_times_in_batches():
+    from app.motion import BATCH, MotionSampler
+
+    body = Parameters.from_preset(preset_by_key("t_handle")).build()
+    sampler = MotionSampler(body, step=0.01, stride=2, t0=0.5)
+    assert sampler.index(0.5) == 0 and sampler.index(0.5 + 0.0349) == 3
+    assert sampler.time(3) == pytest.approx(0.53)
+    first = sampler.samples(0, 0)
+    later = sampler.samples(5, 40)
+    assert sampler.evaluations == 1  # one physics call for a whole batch of frames
+    omega, rotation, contact = body.sample(later.t)
+    assert np.array_equal(later.omega, omega) and np.array_equal(later.contact, contact)
+    assert np.array_equal(later.quat_xyzw, rotation.as_quat())  # exact values, no interpolation
+    assert np.allclose(first.t, [0.5])
+    sampler.samples(BATCH + 3, BATCH + 10)
+    assert sampler.evaluations == 2
+
+
+def test_grid_step_keeps_trace_chords_short():
+    from app.motion import STEPS_PER_FRAME, MotionSampler, trace_speed
+
+    body = Parameters.from_preset(preset_by_key("major")).build()
+    scale = 1.0 / float(np.max(body.semi_axes))
+    speed = trace_speed(body, scale)
+    for frame_time in (1 / 60, 4 / 60):
+        sampler = MotionSampler.for_body(body, speed, frame_time, 0.02)
+        assert sampler.step <= frame_time / STEPS_PER_FRAME
+        s = sampler.samples(0, 400)
+        kept = s.contact[s.k % sampler.stride == 0] * scale
+        chords = np.linalg.norm(np.diff(kept, axis=0), axis=1)
+        assert chords.max() <= 0.02 * 1.01
+
+
+def test_frame_budget_shares_one_cpu_among_sessions():
+    from app.budget import FrameBudget
+
+    budget = FrameBudget(max_fps=60, min_fps=10, share=0.5, recalibrate_seconds=0.0)
+    assert budget.fps == 60
+    budget._cost = 1e-3  # as if measured: 1 ms per client-frame
+    budget.set_sessions(1)
+    assert budget.fps == 60  # 1 client x 60 fps x 1 ms = 6 % of a CPU
+    budget.set_sessions(20)
+    assert budget.fps == pytest.approx(25)  # 0.5 CPU / (20 x 1 ms)
+    budget.set_sessions(200)
+    assert budget.fps == 10  # never below min_fps
+    budget.set_sessions(1)
+    start = time.process_time()
+    while time.process_time() - start < 0.05:
+        pass
+    for _ in range(20):
+        budget.frame_done()
+    assert budget.cost > 0.0 and budget.fps == 60

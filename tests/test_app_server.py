@@ -54,20 +54,27 @@ def scene_names(probe) -> set[str]:
 
 def visible_labels(probe) -> set[str]:
     _, widgets = probe.snapshot()
-    return {w.props["label"] for w in widgets.values()
-            if w.props.get("label") and w.props.get("visible", True)}
+    return {
+        w.props["label"]
+        for w in widgets.values()
+        if w.props.get("label") and w.props.get("visible", True)
+    }
 
 
 def has_plot(probe) -> bool:
     _, widgets = probe.snapshot()
-    return any(w.type == "GuiUplotMessage" and w.props.get("visible", True)
-               for w in widgets.values())
+    return any(
+        w.type == "GuiUplotMessage" and w.props.get("visible", True) for w in widgets.values()
+    )
 
 
 def markdown_texts(probe) -> list[str]:
     """The markdown the browser shows (the probe's model is read under its lock)."""
-    return [str(w.props.get("_markdown", "")) for w in probe.widgets.values()
-            if w.type == "GuiMarkdownMessage"]
+    return [
+        str(w.props.get("_markdown", ""))
+        for w in probe.widgets.values()
+        if w.type == "GuiMarkdownMessage"
+    ]
 
 
 def expected_nodes(preset) -> set[str]:
@@ -85,9 +92,9 @@ def test_only_what_the_preset_declares_is_created(preset, make_app, make_probe):
     probe = make_probe(app)
     session = session_of(app)
     assert wait_until(lambda: session.stats.frames > 3, 10)
-    assert probe.wait_for(lambda p: scene_names(p) == expected_nodes(preset), 10), (
-        scene_names(probe) ^ expected_nodes(preset)
-    )
+    assert probe.wait_for(lambda p: scene_names(p) == expected_nodes(preset), 10), scene_names(
+        probe
+    ) ^ expected_nodes(preset)
     labels = visible_labels(probe)
     for control, names in CONTROL_LABELS.items():
         assert (names <= labels) == (control in preset.controls), control
@@ -104,9 +111,11 @@ def test_switching_preset_creates_and_removes_exactly(poinsot_app, probe):
     for key in ("sphere", "t_handle", "sphere", "oblate"):
         preset = preset_by_key(key)
         probe.set_value(uuid, preset.label)
-        assert wait_until(lambda p=preset: session.preset is p and session.params.inertia
-                          == p.inertia, 10)
-        assert probe.wait_for(lambda p, e=expected_nodes(preset): scene_names(p) == e, 10)
+        assert wait_until(
+            lambda p=preset: session.preset is p and session.params.inertia == p.inertia, 10
+        )
+        expected = expected_nodes(preset)
+        assert probe.wait_for(lambda p, e=expected: scene_names(p) == e, 10)
         assert probe.wait_for(lambda p, pr=preset: has_plot(p) == (Plot.OMEGA in pr.plots), 10)
     assert session.stats.errors == 0, session.stats.last_error
 
@@ -118,8 +127,12 @@ def frame_traffic(probe, seconds: float) -> list:
 
 
 PER_FRAME_TYPES = {
-    "SetOrientationMessage", "SetPositionMessage", "SceneNodeUpdateMessage",
-    "LineSegmentsMessage", "RemoveSceneNodeMessage", "SetSceneNodeVisibilityMessage",
+    "SetOrientationMessage",
+    "SetPositionMessage",
+    "SceneNodeUpdateMessage",
+    "LineSegmentsMessage",
+    "RemoveSceneNodeMessage",
+    "SetSceneNodeVisibilityMessage",
     "GuiUpdateMessage",
 }
 
@@ -180,7 +193,8 @@ def test_a_stalled_client_does_not_stall_the_others(poinsot_app, make_probe):
     assert wait_until(lambda: fast_session.stats.frames > 10, 10)
     slow.stall()
     time.sleep(1.0)  # let the stalled socket's buffers fill
-    f_fast, f_slow, n_batches = fast_session.stats.frames, slow_session.stats.frames, len(fast.batches)
+    f_fast, f_slow = fast_session.stats.frames, slow_session.stats.frames
+    n_batches = len(fast.batches)
     time.sleep(2.0)
     assert fast_session.stats.frames - f_fast > 60  # the other session keeps animating
     assert len(fast.batches) - n_batches > 60  # and its browser keeps receiving
@@ -225,8 +239,9 @@ def test_an_impossible_body_is_refused_and_the_last_scene_kept(poinsot_app, prob
     session.wait_applied(generation)
     assert session.status == "" and session.body is not body_before
     assert probe.wait_for(lambda p: not any("No real body" in t for t in markdown_texts(p)), 5)
-    assert probe.wait_for(lambda p: not np.allclose(
-        p.nodes["/space/body/ellipsoid"].props["scale"], scale_before), 5)
+    assert probe.wait_for(
+        lambda p: not np.allclose(p.nodes["/space/body/ellipsoid"].props["scale"], scale_before), 5
+    )
 
 
 def test_random_input_never_raises_nor_sends_nan(poinsot_app, probe):
@@ -235,8 +250,12 @@ def test_random_input_never_raises_nor_sends_nan(poinsot_app, probe):
     session = session_of(poinsot_app)
     rng = random.Random(1234)
     sliders = {
-        "I₁": (0.1, 5.0), "I₂": (0.1, 5.0), "I₃": (0.1, 5.0), "|ω₀|": (0.2, 4.0),
-        "Speed": (0.05, 4.0), "Trail length": (100, 6000),
+        "I₁": (0.1, 5.0),
+        "I₂": (0.1, 5.0),
+        "I₃": (0.1, 5.0),
+        "|ω₀|": (0.2, 4.0),
+        "Speed": (0.05, 4.0),
+        "Trail length": (100, 6000),
     }
     presets = [p.label for p in (*PRESETS, CUSTOM)]
     for _ in range(150):
@@ -310,8 +329,14 @@ def test_slider_to_redraw_is_fast(poinsot_app, probe):
         start = time.perf_counter()
         probe.set_value(uuid, value)
         assert probe.wait_for(
-            lambda p, v=value: session.params.inertia[1] == v
-            and np.allclose(p.nodes["/space/body/ellipsoid"].props["scale"],
-                            session.scene.geometry.semi_axes), 5)
+            lambda p, v=value: (
+                session.params.inertia[1] == v
+                and np.allclose(
+                    p.nodes["/space/body/ellipsoid"].props["scale"],
+                    session.scene.geometry.semi_axes,
+                )
+            ),
+            5,
+        )
         assert time.perf_counter() - start < 0.5
     assert max(session.stats.rebuild_seconds) < 0.1

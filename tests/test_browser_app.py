@@ -9,9 +9,9 @@ import colorsys
 
 import numpy as np
 import pytest
+from conftest import session_of, wait_until
 
 from app.presets import DEFAULT_PRESET, Element, preset_by_key
-from conftest import session_of, wait_until
 
 pytestmark = pytest.mark.browser
 
@@ -100,8 +100,14 @@ def test_choosing_a_preset_changes_the_scene(poinsot_app, open_page):
     before = canvas_pixels(page)
     sphere = preset_by_key("sphere")
     page.choose("Preset", sphere.label)
-    assert wait_until(lambda: session.preset.key == "sphere" and session.body is not None
-                      and session.params.inertia == sphere.inertia, 10)
+    assert wait_until(
+        lambda: (
+            session.preset.key == "sphere"
+            and session.body is not None
+            and session.params.inertia == sphere.inertia
+        ),
+        10,
+    )
     # The sphere declares no traces and no energy control: they are gone from scene and panel.
     assert session.scene.elements == sphere.elements
     for gone in ("polhode (live)", "D = |L|²/2T", "Trail length"):
