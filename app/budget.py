@@ -16,7 +16,10 @@ import time
 
 class FrameBudget:
     def __init__(
-        self, max_fps: float = 60.0, min_fps: float = 12.0, share: float = 0.6,
+        self,
+        max_fps: float = 60.0,
+        min_fps: float = 12.0,
+        share: float = 0.6,
         recalibrate_seconds: float = 0.5,
     ) -> None:
         self.max_fps, self.min_fps, self.share = float(max_fps), float(min_fps), float(share)

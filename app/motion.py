@@ -77,7 +77,11 @@ class MotionSampler:
 
     @classmethod
     def for_body(
-        cls, body: FreeRigidBody, speed_display: float, frame_time: float, max_chord: float,
+        cls,
+        body: FreeRigidBody,
+        speed_display: float,
+        frame_time: float,
+        max_chord: float,
         t0: float = 0.0,
     ) -> MotionSampler:
         """Grid for ``body`` when one frame advances the clock by ``frame_time``."""
@@ -110,5 +114,6 @@ class MotionSampler:
             self.evaluations += 1
             cache = self._cache = Samples(k, t, omega, quat, contact)
         i, j = k_first - int(cache.k[0]), k_last - int(cache.k[0]) + 1
-        return Samples(cache.k[i:j], cache.t[i:j], cache.omega[i:j], cache.quat_xyzw[i:j],
-                       cache.contact[i:j])
+        return Samples(
+            cache.k[i:j], cache.t[i:j], cache.omega[i:j], cache.quat_xyzw[i:j], cache.contact[i:j]
+        )

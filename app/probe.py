@@ -105,8 +105,14 @@ class Probe:
         self._thread.start()
         self.send(
             _messages.ViewerCameraMessage(
-                wxyz=(1.0, 0.0, 0.0, 0.0), position=(3.0, -3.0, 2.0), fov=0.8, near=0.01,
-                far=100.0, image_height=720, image_width=1280, look_at=(0.0, 0.0, 0.0),
+                wxyz=(1.0, 0.0, 0.0, 0.0),
+                position=(3.0, -3.0, 2.0),
+                fov=0.8,
+                near=0.01,
+                far=100.0,
+                image_height=720,
+                image_width=1280,
+                look_at=(0.0, 0.0, 0.0),
                 up_direction=(0.0, 0.0, 1.0),
             )
         )
@@ -162,8 +168,12 @@ class Probe:
                         self._apply(message)
                     if self.keep_batches:
                         self.batches.append(
-                            Batch(now, len(frame), [m["type"] for m in messages],
-                                  [m.get("name", m.get("uuid", "")) for m in messages])
+                            Batch(
+                                now,
+                                len(frame),
+                                [m["type"] for m in messages],
+                                [m.get("name", m.get("uuid", "")) for m in messages],
+                            )
                         )
                     self._cond.notify_all()
                 for message in messages:

@@ -42,9 +42,7 @@ class Trail:
         self._chunk = int(chunk)
         self._max_points = max(int(max_points), 2 * self._chunk)
         self.group = api.add_frame(name, show_axes=False, position=position)
-        self._frozen: collections.deque[tuple[viser.LineSegmentsHandle, int]] = (
-            collections.deque()
-        )
+        self._frozen: collections.deque[tuple[viser.LineSegmentsHandle, int]] = collections.deque()
         self._head: viser.LineSegmentsHandle | None = None
         self._head_segments = np.zeros((0, 2, 3), dtype=np.float32)
         self._last: np.ndarray | None = None
