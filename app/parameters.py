@@ -22,20 +22,26 @@ TRAIL_RANGE = (100, 6000)
 
 @dataclasses.dataclass(frozen=True)
 class Parameters:
-    """Moments (caller order), D = |L|²/2T, which polhode, and |omega0|."""
+    """Moments (caller order), D = |L|²/2T, which polhode, and |omega0|.
+
+    ``omega0``: an exact initial omega given by a preset (data), used instead of
+    :func:`physics.omega_from_energy`; any edit drops it (the sliders then speak).
+    """
 
     inertia: tuple[float, float, float]
     D: float
     pole_sign: int = 1
     omega_norm: float = 1.0
+    omega0: tuple[float, float, float] | None = None
 
     @classmethod
     def from_preset(cls, preset: Preset) -> Parameters:
         return cls(
-            tuple(float(i) for i in preset.inertia),
-            float(preset.D),  # type: ignore[arg-type]
+            tuple(float(i) for i in preset.inertia),  # type: ignore[arg-type]
+            float(preset.D),
             int(preset.pole_sign),
             float(preset.omega_norm),
+            None if preset.omega0 is None else tuple(float(w) for w in preset.omega0),  # type: ignore[arg-type]
         )
 
     @property
@@ -55,6 +61,7 @@ class Parameters:
             self,
             inertia=tuple(inertia),
             D=min(max(self.D, lo), hi),  # type: ignore[arg-type]
+            omega0=None,
         )
 
     def mirrored(self, side: str) -> Parameters:
@@ -64,10 +71,10 @@ class Parameters:
         mid = self.intermediate
         if side == "major" and self.D < mid and mid > lo:
             frac = (mid - self.D) / (mid - lo)
-            return dataclasses.replace(self, D=mid + frac * (hi - mid))
+            return dataclasses.replace(self, D=mid + frac * (hi - mid), omega0=None)
         if side == "minor" and self.D > mid and hi > mid:
             frac = (self.D - mid) / (hi - mid)
-            return dataclasses.replace(self, D=mid - frac * (mid - lo))
+            return dataclasses.replace(self, D=mid - frac * (mid - lo), omega0=None)
         return self
 
     def side(self) -> str:
@@ -83,7 +90,10 @@ class Parameters:
     def build(self) -> FreeRigidBody:
         """The body, with L along +z at t = 0. Raises ValueError with a readable message."""
         self.check()
-        omega0 = omega_from_energy(self.inertia, self.D, self.omega_norm, self.pole_sign)
+        if self.omega0 is not None:
+            omega0 = self.omega0
+        else:
+            omega0 = omega_from_energy(self.inertia, self.D, self.omega_norm, self.pole_sign)
         attitude0 = attitude_with_L_along_z(self.inertia, omega0)
         return FreeRigidBody(self.inertia, omega0, attitude0)
 
@@ -98,4 +108,5 @@ class Parameters:
             and math.isclose(self.D, other.D, rel_tol=rel)
             and self.pole_sign == other.pole_sign
             and math.isclose(self.omega_norm, other.omega_norm, rel_tol=rel)
+            and self.omega0 == other.omega0
         )

@@ -90,6 +90,9 @@ class Preset:
     speed: float = 1.0
     trail_points: int = 1200
     solid: Solid | None = None
+    #: An exact initial omega (data) instead of one built from D, |omega0| and the pole;
+    #: for a state that rounding must not move (the separatrix).
+    omega0: tuple[float, float, float] | None = None
     elements: frozenset[Element] = ALL_ELEMENTS
     controls: frozenset[Control] = ALL_CONTROLS
     plots: frozenset[Plot] = ALL_PLOTS
@@ -175,12 +178,14 @@ PRESETS: tuple[Preset, ...] = (
         key="separatrix",
         label="Exactly on the separatrix",
         source="Landau Sec. 37 problem 2; Fasano-Marmi Eq. (7.79); Pars 13.12.19-20: D = I2, "
-        "omega tends to the intermediate axis as sech/tanh, never returning. " + _BOX_SOURCE,
-        inertia=_BOX_INERTIA,
+        "omega tends to the intermediate axis as sech/tanh, never returning. I = (1, 2, 9/4), "
+        "omega0 = (3/4, 0, 1): I1 (I2 - I1) w1^2 = I3 (I3 - I2) w3^2 holds exactly in binary "
+        "floating point, so D = I2 exactly (Fasano-Marmi Eq. 7.57)",
+        inertia=(1.0, 2.0, 2.25),
         D=2.0,
-        omega_norm=1.5,
+        omega_norm=1.25,
+        omega0=(0.75, 0.0, 1.0),
         trail_points=2400,
-        solid=_BOX_321,
     ),
     Preset(
         key="oblate",

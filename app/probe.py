@@ -124,11 +124,14 @@ class Probe:
         self.close()
 
     def close(self) -> None:
-        if not self._closed:
-            self._closed = True
+        """Close the connection. The receiving thread keeps draining until the close
+        handshake completes (stopping it first would leave the server's close frame unread
+        behind a backlog, and the handshake would wait for its timeout)."""
+        if self._thread.is_alive():
             self._reading.set()
             self._ws.close()
             self._thread.join(5.0)
+        self._closed = True
 
     def stall(self, stalled: bool = True) -> None:
         """Stop (or resume) reading from the socket: a frozen or very slow browser."""
@@ -155,8 +158,6 @@ class Probe:
         try:
             while True:
                 self._reading.wait()
-                if self._closed:
-                    break
                 frame = self._ws.recv()
                 now = time.perf_counter()
                 assert isinstance(frame, bytes)

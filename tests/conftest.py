@@ -105,7 +105,20 @@ def make_probe() -> Iterator[Callable[..., Probe]]:
 def probe(poinsot_app, make_probe) -> Probe:
     """A probe connected to ``poinsot_app``, once its session has drawn the scene."""
     p = make_probe(poinsot_app)
-    assert p.wait_for(lambda p: "/space/body/ellipsoid" in p.nodes, 15), "scene never arrived"
+    session = session_of(poinsot_app)
+    assert wait_until(lambda: session.running, 15), "the session never started"
+    # The ellipsoid's size is sent by the first rebuild, after the panel's widgets: once it
+    # has arrived, so has everything the session queued before it.
+    assert p.wait_for(
+        lambda p: (
+            "/space/body/ellipsoid" in p.nodes
+            and np.allclose(
+                p.nodes["/space/body/ellipsoid"].props.get("scale", 0.0),
+                session.scene.geometry.semi_axes,
+            )
+        ),
+        15,
+    ), "scene never arrived"
     return p
 
 

@@ -55,7 +55,10 @@ def test_each_preset_is_a_real_body_with_a_source(preset):
     assert params.matches(preset)
 
 
-@pytest.mark.parametrize("preset", PRESETS, ids=[p.key for p in PRESETS])
+WITH_SOLID = [p for p in PRESETS if p.solid is not None]
+
+
+@pytest.mark.parametrize("preset", WITH_SOLID, ids=[p.key for p in WITH_SOLID])
 def test_a_preset_s_solid_has_the_preset_s_moments(preset):
     """The drawn solid is the body: trimesh's mass properties of the exact mesh the app sends
     (centre of mass at the origin, principal axes = body axes) give the preset's moments."""
@@ -69,6 +72,23 @@ def test_a_preset_s_solid_has_the_preset_s_moments(preset):
     assert np.allclose(
         moments / moments.max(), np.divide(preset.inertia, max(preset.inertia)), rtol=5e-3
     )
+
+
+def test_a_body_without_a_preset_solid_is_drawn_as_the_physics_box(make_app, make_probe):
+    """The separatrix preset (exact data, no solid of its own) and any hand-edited body show
+    the homogeneous box with the same moments, from physics.box_dimensions."""
+    from physics import box_dimensions
+
+    preset = preset_by_key("separatrix")
+    assert preset.solid is None and len(WITH_SOLID) == len(PRESETS) - 1
+    app = make_app(preset)
+    probe = make_probe(app)
+    assert probe.wait_for(lambda p: "/space/body/solid" in p.nodes, 15)
+    session = app.wait_for_sessions(1)[0]
+    sides = np.asarray(probe.snapshot()[0]["/space/body/solid"].props["scale"])
+    expected = box_dimensions(preset.inertia)
+    assert np.allclose(sides / sides.max(), expected / expected.max())
+    assert session.body.regime is Regime.SEPARATRIX
 
 
 def test_presets_are_found_by_key_and_label():

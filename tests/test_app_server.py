@@ -80,9 +80,7 @@ def markdown_texts(probe) -> list[str]:
 def expected_nodes(preset) -> set[str]:
     names = set(ALWAYS)
     for element in preset.elements:
-        if element is Element.SOLID and preset.solid is None:
-            continue
-        names |= ELEMENT_NODES[element]
+        names |= ELEMENT_NODES[element]  # a preset without a solid gets the physics box
     return names
 
 
@@ -208,14 +206,23 @@ def test_two_clients_have_independent_sessions(poinsot_app, make_probe):
     sa = session_of(poinsot_app, 1)
     b = make_probe(poinsot_app)
     sb = session_of(poinsot_app, 2)
+    for p in (a, b):
+        assert p.wait_for(lambda p: "/space/body/ellipsoid" in p.nodes and p.has_widget("I₂"), 15)
     uuid, _ = a.widget("I₂")
     a.set_value(uuid, 1.7)
     assert wait_until(lambda: sa.params.inertia[1] == 1.7, 10)
+    assert a.wait_for(
+        lambda p: np.allclose(
+            p.nodes["/space/body/ellipsoid"].props["scale"], sa.scene.geometry.semi_axes
+        ),
+        10,
+    )
     time.sleep(0.3)
     assert sb.params.inertia == DEFAULT_PRESET.inertia and sb.preset is DEFAULT_PRESET
     a_scale = a.snapshot()[0]["/space/body/ellipsoid"].props["scale"]
     b_scale = b.snapshot()[0]["/space/body/ellipsoid"].props["scale"]
     assert not np.allclose(a_scale, b_scale)
+    assert np.allclose(b_scale, sb.scene.geometry.semi_axes)
 
 
 def test_an_impossible_body_is_refused_and_the_last_scene_kept(poinsot_app, probe):
@@ -339,4 +346,5 @@ def test_slider_to_redraw_is_fast(poinsot_app, probe):
             5,
         )
         assert time.perf_counter() - start < 0.5
-    assert max(session.stats.rebuild_seconds) < 0.1
+    slider_rebuilds = list(session.stats.rebuild_seconds)[-3:]  # not the first, full build
+    assert max(slider_rebuilds) < 0.1, slider_rebuilds
