@@ -262,44 +262,51 @@ def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     session = started_session(poinsot_app)
     lecture_of(session)
     camera = session.client.camera
-    page.page.mouse.click(40, 500)  # focus the 3D view (not a widget)
+    box = page.canvas_box()
+    # Focus the 3D view (not a widget): its bottom centre, between the floating panels.
+    page.page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] - 8)
+
+    def near(target, atol=1e-3):
+        return lambda: np.allclose(camera.position, target, atol=atol)
+
     # Space: play/pause, through viser's command hotkeys.
     page.page.keyboard.press("Space")
-    assert wait_until(lambda: session.clock.paused, 5)
+    assert wait_until(lambda: session.clock.paused, 5), "space did not pause"
     page.page.keyboard.press("Space")
-    assert wait_until(lambda: not session.clock.paused, 5)
+    assert wait_until(lambda: not session.clock.paused, 5), "space did not resume"
     # 2: view along L. The browser reports its camera back to the server.
     page.page.keyboard.press("2")
     top = VIEWS["top"]
-    assert wait_until(lambda: np.allclose(camera.position, top.position, atol=1e-3), 10)
+    assert wait_until(near(top.position), 10), ("top view", camera.position)
     assert np.allclose(camera.look_at, top.look_at, atol=1e-3)
     # 4: ride along. Paused, the camera sits exactly where the body carries BODY_VIEW ...
     page.page.keyboard.press("Space")
-    assert wait_until(lambda: session.clock.paused, 5)
+    assert wait_until(lambda: session.clock.paused, 5), "space did not pause"
     page.page.keyboard.press("4")
     expected = ride_along(BODY_VIEW, session.frame.wxyz)
-    assert wait_until(lambda: np.allclose(camera.position, expected.position, atol=1e-3), 10)
+    assert wait_until(near(expected.position), 10), ("ride along", camera.position, expected)
     # ... and, running, it turns with the body.
     page.page.keyboard.press("Space")
-    assert wait_until(lambda: not session.clock.paused, 5)
-    assert wait_until(lambda: not np.allclose(camera.position, expected.position, atol=0.05), 10)
+    assert wait_until(lambda: not session.clock.paused, 5), "space did not resume"
+    assert wait_until(lambda: not near(expected.position, 0.05)(), 10), "the camera stood still"
     assert np.linalg.norm(camera.position) == pytest.approx(np.linalg.norm(BODY_VIEW.position),
                                                             rel=1e-3)
     # 3: side view ends the ride.
     page.page.keyboard.press("3")
-    assert wait_until(lambda: np.allclose(camera.position, VIEWS["side"].position, atol=1e-3), 10)
+    assert wait_until(near(VIEWS["side"].position), 10), ("side view", camera.position)
     # Theme: the page's background turns light.
     page.page.keyboard.press("Space")
-    dark_corner = screenshot_rgb(page.page)[-5, 5]
+    corner = (-3, int(box["x"] + box["width"] / 2))  # below the floating panels
+    dark = screenshot_rgb(page.page)[corner]
     page.set_checkbox("Dark theme", False)
-    assert wait_until(lambda: screenshot_rgb(page.page)[-5, 5].mean() > 200, 10), dark_corner
-    assert dark_corner.mean() < 40
+    assert wait_until(lambda: screenshot_rgb(page.page)[corner].mean() > 200, 10), dark
+    assert dark.mean() < 40, dark
     # Large text: the root font size (all panel text is in rem) grows.
     root = "parseFloat(getComputedStyle(document.documentElement).fontSize)"
     before = page.page.evaluate(root)
     page.set_checkbox("Large text (projector)", True)
-    assert wait_until(lambda: page.page.evaluate(root) >= before * LARGE_TEXT_PERCENT / 100 - 0.5,
-                      10)
+    grown = before * LARGE_TEXT_PERCENT / 100
+    assert wait_until(lambda: page.page.evaluate(root) >= grown - 0.5, 10), before
     label = "parseFloat(getComputedStyle([...document.querySelectorAll('label')].find(" \
             "l => l.textContent === 'Dark theme')).fontSize)"
     assert page.page.evaluate(label) >= 1.2 * 12
