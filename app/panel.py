@@ -383,15 +383,17 @@ class ControlPanel:
             "grid": {"stroke": "#3a4048", "width": 1},
             "ticks": {"stroke": "#3a4048"},
         }
-        empty = np.zeros(0)
+        # Created with two samples, not empty: viser's uPlot keeps the x range relative to the
+        # data's extent, and an empty first data set (extent -inf..inf) leaves it NaN forever.
         with self._data_tab:
-            plot = self._add_plot(series, axis, empty)
+            plot = self._add_plot(series, axis)
         self._plot_t, self._plot_w = [], []
         return self._tag(Plot.OMEGA, plot=plot)
 
-    def _add_plot(self, series, axis, empty):
+    def _add_plot(self, series, axis):
+        zeros = np.zeros(2)
         return self.gui.add_uplot(
-            data=(empty, empty, empty, empty),
+            data=(np.array([0.0, 1.0]), zeros, zeros, zeros),
             series=tuple(series),
             title="ω in the body frame",
             scales={"x": {"time": False, "auto": True}, "y": {"auto": True}},

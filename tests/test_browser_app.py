@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from conftest import session_of, wait_until
 
+from app import palette
 from app.presets import DEFAULT_PRESET, Element, preset_by_key
 
 pytestmark = pytest.mark.browser
@@ -52,6 +53,25 @@ def test_page_loads_without_console_errors(poinsot_app, open_page):
     assert page.errors == []
     assert session.stats.errors == 0, session.stats.last_error
     assert page.page.get_by_text("Stable about the major axis").count() >= 1
+
+
+def test_the_omega_plot_draws_its_three_components(poinsot_app, open_page):
+    """The live uPlot of omega_1, omega_2, omega_3 (numeric time axis) shows three curves."""
+    from PIL import Image
+
+    page = open_page(poinsot_app.url)
+    started(poinsot_app, frames=30)
+    plot = page.page.locator(".uplot-container").first
+    plot.wait_for(state="visible", timeout=20000)
+    page.page.wait_for_timeout(2500)  # a couple of seconds of samples
+    import io
+
+    rgb = np.asarray(Image.open(io.BytesIO(plot.screenshot())).convert("RGB")).astype(int)
+    for hex_color in palette.PLOT_SERIES:
+        color = np.array([int(hex_color[i : i + 2], 16) for i in (1, 3, 5)])
+        near = np.sum(np.abs(rgb - color).sum(axis=2) < 60)
+        assert near > 40, (hex_color, near)
+    assert page.errors == []
 
 
 def test_canvas_shows_the_ellipsoid(poinsot_app, open_page):
