@@ -20,8 +20,14 @@ def wxyz(rotation: Rotation) -> np.ndarray:
 def wxyz_from_xyzw(xyzw: np.ndarray) -> np.ndarray:
     """The same for quaternions already taken out of scipy (``Rotation.as_quat()``, scalar
     last), (4,) or (N, 4)."""
-    q = np.roll(np.asarray(xyzw, dtype=np.float64), 1, axis=-1)
-    return np.where(q[..., :1] < 0.0, -q, q)
+    q = np.asarray(xyzw, dtype=np.float64)[..., _WXYZ_FROM_XYZW]
+    if q.ndim == 1:
+        return -q if q[0] < 0.0 else q
+    return np.where(q[:, :1] < 0.0, -q, q)
+
+
+#: Index order taking (x, y, z, w) to (w, x, y, z).
+_WXYZ_FROM_XYZW = [3, 0, 1, 2]
 
 
 def rotation_from_wxyz(q: np.ndarray) -> Rotation:

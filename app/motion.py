@@ -112,6 +112,10 @@ class MotionSampler:
             t = self.t0 + k * self.step
             omega, quat, contact = evaluate(self.body, t)
             self.evaluations += 1
+            # Checked once per batch, so that a frame never draws a NaN.
+            for name, values in (("omega", omega), ("attitude", quat), ("contact", contact)):
+                if not np.all(np.isfinite(values)):
+                    raise ValueError(f"physics gave a non-finite {name}; nothing is drawn")
             cache = self._cache = Samples(k, t, omega, quat, contact)
         i, j = k_first - int(cache.k[0]), k_last - int(cache.k[0]) + 1
         return Samples(

@@ -288,7 +288,7 @@ class PoinsotScene:
             k_first = k
         else:
             k_first = max(self._k_last + 1, k - MAX_SAMPLES_PER_FRAME + 1)
-        samples = self._checked(sampler.samples(k_first, k))
+        samples = sampler.samples(k_first, k)  # checked finite once per batch
         with self._atomic():
             return self._draw(samples, restart)
 
