@@ -25,13 +25,13 @@ from typing import Protocol
 
 import viser
 
-from app import export, palette
+from app import export
 from app.cameras import BODY_VIEW, CAMERA_LABELS, ride_along, space_view
 from app.clock import SimClock
 from app.presets import Preset
 from app.scene import Frame, PoinsotScene
 from app.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
-from app.view import View
+from app.view import View, configure_theme
 from physics import FreeRigidBody
 
 #: Seconds a screenshot waits for the browser's render. A GPU browser answers a 4K render in
@@ -164,13 +164,7 @@ class LectureControls:
             self.dark_mode = dark
         if large is not None:
             self.large_text = large
-        self.client.gui.configure_theme(
-            dark_mode=self.dark_mode,
-            show_share_button=False,
-            show_logo=False,
-            brand_color=palette.BRAND,
-            control_width="large" if self.large_text else "medium",
-        )
+        configure_theme(self.client.gui, dark_mode=self.dark_mode, large_controls=self.large_text)
         self.style.content = large_text_css(self.large_text)
 
     # -- exports -------------------------------------------------------------------------

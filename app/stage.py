@@ -16,11 +16,10 @@ import warnings
 import numpy as np
 import viser
 
-from app import palette
 from app.parameters import Parameters
 from app.presets import Element, Preset, Solid
 from app.scene import Frame, PoinsotScene
-from app.view import View
+from app.view import View, apply_lighting, configure_theme
 
 #: Largest step of simulation time between two trail updates while seeking [time units]. The
 #: scene resamples every step by chord length (at most 48 points a step), so this only bounds
@@ -29,16 +28,6 @@ SEEK_STEP = 0.05
 #: Seeking to time T replays at most this much simulation time before T: enough to fill any
 #: trail the presets declare (up to 6000 points at chord 0.02 display units).
 SEEK_WINDOW = 250.0
-
-
-def _light(scene: viser.SceneApi) -> None:
-    """The app's lighting (:func:`app.view.apply_theme` sets the same on each browser):
-    default lights without shadow maps, no environment map, a hemisphere fill light."""
-    scene.configure_default_lights(enabled=True, cast_shadow=False)
-    scene.configure_environment_map(None)
-    scene.add_light_hemisphere(
-        "/lights/fill", sky_color=(200, 215, 255), ground_color=(70, 55, 40), intensity=1.2
-    )
 
 
 class Stage:
@@ -65,12 +54,9 @@ class Stage:
             self.server = viser.ViserServer(host=host, port=port, verbose=False)
         try:
             warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection")
-            self.server.gui.configure_theme(
-                dark_mode=dark_mode, show_share_button=False, show_logo=False,
-                brand_color=palette.BRAND,
-            )
+            configure_theme(self.server.gui, dark_mode=dark_mode)
             self.server.scene.world_axes.visible = False
-            _light(self.server.scene)
+            apply_lighting(self.server.scene)  # as each browser of the app is lit
             self.scene = PoinsotScene(
                 self.server.scene, elements, trail_points, atomic=self.server.atomic
             )

@@ -36,21 +36,34 @@ VIEWS: dict[str, View] = {
 
 
 def apply_theme(client: viser.ClientHandle) -> None:
-    """Dark theme, no share button (it needs the internet), brand colour of the ellipsoid.
+    """Dark theme, the panel's title, and the lights (see :func:`configure_theme` and
+    :func:`apply_lighting`)."""
+    configure_theme(client.gui)
+    client.gui.set_panel_label("Poinsot: free rigid body")
+    apply_lighting(client.scene)
 
-    Lighting: viser's default lights without shadow maps (nothing here casts a useful shadow,
-    and re-rendering the shadow maps every frame tripled the frame time of a software-WebGL
-    browser), and a hemisphere fill light instead of an environment map (which halved it again)."""
-    client.gui.configure_theme(
-        dark_mode=True,
+
+def configure_theme(
+    gui: viser.GuiApi, *, dark_mode: bool = True, large_controls: bool = False
+) -> None:
+    """No share button (it needs the internet), brand colour of the ellipsoid; dark unless a
+    lecturer switches to light, wide controls for the projector's large text."""
+    gui.configure_theme(
+        dark_mode=dark_mode,
         show_share_button=False,
         show_logo=False,
         brand_color=palette.BRAND,
-        control_width="medium",
+        control_width="large" if large_controls else "medium",
     )
-    client.gui.set_panel_label("Poinsot: free rigid body")
-    client.scene.configure_default_lights(enabled=True, cast_shadow=False)
-    client.scene.configure_environment_map(None)
-    client.scene.add_light_hemisphere(
+
+
+def apply_lighting(scene: viser.SceneApi) -> None:
+    """viser's default lights without shadow maps (nothing here casts a useful shadow, and
+    re-rendering the shadow maps every frame tripled the frame time of a software-WebGL
+    browser), and a hemisphere fill light instead of an environment map (which halved it again).
+    Used on each browser's scene and on the export stage's shared scene alike."""
+    scene.configure_default_lights(enabled=True, cast_shadow=False)
+    scene.configure_environment_map(None)
+    scene.add_light_hemisphere(
         "/lights/fill", sky_color=(200, 215, 255), ground_color=(70, 55, 40), intensity=1.2
     )
