@@ -22,6 +22,7 @@ import viser
 from app import readouts
 from app.budget import FrameBudget
 from app.clock import SimClock
+from app.ghost import add_ghost_controls
 from app.lecture import add_lecture_controls
 from app.panel import ControlPanel
 from app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters
@@ -101,6 +102,8 @@ class Session:
         self._rebuild()
         # Exports, camera views, theme and hotkeys (issue 5) mount on the session's panel.
         self.lecture = add_lecture_controls(self)
+        # The numerical ghost (issue 4): its controls now, the ghost itself only when switched on.
+        self.ghost = add_ghost_controls(self)
 
     # -- lifecycle -----------------------------------------------------------------------
     def start(self) -> Session:
@@ -237,6 +240,7 @@ class Session:
         start = time.perf_counter()
         self.frame = self.scene.advance(self.clock.now())
         self.lecture.on_frame(self.frame)
+        self.ghost.on_frame(self.frame)
         self.stats.frame_seconds.append(time.perf_counter() - start)
         self.stats.frames += 1
         self.budget.frame_done()

@@ -17,6 +17,10 @@ which the tests and the work-precision report loop over:
   space angular momentum L = R m. For R' = R [w]x the midpoint rule is R1 = R0 cay(h [w_mid]x),
   the Cayley transform, a rotation by 2 atan(h |w_mid| / 2) about w_mid.
 
+:class:`Propagation` advances the same methods piece by piece, carrying their whole state
+(scipy's stepper for the adaptive pairs, the grid state for the fixed-step methods): what an
+animation needs to show a method's solution frame by frame without restarting it.
+
 Conventions (as in :mod:`physics`): ``omega`` is the body-frame angular velocity, ``m = I omega``
 the body angular momentum, the attitude ``R`` maps body to space coordinates and obeys
 ``R' = R [omega]x``; quaternions are scipy's, scalar last ``(x, y, z, w)``. The principal moments
@@ -31,10 +35,10 @@ from dataclasses import dataclass
 from typing import Literal, NamedTuple
 
 import numpy as np
-from scipy.integrate import solve_ivp
+from scipy.integrate import DOP853, RK45, OdeSolver, solve_ivp
 from scipy.spatial.transform import Rotation
 
-__all__ = ["INTEGRATORS", "Integrator", "Trajectory", "integrate"]
+__all__ = ["INTEGRATORS", "Integrator", "Propagation", "State", "Trajectory", "integrate"]
 
 _EPS = np.finfo(float).eps
 
@@ -209,6 +213,39 @@ def _steps_per_interval(t_eval: np.ndarray, h: float) -> np.ndarray:
 # Adaptive Runge-Kutta (scipy)
 
 
+def _euler_quaternion_rhs(inertia: np.ndarray) -> Callable[[float, np.ndarray], np.ndarray]:
+    """Right-hand side of the adaptive pairs: Euler's equations for omega and the quaternion
+    kinematics of the attitude, state y = (omega1, omega2, omega3, x, y, z, w)."""
+    i1, i2, i3 = (float(v) for v in inertia)
+    # Euler's equations I1 w1' = (I2 - I3) w2 w3 and cyclic (Landau 36.5).
+    a1, a2, a3 = (i2 - i3) / i1, (i3 - i1) / i2, (i1 - i2) / i3
+
+    def rhs(_t: float, y: np.ndarray) -> np.ndarray:
+        # Plain floats: a 7-vector is far cheaper as Python scalars than as numpy ops.
+        w1, w2, w3, x, yq, z, w = y.tolist()
+        return np.array(
+            (
+                a1 * w2 * w3,
+                a2 * w3 * w1,
+                a3 * w1 * w2,
+                # q' = q (omega, 0) / 2, i.e. R' = R [omega]x (body angular velocity).
+                0.5 * (w * w1 + yq * w3 - z * w2),
+                0.5 * (w * w2 + z * w1 - x * w3),
+                0.5 * (w * w3 + x * w2 - yq * w1),
+                -0.5 * (x * w1 + yq * w2 + z * w3),
+            )
+        )
+
+    return rhs
+
+
+def _scipy_atol(omega0: np.ndarray, rtol: float) -> np.ndarray:
+    """Absolute tolerance of the adaptive pairs: rtol * max|omega0| on omega, rtol on the unit
+    quaternion (a relative tolerance alone would be meaningless where a component crosses 0)."""
+    scale = max(float(np.max(np.abs(omega0))), np.finfo(float).tiny)
+    return rtol * np.array([scale, scale, scale, 1.0, 1.0, 1.0, 1.0])
+
+
 def _run_scipy(
     method: str,
 ) -> Callable[[np.ndarray, np.ndarray, Rotation, np.ndarray, float], Trajectory]:
@@ -219,29 +256,9 @@ def _run_scipy(
         t_eval: np.ndarray,
         rtol: float,
     ) -> Trajectory:
-        i1, i2, i3 = (float(v) for v in inertia)
-        # Euler's equations I1 w1' = (I2 - I3) w2 w3 and cyclic (Landau 36.5).
-        a1, a2, a3 = (i2 - i3) / i1, (i3 - i1) / i2, (i1 - i2) / i3
-
-        def rhs(_t: float, y: np.ndarray) -> np.ndarray:
-            # Plain floats: a 7-vector is far cheaper as Python scalars than as numpy ops.
-            w1, w2, w3, x, yq, z, w = y.tolist()
-            return np.array(
-                (
-                    a1 * w2 * w3,
-                    a2 * w3 * w1,
-                    a3 * w1 * w2,
-                    # q' = q (omega, 0) / 2, i.e. R' = R [omega]x (body angular velocity).
-                    0.5 * (w * w1 + yq * w3 - z * w2),
-                    0.5 * (w * w2 + z * w1 - x * w3),
-                    0.5 * (w * w3 + x * w2 - yq * w1),
-                    -0.5 * (x * w1 + yq * w2 + z * w3),
-                )
-            )
-
+        rhs = _euler_quaternion_rhs(inertia)
         y0 = np.concatenate((omega0, attitude0.as_quat()))
-        scale = max(float(np.max(np.abs(omega0))), np.finfo(float).tiny)
-        atol = rtol * np.array([scale, scale, scale, 1.0, 1.0, 1.0, 1.0])
+        atol = _scipy_atol(omega0, rtol)
         if t_eval[-1] == 0.0:
             ys = np.repeat(y0[:, None], len(t_eval), axis=1)
             nfev = 0
@@ -455,20 +472,34 @@ def integrate(
         ``omega`` (N, 3), ``attitude`` (stack of N rotations), ``cost`` (RHS evaluations or
         steps). Unpacks as a tuple ``omega, attitude, cost``.
     """
+    integrator, inertia, omega0, attitude0, value = _validated(
+        method, inertia, omega0, attitude0, setting
+    )
+    t_eval = np.atleast_1d(np.asarray(t_eval, dtype=float))
+    if t_eval.ndim != 1 or len(t_eval) == 0 or not np.all(np.isfinite(t_eval)):
+        raise ValueError("t_eval must be a non-empty 1-D array of finite times")
+    if t_eval[0] < 0.0 or np.any(np.diff(t_eval) < 0.0):
+        raise ValueError("t_eval must be non-negative and non-decreasing")
+    return integrator.run(inertia, omega0, attitude0, t_eval, value)
+
+
+def _validated(
+    method: str,
+    inertia: np.typing.ArrayLike,
+    omega0: np.typing.ArrayLike,
+    attitude0: Rotation | None,
+    setting: float | None,
+) -> tuple[Integrator, np.ndarray, np.ndarray, Rotation, float]:
+    """The checks shared by :func:`integrate` and :class:`Propagation` (readable ValueErrors)."""
     if method not in INTEGRATORS:
         raise ValueError(f"unknown method {method!r}; choose one of {sorted(INTEGRATORS)}")
     integrator = INTEGRATORS[method]
     inertia = np.asarray(inertia, dtype=float)
     omega0 = np.asarray(omega0, dtype=float)
-    t_eval = np.atleast_1d(np.asarray(t_eval, dtype=float))
     if inertia.shape != (3,) or not np.all(np.isfinite(inertia)) or np.any(inertia <= 0.0):
         raise ValueError(f"inertia must be three positive finite numbers, got {inertia!r}")
     if omega0.shape != (3,) or not np.all(np.isfinite(omega0)):
         raise ValueError(f"omega0 must be three finite numbers, got {omega0!r}")
-    if t_eval.ndim != 1 or len(t_eval) == 0 or not np.all(np.isfinite(t_eval)):
-        raise ValueError("t_eval must be a non-empty 1-D array of finite times")
-    if t_eval[0] < 0.0 or np.any(np.diff(t_eval) < 0.0):
-        raise ValueError("t_eval must be non-negative and non-decreasing")
     if attitude0 is None:
         attitude0 = Rotation.identity()
     elif not isinstance(attitude0, Rotation) or not attitude0.single:
@@ -476,4 +507,160 @@ def integrate(
     value = integrator.default_setting if setting is None else float(setting)
     if not (math.isfinite(value) and value > 0.0):
         raise ValueError(f"setting must be a positive finite number, got {setting!r}")
-    return integrator.run(inertia, omega0, attitude0, t_eval, value)
+    return integrator, inertia, omega0, attitude0, value
+
+
+# --------------------------------------------------------------------------------------------
+# Piecewise propagation (an animation advances the solution a little at every frame)
+
+#: scipy's stepper classes behind the adaptive entries of the registry.
+_SCIPY_STEPPERS: dict[str, type[OdeSolver]] = {"RK45": RK45, "DOP853": DOP853}
+#: A requested time within this many steps' rounding of a grid time counts as that grid time
+#: (the same slack as :func:`_steps_per_interval`).
+_GRID_SLACK = 1e-9
+
+
+class State(NamedTuple):
+    """A numerical solution at one time."""
+
+    t: float
+    """The time of this state [time units] (behind the requested time if the work ran out)."""
+    omega: np.ndarray
+    """(3,) body-frame angular velocity [rad / time unit], caller's axes."""
+    attitude: Rotation
+    """Single rotation, body -> space."""
+    cost: int
+    """Total work since the start: RHS evaluations (adaptive) or steps (fixed-step)."""
+
+
+class Propagation:
+    """One numerical solution started at ``t0``, advanced piece by piece with the integrator's
+    whole state carried from call to call.
+
+    :func:`integrate` solves from t = 0 to the last requested time in one call. An animation
+    needs the solution a little further at every frame, without redoing the past and without
+    changing it: restarting a method at each frame would, for the adaptive pairs, throw away
+    the step-size control and force at least one step per frame, a far more accurate run than
+    the method at that tolerance really is (RK45 at rtol 1e-3 takes steps of about one time
+    unit here; a frame is 1/60 of one). So this class keeps
+
+    - for the adaptive pairs, scipy's stepper object (its step size and error history
+      included); a time between two steps is read from the stepper's dense output, which is
+      how ``solve_ivp`` computes its ``t_eval`` samples. The steps are those of one
+      ``integrate`` call with the same tolerance (up to the last one, which ``solve_ivp``
+      shortens to land on its final output time);
+    - for the fixed-step methods, the state on the grid ``t0 + k h``; a time between grid
+      points is reached by one shorter step from the grid state that is not carried, so the
+      trajectory does not depend on when, or how often, it is looked at.
+
+    ``advance(t, max_cost)`` bounds the work of one call (an animation frame must not stall on
+    a tiny step or a tight tolerance); the state it returns then lies behind ``t``, and the
+    next call continues from there.
+    """
+
+    def __init__(
+        self,
+        method: str,
+        inertia: np.typing.ArrayLike,
+        omega0: np.typing.ArrayLike,
+        attitude0: Rotation | None = None,
+        setting: float | None = None,
+        t0: float = 0.0,
+    ) -> None:
+        """Arguments as for :func:`integrate`; ``omega0`` and ``attitude0`` hold at ``t0``."""
+        integrator, inertia, omega0, attitude0, value = _validated(
+            method, inertia, omega0, attitude0, setting
+        )
+        if not math.isfinite(t0):
+            raise ValueError(f"t0 must be finite, got {t0!r}")
+        self.integrator, self.setting, self.t0 = integrator, value, float(t0)
+        self._inertia = inertia
+        self._omega, self._attitude = omega0.copy(), attitude0
+        self._steps = 0  # fixed-step: grid steps taken, the carried state is at t0 + steps h
+        self._cost = 0
+        self._stepper: OdeSolver | None = None
+        self._dense: Callable[[float], np.ndarray] | None = None
+        if integrator.kind == "adaptive":
+            self._stepper = _SCIPY_STEPPERS[method](
+                _euler_quaternion_rhs(inertia),
+                self.t0,
+                np.concatenate((omega0, attitude0.as_quat())),
+                t_bound=math.inf,
+                rtol=value,
+                atol=_scipy_atol(omega0, value),
+            )
+
+    @property
+    def method(self) -> str:
+        return self.integrator.name
+
+    @property
+    def t(self) -> float:
+        """Time of the carried state: the last step's end (adaptive), the grid time (fixed)."""
+        if self._stepper is not None:
+            return float(self._stepper.t)
+        return self.t0 + self._steps * self.setting
+
+    @property
+    def cost(self) -> int:
+        return self._cost
+
+    def advance(self, t: float, max_cost: int | None = None) -> State:
+        """The solution at time ``t``, or at the furthest time reached when ``max_cost``
+        (RHS evaluations or steps in this call) runs out first. ``t`` may not lie before the
+        start of the last step taken (ValueError): the past is not kept."""
+        t = float(t)
+        if not math.isfinite(t):
+            raise ValueError(f"t must be finite, got {t!r}")
+        if max_cost is not None and max_cost < 1:
+            raise ValueError(f"max_cost must be at least 1, got {max_cost!r}")
+        if self._stepper is not None:
+            return self._advance_adaptive(t, max_cost)
+        return self._advance_fixed(t, max_cost)
+
+    def _advance_adaptive(self, t: float, max_cost: int | None) -> State:
+        stepper = self._stepper
+        assert stepper is not None
+        start = self.t0 if self._dense is None else float(stepper.t_old)
+        if t < start:
+            raise ValueError(f"t = {t:g} lies before this propagation's last step ({start:g})")
+        nfev0 = stepper.nfev
+        stepped = False
+        while stepper.t < t and (max_cost is None or stepper.nfev - nfev0 < max_cost):
+            message = stepper.step()
+            if stepper.status == "failed":
+                raise RuntimeError(f"{self.method} failed: {message}")
+            stepped = True
+        if stepped:
+            self._dense = stepper.dense_output()
+        self._cost = int(stepper.nfev)
+        reached = min(t, float(stepper.t))
+        if reached == stepper.t or self._dense is None:
+            y = np.asarray(stepper.y, dtype=float)
+        else:
+            y = np.asarray(self._dense(reached), dtype=float)
+        # The quaternion's norm drifts like any other error; from_quat normalises it.
+        return State(reached, y[:3].copy(), Rotation.from_quat(y[3:]), self._cost)
+
+    def _advance_fixed(self, t: float, max_cost: int | None) -> State:
+        h, grid = self.setting, self.t
+        if t < grid - _GRID_SLACK * h:
+            raise ValueError(f"t = {t:g} lies before this propagation's grid time {grid:g}")
+        whole = max(int(math.floor((t - grid) / h + _GRID_SLACK)), 0)
+        if max_cost is not None and whole >= max_cost:
+            whole, rest = max_cost, 0.0
+        else:
+            rest = max(t - (grid + whole * h), 0.0)
+        if whole == 0 and rest == 0.0:
+            return State(grid, self._omega.copy(), self._attitude, self._cost)
+        # Two outputs from the carried grid state: after ``whole`` steps of exactly h (the new
+        # grid state) and one shorter step further (the requested time, not carried).
+        run = self.integrator.run(
+            self._inertia, self._omega, self._attitude, np.array([whole * h, whole * h + rest]), h
+        )
+        self._omega, self._attitude = run.omega[0].copy(), run.attitude[0]
+        self._steps += whole
+        self._cost += whole
+        if rest == 0.0:
+            return State(self.t, self._omega.copy(), self._attitude, self._cost)
+        return State(t, run.omega[1].copy(), run.attitude[1], self._cost + 1)
