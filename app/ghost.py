@@ -636,17 +636,24 @@ class GhostControls:
             self._fail(exc)
 
     def _apply(self, wanted: GhostConfig) -> None:
-        """Mirror the configuration into the widgets; create nothing, remove the ghost if off."""
-        if wanted.adaptive != self._applied.adaptive:
-            if wanted.adaptive:
-                options = tuple(tolerance_label(t) for t in TOLERANCES)
-                label, value = "Tolerance", tolerance_label(wanted.tolerance)
-            else:
-                options = tuple(division_label(n) for n in DIVISIONS)
-                label, value = "Step h", division_label(wanted.divisions)
+        """Mirror the configuration into the widgets (it may come from :meth:`configure`, not
+        the browser); create nothing, remove the ghost if off."""
+        if wanted.adaptive:
+            options = tuple(tolerance_label(t) for t in TOLERANCES)
+            label, value = "Tolerance", tolerance_label(wanted.tolerance)
+        else:
+            options = tuple(division_label(n) for n in DIVISIONS)
+            label, value = "Step h", division_label(wanted.divisions)
+        if self.setting.options != options:
             self.setting.options = options
-            self.setting.value = value
             self.setting.label = label
+        for handle, shown in (
+            (self.enabled, wanted.enabled),
+            (self.method, METHOD_LABELS[wanted.method]),
+            (self.setting, value),
+        ):
+            if handle.value != shown:
+                handle.value = shown
         self._applied = wanted
         if not wanted.enabled and self.ghost is not None:
             self._remove()
