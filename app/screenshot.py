@@ -217,7 +217,6 @@ class Shot:
     width: int
     height: int
     fov_degrees: float
-    probes: int
     seconds: float
 
 
@@ -265,10 +264,8 @@ def capture(
         # The browser decodes meshes asynchronously: render until two probes agree.
         deadline = time.monotonic() + SETTLE_TIMEOUT
         previous = render(probe_w, probe_h, fov)
-        probes = 1
         while True:
             current = render(probe_w, probe_h, fov)
-            probes += 1
             if np.array_equal(current, previous) and current[..., 3].any():
                 break
             if time.monotonic() > deadline:
@@ -281,7 +278,7 @@ def capture(
         raise RuntimeError(
             f"the browser returned {rgba.shape[1]}x{rgba.shape[0]}, not {width}x{height}"
         )
-    return Shot(png_bytes(rgba, background), width, height, math.degrees(fov), probes,
+    return Shot(png_bytes(rgba, background), width, height, math.degrees(fov),
                 time.perf_counter() - start)
 
 
