@@ -108,6 +108,8 @@ class Recorder:
 
 
 def switch_on(probe, session) -> Ghost:
+    # The ghost's controls are mounted after the first scene (what the probe fixture awaits).
+    assert probe.wait_for(lambda p: p.has_widget(CHECKBOX), 10)
     uuid, _ = probe.widget(CHECKBOX)
     probe.set_value(uuid, True)
     assert wait_until(lambda: session.ghost.ghost is not None, 10), session.ghost.message.content
@@ -120,6 +122,7 @@ def test_off_by_default_nothing_of_the_ghost_exists(poinsot_app, probe):
     session = session_of(poinsot_app)
     recorder = Recorder(probe)
     assert wait_until(lambda: session.stats.frames > 30, 10)
+    assert probe.wait_for(lambda p: p.has_widget(CHECKBOX), 10)
     assert ghost_nodes(probe) == set()
     assert recorder.messages == []
     assert session.ghost.ghost is None
@@ -149,8 +152,10 @@ def test_switching_on_creates_it_and_off_removes_it(poinsot_app, probe):
     assert probe.wait_for(plotted, 10)
     data = [np.asarray(a, dtype=float) for a in ghost_plot(probe).props["data"]]
     assert all(np.all(np.isfinite(a)) for a in data)
-    assert np.all(np.diff(data[0]) > 0) and all(np.all(a > 0) for a in data[1:])
-    assert np.max(data[2]) > 1e-8  # RK45 at 1e-3 is visibly off within a second
+    # log10 of the errors, floored at rounding level.
+    floor = math.log10(ghost_module.PLOT_FLOOR)
+    assert np.all(np.diff(data[0]) > 0) and all(np.all(a >= floor) for a in data[1:])
+    assert np.max(data[2]) > -8  # RK45 at 1e-3 is visibly off within a second
 
     # Per frame only the two poses travel.
     start = len(recorder.messages)
@@ -297,7 +302,7 @@ def test_the_plot_covers_the_whole_run_within_its_bound(server):
     ghost, _ = drive(server, GhostConfig(enabled=True, method="DOP853", tolerance=1e-6), times)
     t, e = ghost.plot_data()
     assert len(t) <= ghost_module.PLOT_POINTS
-    assert t[0] == 0.0 and t[-1] > 110.0
+    assert 0.0 < t[0] < 0.1 and t[-1] > 110.0  # from the first frame after the start
     assert np.all(np.diff(t) > 0) and np.all(np.isfinite(e))
     assert ghost.send_plot()
 
