@@ -1,16 +1,17 @@
 """The numerical ghost (issue 4): the same body advanced by a numerical integrator, drawn as a
-translucent shell over the exact ellipsoid, with a live readout and a plot of its error.
+translucent ice-blue cage over the exact ellipsoid, with a live readout and a plot of its error.
 
 What a student sees: at the moment the ghost is switched on it coincides with the body; then
 the chosen method carries it along on its own. RK45 at a loose tolerance visibly drifts out of
 the ellipsoid (its energy error grows without bound); the symplectic splitting wobbles but its
 energy error stays bounded; the implicit midpoint keeps the energy and |L| to rounding yet
-still falls behind in phase. The plot (log scale) shows the ω error, the attitude error (the
-geodesic angle between the two rotations) and the energy error against simulated time.
+still falls behind in phase. The plot shows log₁₀ of the ω error, of the attitude error (the
+geodesic angle between the two rotations) and of the energy error against simulated time.
 
 Lifecycle: the session mounts :class:`GhostControls` (a checkbox, the method and its setting)
 at start; nothing else exists until the box is ticked. Switching on creates the scene nodes
-(``/space/ghost``: the shell and the principal axes, posed by the ghost's attitude;
+(``/space/ghost``: a faint shell, the three principal sections and the principal axes, posed
+by the ghost's attitude;
 ``/space/ghost_tip``: the tip of the ghost's ω, which leaves the invariable plane when the
 energy drifts), and the readout and the plot below the controls (in the control panel, where
 the box was ticked: a floating window would cover the panel or the "Motion" window on a
@@ -76,7 +77,8 @@ MIN_WORK, MAX_WORK = 32, 200_000
 #: Starting estimate of the cost of one step or RHS evaluation [s] (the slowest measured here,
 #: the midpoint's fixed-point solve, is ~12 us); replaced by measurements.
 INITIAL_UNIT_COST = 2e-5
-#: The ghost counts as caught up when within this fraction of a frame's time of the body.
+#: The ghost counts as behind the body when it lags by more than this fraction of the time
+#: (rounding of the times themselves is not a lag).
 BEHIND_FRACTION = 1e-6
 
 #: Index order taking viser's (w, x, y, z) back to scipy's (x, y, z, w).
@@ -90,15 +92,15 @@ PLOT_HZ = 4.0
 #: and the interval doubled (so the plot stays small and keeps the early, small errors).
 PLOT_POINTS = 400
 PLOT_FIRST_INTERVAL = 0.05
+# The plot shows log10 of the errors on a linear axis. viser's uPlot does take a log scale
+# (``distr: 3``), but its tick labels need a JavaScript formatter, which viser cannot send
+# (the default prints 1e-6 as "0"); ticks given as data are also drawn outside the fitted
+# range (over the legend), and changing the axis options rebuilds the chart, which then loses
+# its x range. log10 values get uPlot's own ticks and a range fitted to the data, so a drift of
+# one decade stays visible.
 #: Errors below this are drawn at this value (rounding level; log10 needs a positive number).
 PLOT_FLOOR = 1e-16
 _LOG_FLOOR = math.log10(PLOT_FLOOR)
-#: The plot shows log10 of the errors on a linear axis. viser's uPlot does take a log scale
-#: (``distr: 3``), but its tick labels need a JavaScript formatter, which viser cannot send
-#: (the default prints 1e-6 as "0"); ticks given as data are also drawn outside the fitted
-#: range (over the legend), and changing the axis options rebuilds the chart, which then loses
-#: its x range. log10 values get uPlot's own ticks and a range fitted to the data, so a drift of
-#: one decade stays visible.
 #: How long removed widgets stay hidden before they are deleted [s] (see app/panel.py: an
 #: update sent just before a removal must not reach the browser after it).
 RETIRE_SECONDS = 1.5
