@@ -4,9 +4,23 @@ import ast
 import pathlib
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-ALLOWED = {"numpy", "scipy", "math", "enum", "dataclasses", "typing", "__future__",
-           "functools", "time", "argparse", "sys", "collections", "warnings",
-           "fractions", "dataclasses", "decimal"}
+ALLOWED = {
+    "numpy",
+    "scipy",
+    "math",
+    "enum",
+    "dataclasses",
+    "typing",
+    "__future__",
+    "functools",
+    "time",
+    "argparse",
+    "sys",
+    "collections",
+    "warnings",
+    "fractions",
+    "decimal",
+}
 
 
 def _top_level_imports(path: pathlib.Path) -> set[str]:

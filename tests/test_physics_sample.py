@@ -1,4 +1,4 @@
-"""``FreeRigidBody.sample``: ω, R and the contact point from one evaluation, as a renderer uses it."""
+"""``FreeRigidBody.sample``: ω, R and the contact point from one evaluation."""
 
 import numpy as np
 import pytest

@@ -12,7 +12,9 @@ def _box_moments(sides, mass):
     return mass / 12.0 * np.array([a2**2 + a3**2, a3**2 + a1**2, a1**2 + a2**2])
 
 
-@pytest.mark.parametrize("sides", [(1.0, 2.0, 3.0), (0.1, 5.0, 0.3), (2.0, 2.0, 2.0), (1.0, 1.0, 0.0)])
+@pytest.mark.parametrize(
+    "sides", [(1.0, 2.0, 3.0), (0.1, 5.0, 0.3), (2.0, 2.0, 2.0), (1.0, 1.0, 0.0)]
+)
 @pytest.mark.parametrize("mass", [1.0, 0.25, 40.0])
 def test_box_dimensions_round_trip(sides, mass):
     inertia = _box_moments(sides, mass)
