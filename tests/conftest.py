@@ -28,22 +28,11 @@ import pytest
 
 from app.presets import DEFAULT_PRESET, Preset
 from app.probe import Probe
+from app.screenshot import CHROMIUM_ARGS, CHROMIUM_ENV, DEFAULT_CHROMIUM
 from app.server import PoinsotApp
 from app.session import Session
 
-CHROMIUM = os.environ.get("POINSOT_CHROMIUM", "/usr/bin/chromium")
-#: Flags that work here: headless, root, closed network, SwiftShader WebGL.
-CHROMIUM_ARGS = (
-    "--no-sandbox",
-    "--disable-gpu",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-)
+CHROMIUM = os.environ.get(CHROMIUM_ENV, DEFAULT_CHROMIUM)
 #: Console messages that are not errors of ours (they are emitted at "warning" level anyway;
 #: listed so that a change of level in a later viser does not fail the suite silently).
 BENIGN_CONSOLE = ("GPU stall due to ReadPixels", "THREE.Clock: This module has been deprecated")

@@ -25,6 +25,7 @@ import uuid
 
 import numpy as np
 import pytest
+from conftest import chromium_or_fail, session_of, wait_until
 from PIL import Image
 
 from app import export
@@ -33,7 +34,6 @@ from app.lecture import LARGE_TEXT_PERCENT
 from app.presets import preset_by_key
 from app.screenshot import THEME_BACKGROUND
 from app.view import VIEWS
-from tests.conftest import chromium_or_fail, session_of, wait_until
 from tests.test_export_lecture import lecture_of
 
 pytestmark = pytest.mark.browser

@@ -12,10 +12,10 @@ import time
 import numpy as np
 import pytest
 import trimesh
+from conftest import session_of, wait_until
 
 from app import export
 from app.lecture import LectureControls
-from tests.conftest import session_of, wait_until
 
 
 class Downloads:
