@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import math
 import multiprocessing as mp
 import statistics
 import sys
@@ -169,6 +170,58 @@ def run(clients: int, seconds: float = 5.0, redraws: int = 30) -> Result:
     )
 
 
+def _probe_main(port: int, seconds: float) -> None:
+    """Child process of :func:`viser_floor`: one headless client that just listens."""
+    from app.probe import Probe
+
+    Probe(port)
+    time.sleep(seconds)
+
+
+def viser_floor(seconds: float = 4.0) -> float:
+    """Server CPU per frame [ms] of a bare viser server sending one pose per frame at 60 Hz.
+
+    The same client, transport and machine as :func:`run`, with no Poinsot code: the part of
+    the per-client-frame figure that viser's message path costs by itself, measured in this run
+    so that the ratio is meaningful on a noisy machine.
+    """
+    import threading
+
+    import numpy as np
+    import viser
+
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    connected: list[Any] = []
+    ready = threading.Event()
+
+    @server.on_client_connect
+    def _(client) -> None:
+        connected.append((client, client.scene.add_frame("/pose", show_axes=False)))
+        ready.set()
+
+    proc = mp.get_context("spawn").Process(
+        target=_probe_main, args=(server.get_port(), seconds + 4.0)
+    )
+    proc.start()
+    try:
+        if not ready.wait(30):
+            raise RuntimeError("the floor client never connected")
+        time.sleep(1.0)
+        client, frame = connected[0]
+        n, cpu0, t0 = 0, time.process_time(), time.perf_counter()
+        while time.perf_counter() - t0 < seconds:
+            with client.atomic():
+                frame.wxyz = np.array([math.cos(0.01 * n), 0.0, math.sin(0.01 * n), 0.0])
+            n += 1
+            time.sleep(1.0 / 60.0)
+        return 1e3 * (time.process_time() - cpu0) / max(n, 1)
+    finally:
+        proc.join(seconds + 30)
+        if proc.is_alive():
+            proc.terminate()
+        server.stop()
+
+
 def format_result(r: Result) -> str:
     return "\n".join(
         [
@@ -205,6 +258,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     for n in args.clients:
         print(format_result(run(n, args.seconds, args.redraws)), flush=True)
+    print(
+        f"viser floor: a bare viser server sending one pose per frame costs "
+        f"{viser_floor():.3f} ms CPU per client-frame here (no Poinsot code)"
+    )
     return 0
 
 
