@@ -247,11 +247,6 @@ def ellipk(m: float, mc: float | None = None) -> float:
     return float(special.elliprf(0.0, mc, 1.0))
 
 
-def ellippi_complete(n: float, m: float, mc: float) -> float:
-    """Complete integral of the third kind ``Π(n|m)`` for ``n < 1``, ``m < 1`` (DLMF 19.25.2)."""
-    return float(special.elliprf(0.0, mc, 1.0) + n / 3.0 * special.elliprj(0.0, mc, 1.0, 1.0 - n))
-
-
 def ellippi_from_jacobi(n: float, sn: np.ndarray, cn: np.ndarray, dn: np.ndarray) -> np.ndarray:
     """Incomplete ``Π(n; am u | m)`` from ``sn, cn, dn`` of a reduced argument (``cn >= 0``).
 

@@ -488,8 +488,7 @@ class _Circular:
     ):
         self.w0 = w
         self.axis = axis
-        self.m0 = inertia * w
-        self.G = float(np.linalg.norm(self.m0))
+        self.G = float(np.linalg.norm(inertia * w))
         w_axial = float(w @ axis)
         # The two rates to double-double from the exact data, so that the angles p τ and s τ
         # (reduced mod 2π) stay exact over long runs (physics.precise).
@@ -764,11 +763,9 @@ class FreeRigidBody:
         return rot[0] if scalar else rot
 
     def state(self, t) -> tuple[np.ndarray, Rotation]:
-        """ω(t) and R(t) together (cheaper than two calls): ((N,3) or (3,), Rotation)."""
-        tt, scalar = _check_times(t)
-        w, q = self._quat_user(tt * self._w_ref)
-        rot = Rotation.from_quat(q)
-        return (w[0], rot[0]) if scalar else (w, rot)
+        """ω(t) and R(t) from one evaluation: ((N,3) or (3,), Rotation); see :meth:`sample`."""
+        w, rot, _ = self.sample(t)
+        return w, rot
 
     def contact_point(self, t) -> np.ndarray:
         """The tip of ω in space, ``R(t) ω(t)`` (the herpolhode): (3,) or (N, 3).
