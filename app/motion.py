@@ -20,8 +20,11 @@ import numpy as np
 
 from physics import FreeRigidBody
 
-#: Grid times evaluated per physics call.
-BATCH = 128
+#: Grid times evaluated per physics call (about 128 frames' worth: a 512-time call costs
+#: little more than a 128-time one, so a frame's share of the physics is a few microseconds).
+BATCH = 512
+#: The first batch after a parameter change is smaller: the slider-to-redraw time pays for it.
+FIRST_BATCH = 64
 #: Grid steps per frame when the motion is slow (the display lags the clock by < 1/4 frame).
 STEPS_PER_FRAME = 4
 #: Samples of the one-period survey that measures how fast the traces move.
@@ -100,14 +103,15 @@ class MotionSampler:
     def time(self, k: int) -> float:
         return self.t0 + k * self.step
 
-    def samples(self, k_first: int, k_last: int) -> Samples:
-        """The motion at grid indices ``k_first..k_last`` (inclusive), from the cache or a new
-        batch starting at ``k_first``."""
+    def batch(self, k_first: int, k_last: int, size: int = BATCH) -> Samples:
+        """The whole cached batch holding grid indices ``k_first..k_last`` (inclusive),
+        evaluating a new one of ``size`` (or more) grid times starting at ``k_first`` if the
+        cache does not hold them all."""
         if k_last < k_first:
             raise ValueError("empty grid range")
         cache = self._cache
         if cache is None or k_first < cache.k[0] or k_last > cache.k[-1]:
-            count = max(BATCH, k_last - k_first + 1)
+            count = max(size, k_last - k_first + 1)
             k = np.arange(k_first, k_first + count)
             t = self.t0 + k * self.step
             omega, quat, contact = evaluate(self.body, t)
@@ -117,6 +121,12 @@ class MotionSampler:
                 if not np.all(np.isfinite(values)):
                     raise ValueError(f"physics gave a non-finite {name}; nothing is drawn")
             cache = self._cache = Samples(k, t, omega, quat, contact)
+        return cache
+
+    def samples(self, k_first: int, k_last: int) -> Samples:
+        """The motion at grid indices ``k_first..k_last`` (inclusive), from the cache or a new
+        batch starting at ``k_first``."""
+        cache = self.batch(k_first, k_last)
         i, j = k_first - int(cache.k[0]), k_last - int(cache.k[0]) + 1
         return Samples(
             cache.k[i:j], cache.t[i:j], cache.omega[i:j], cache.quat_xyzw[i:j], cache.contact[i:j]

@@ -39,7 +39,7 @@ import viser
 
 from app import palette, solids
 from app.frames import wxyz_from_xyzw
-from app.motion import MotionSampler, Samples, trace_speed
+from app.motion import FIRST_BATCH, MotionSampler, Samples, trace_speed
 from app.presets import Element, Solid
 from app.trail import Trail
 from physics import FreeRigidBody, Regime
@@ -140,6 +140,52 @@ class Frame:
     samples: int  # trace samples evaluated for this frame
 
 
+@dataclasses.dataclass(frozen=True)
+class _Batch:
+    """One physics batch (:meth:`MotionSampler.batch`) converted, once and vectorised, into
+    what frames send: a frame then only picks rows (no numpy work, no allocation per frame).
+    Row ``i`` is grid index ``k0 + i``; the arrays are read-only."""
+
+    k0: int
+    t: np.ndarray  # (N,) simulation time
+    omega: np.ndarray  # (N, 3) body frame, physical units
+    wxyz: np.ndarray  # (N, 4) attitude as viser takes it
+    tip: np.ndarray  # (N, 3) contact point, space frame, display units (float64)
+    arrow: np.ndarray  # (N, 1, 2, 3) float32: the omega arrow, origin to contact point
+    polhode: np.ndarray  # (N, 3) float32 trace points, body frame, display units
+    herpolhode: np.ndarray  # (N, 3) float32 trace points, space frame, display units
+    keep: np.ndarray  # (N,) bool: grid samples the traces take (every stride-th)
+
+    @classmethod
+    def convert(cls, samples: Samples, scale: float, stride: int) -> _Batch:
+        tip = samples.contact * scale
+        arrow = np.zeros((len(tip), 1, 2, 3), np.float32)
+        arrow[:, 0, 1] = tip
+        batch = cls(
+            int(samples.k[0]),
+            samples.t,
+            samples.omega,
+            wxyz_from_xyzw(samples.quat_xyzw),
+            tip,
+            arrow,
+            (samples.omega * scale).astype(np.float32),
+            tip.astype(np.float32),
+            samples.k % stride == 0,
+        )
+        for field in dataclasses.fields(cls)[1:]:
+            getattr(batch, field.name).flags.writeable = False
+        return batch
+
+    def trace(self, element: Element, i: int, j: int, last: bool) -> np.ndarray:
+        """Trace points of rows ``i..j-1`` (the last row too if ``last``)."""
+        points = self.polhode if element is Element.POLHODE else self.herpolhode
+        keep = self.keep[i:j]
+        if last and not keep[-1]:
+            keep = keep.copy()
+            keep[-1] = True
+        return points[i:j][keep]
+
+
 class PoinsotScene:
     """The scene nodes of one view. Create with the elements to draw; then :meth:`load` a body
     and call :meth:`advance` every frame. Not thread-safe: one thread drives a scene."""
@@ -169,7 +215,11 @@ class PoinsotScene:
         self._solid_key: tuple | None = None
         self._k_last: int | None = None
         self._frame: Frame | None = None
-        self._pending: dict[Element, list[np.ndarray]] = {}
+        self._batch: _Batch | None = None
+        self._batch_source: Samples | None = None
+        self._omega_arrow: viser.SceneNodeHandle | None = None
+        # Rows drawn since the last trail flush: (batch, first row, end row, force last row).
+        self._pending: list[tuple[_Batch, int, int, bool]] = []
         self._frames_since_flush = 0
         self.space = api.add_frame(root, show_axes=False)
         self.body_frame = api.add_frame(f"{root}/body", show_axes=False)
@@ -243,17 +293,19 @@ class PoinsotScene:
         geometry = Geometry.from_body(body, solid)
         sampler = MotionSampler.for_body(body, geometry.trace_speed, frame_time, MAX_CHORD, t)
         k = sampler.index(t)
-        first = self._checked(sampler.samples(k, k))
+        source = sampler.batch(k, k, FIRST_BATCH)  # checked finite by the sampler
+        batch = _Batch.convert(source, geometry.scale, sampler.stride)
         with self._atomic():
             self._body, self._solid, self._geometry = body, solid, geometry
             self._sampler = sampler
+            self._batch, self._batch_source = batch, source
             for element in sorted(self._elements):
                 if not self._nodes.get(element) and element not in self._trails:
                     self._build(element)
                 self._apply_geometry(element)
             self._k_last = None
             self._frame = None
-            return self._draw(first, restart=True)
+            return self._draw(k, k, restart=True)
 
     def set_frame_time(self, frame_time: float) -> None:
         """The clock's speed changed: re-grid the motion from the time now shown."""
@@ -288,57 +340,49 @@ class PoinsotScene:
             k_first = k
         else:
             k_first = max(self._k_last + 1, k - MAX_SAMPLES_PER_FRAME + 1)
-        samples = sampler.samples(k_first, k)  # checked finite once per batch
         with self._atomic():
-            return self._draw(samples, restart)
+            return self._draw(k_first, k, restart)
 
-    @staticmethod
-    def _checked(samples: Samples) -> Samples:
-        _finite("omega", samples.omega)
-        _finite("the contact point", samples.contact)
-        _finite("the attitude", samples.quat_xyzw)
-        return samples
+    def _batch_for(self, k_first: int, k_last: int) -> _Batch:
+        sampler, geometry = self._sampler, self._geometry
+        assert sampler is not None and geometry is not None
+        source = sampler.batch(k_first, k_last)  # checked finite once per batch
+        if source is not self._batch_source or self._batch is None:
+            self._batch = _Batch.convert(source, geometry.scale, sampler.stride)
+            self._batch_source = source
+        return self._batch
 
-    def _draw(self, samples: Samples, restart: bool) -> Frame:
-        geometry, sampler = self._geometry, self._sampler
-        assert geometry is not None and sampler is not None
-        s = geometry.scale
+    def _draw(self, k_first: int, k: int, restart: bool) -> Frame:
+        """Send the pose at grid index ``k`` and queue the trace rows ``k_first..k``: three
+        pose-sized messages, every value precomputed by :class:`_Batch`."""
+        batch = self._batch_for(k_first, k)
+        i, j = k_first - batch.k0, k - batch.k0
         if restart:
             for trail in self._trails.values():
                 trail.clear()
             self._pending.clear()
-        q = wxyz_from_xyzw(samples.quat_xyzw[-1])
-        tip = samples.contact[-1] * s  # poses travel as float64
-        self.body_frame.wxyz = q
+        wxyz, tip = batch.wxyz[j], batch.tip[j]
+        self.body_frame.wxyz = wxyz
         self.tip.position = tip
-        if Element.OMEGA in self._nodes:
-            self._nodes[Element.OMEGA][0].points = np.array([[[0.0, 0.0, 0.0], tip]], np.float32)
-        # Trace samples: every stride-th grid time (and the first point of a new trace).
-        keep = samples.k % sampler.stride == 0
-        if restart:
-            keep[-1] = True
-        if keep.any():
-            for element, points in (
-                (Element.POLHODE, samples.omega),
-                (Element.HERPOLHODE, samples.contact),
-            ):
-                if element in self._trails:
-                    self._pending.setdefault(element, []).append(
-                        (points[keep] * s).astype(np.float32)
-                    )
+        if self._omega_arrow is not None:
+            self._omega_arrow.points = batch.arrow[j]
+        if self._trails:
+            self._pending.append((batch, i, j + 1, restart))
         self._frames_since_flush += 1
         if restart or self._frames_since_flush >= TRAIL_EVERY:
             self.flush_trails()
-        self._k_last = int(samples.k[-1])
-        self._frame = Frame(float(samples.t[-1]), samples.omega[-1].copy(), q, tip, len(samples.k))
+        self._k_last = k
+        self._frame = Frame(float(batch.t[j]), batch.omega[j], wxyz, tip, j - i + 1)
         return self._frame
 
     def flush_trails(self) -> None:
         """Send the trace points gathered since the last flush."""
-        for element, parts in self._pending.items():
-            trail = self._trails.get(element)
-            if trail is not None and parts:
-                trail.append(np.concatenate(parts))
+        if self._pending:
+            for element, trail in self._trails.items():
+                parts = [b.trace(element, i, j, last) for b, i, j, last in self._pending]
+                points = parts[0] if len(parts) == 1 else np.concatenate(parts)
+                if len(points):
+                    trail.append(points)
         self._pending.clear()
         self._frames_since_flush = 0
 
@@ -352,7 +396,8 @@ class PoinsotScene:
         if trail is not None:
             trail.clear()
             trail.group.remove()
-        self._pending.pop(element, None)
+        if element is Element.OMEGA:
+            self._omega_arrow = None
 
     def _build(self, element: Element) -> None:
         api, r = self.api, self.root
@@ -439,15 +484,16 @@ class PoinsotScene:
             )
         elif element is Element.OMEGA:
             # The label rides on /space/tip, posed at the contact point: no message of its own.
+            self._omega_arrow = api.add_arrows(
+                f"{r}/omega",
+                np.array([[[0, 0, 0], [0, 0, 1]]], np.float32),
+                palette.OMEGA,
+                shaft_radius=0.014,
+                head_radius=0.04,
+                head_length=0.11,
+            )
             nodes += [
-                api.add_arrows(
-                    f"{r}/omega",
-                    np.array([[[0, 0, 0], [0, 0, 1]]], np.float32),
-                    palette.OMEGA,
-                    shaft_radius=0.014,
-                    head_radius=0.04,
-                    head_length=0.11,
-                ),
+                self._omega_arrow,
                 api.add_label(
                     f"{r}/tip/omega_label",
                     "ω",

@@ -43,15 +43,18 @@ class Trail:
         self._max_points = max(int(max_points), 2 * self._chunk)
         self.group = api.add_frame(name, show_axes=False, position=position)
         self._frozen: collections.deque[tuple[viser.LineSegmentsHandle, int]] = collections.deque()
+        self._frozen_segments = 0  # sum of the frozen chunks' segment counts
         self._head: viser.LineSegmentsHandle | None = None
-        self._head_segments = np.zeros((0, 2, 3), dtype=np.float32)
+        # The head chunk's segments live in a preallocated buffer: rows [0, n) are drawn.
+        self._buffer = np.empty((self._chunk, 2, 3), dtype=np.float32)
+        self._n = 0
         self._last: np.ndarray | None = None
         self._counter = 0
 
     # -- state ---------------------------------------------------------------------------
     @property
     def segment_count(self) -> int:
-        return sum(n for _, n in self._frozen) + len(self._head_segments)
+        return self._frozen_segments + self._n
 
     @property
     def max_points(self) -> int:
@@ -73,7 +76,7 @@ class Trail:
     def points(self) -> np.ndarray:
         """All points currently drawn, oldest first, shape (N, 3) (for tests and exports)."""
         parts = [h.points for h, _ in self._frozen]
-        parts.append(self._head_segments)
+        parts.append(self._buffer[: self._n])
         segments = np.concatenate(parts) if parts else np.zeros((0, 2, 3), np.float32)
         if len(segments) == 0:
             return np.zeros((0, 3), dtype=np.float32)
@@ -84,10 +87,11 @@ class Trail:
         for handle, _ in self._frozen:
             handle.remove()
         self._frozen.clear()
+        self._frozen_segments = 0
         if self._head is not None:
             self._head.remove()
         self._head = None
-        self._head_segments = np.zeros((0, 2, 3), dtype=np.float32)
+        self._n = 0
         self._last = None
 
     def append(self, points: np.ndarray) -> None:
@@ -101,15 +105,19 @@ class Trail:
             if len(points) == 0:
                 return
         chain = np.concatenate([self._last[None], points])
-        new = np.stack([chain[:-1], chain[1:]], axis=1)
-        self._last = points[-1]
-        while len(new):
-            room = self._chunk - len(self._head_segments)
+        self._last = chain[-1]
+        start, total = 0, len(points)
+        while start < total:
+            room = self._chunk - self._n
             if room == 0:
                 self._freeze_head()
                 continue
-            take, new = new[:room], new[room:]
-            self._head_segments = np.concatenate([self._head_segments, take])
+            take = min(room, total - start)
+            rows = self._buffer[self._n : self._n + take]
+            rows[:, 0] = chain[start : start + take]
+            rows[:, 1] = chain[start + 1 : start + take + 1]
+            self._n += take
+            start += take
             self._send_head()
         self._trim()
 
@@ -119,22 +127,24 @@ class Trail:
             self._counter += 1
             self._head = self._api.add_line_segments(
                 f"{self._name}/c{self._counter}",
-                self._head_segments,
+                self._buffer[: self._n].copy(),  # the creation message keeps its array
                 self._color,
                 thickness=self._width,
                 thickness_units="screen",
                 scale=self._scale,
             )
         else:
-            self._head.points = self._head_segments
+            self._head.points = self._buffer[: self._n]  # a points update casts (copies)
 
     def _freeze_head(self) -> None:
         if self._head is not None:
-            self._frozen.append((self._head, len(self._head_segments)))
+            self._frozen.append((self._head, self._n))
+            self._frozen_segments += self._n
         self._head = None
-        self._head_segments = np.zeros((0, 2, 3), dtype=np.float32)
+        self._n = 0
 
     def _trim(self) -> None:
         while self._frozen and self.segment_count > self._max_points:
-            handle, _ = self._frozen.popleft()
+            handle, n = self._frozen.popleft()
+            self._frozen_segments -= n
             handle.remove()

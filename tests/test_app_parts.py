@@ -164,7 +164,8 @@ def test_wxyz_is_scalar_first_and_round_trips():
 # -- trail -----------------------------------------------------------------------------
 class FakeHandle:
     def __init__(self, api, name, points) -> None:
-        self.api, self.name, self._points = api, name, np.array(points)
+        # Kept by reference, as viser's add_line_segments keeps a float32 array it is given.
+        self.api, self.name, self._points = api, name, np.asarray(points)
         self.visible = True
         api.sent_bytes += self._points.nbytes
 
@@ -216,6 +217,24 @@ def test_trail_is_bounded_and_sends_increments_only():
     assert trail.segment_count == 0 and api.live == set()
     trail.append(points[:5])
     assert np.array_equal(trail.points(), points[:5])
+
+
+def test_trail_appends_of_any_size_draw_one_unbroken_polyline():
+    """Batches that straddle chunks (as a frame after a stall does) keep every point once,
+    in order, and a chunk already sent is never rewritten by later appends."""
+    api = FakeApi()
+    trail = Trail(api, "/t", (0, 0, 255), 2.0, max_points=10_000, chunk=8)
+    rng = np.random.default_rng(7)
+    points = rng.normal(size=(400, 3)).astype(np.float32)
+    start = 0
+    for size in rng.integers(1, 30, size=200):
+        if start >= len(points):
+            break
+        trail.append(points[start : start + size])
+        start += size
+    assert np.array_equal(trail.points(), points)
+    segments = np.concatenate([h.points for h, _ in trail._frozen])
+    assert np.array_equal(segments[1:, 0], segments[:-1, 1])  # chunks join end to end
 
 
 # -- command line ----------------------------------------------------------------------
