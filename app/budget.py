@@ -6,12 +6,19 @@ would then wait behind them. The budget measures what a client-frame really cost
 time per frame: physics, scene updates, viser's serialisation, the sends) and gives each session
 a frame rate such that all frames together use at most ``share`` of one CPU, never more than
 ``max_fps`` and never less than ``min_fps``.
+
+It also gives a slider move precedence: while any session rebuilds its scene (:meth:`rebuild`),
+the other sessions hold their next frame (:attr:`rebuilding`), so the rebuild has the
+interpreter to itself and the student who moved the slider sees the new body at once; the
+others lose at most a frame or two.
 """
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import time
+from collections.abc import Iterator
 
 
 class FrameBudget:
@@ -31,6 +38,23 @@ class FrameBudget:
         self._cost = 0.0  # CPU seconds per client-frame, smoothed
         self._t0 = time.monotonic()
         self._cpu0 = time.process_time()
+        self._rebuilding = 0
+
+    @contextlib.contextmanager
+    def rebuild(self) -> Iterator[None]:
+        """Scope of one session's rebuild: the other sessions' frames wait until it ends."""
+        with self._lock:
+            self._rebuilding += 1
+        try:
+            yield
+        finally:
+            with self._lock:
+                self._rebuilding -= 1
+
+    @property
+    def rebuilding(self) -> bool:
+        """True while some session rebuilds: hold frames (never the rebuilds themselves)."""
+        return self._rebuilding > 0
 
     def set_sessions(self, count: int) -> None:
         with self._lock:

@@ -40,6 +40,10 @@ PLOT_HZ = 10.0
 TIME_HZ = 5.0
 #: "Step" advances this many wall seconds' worth of simulation time.
 STEP_SECONDS = 0.1
+#: While another session rebuilds, a due frame is retried after this long [s], and held for
+#: at most HOLD_SECONDS (so that many students dragging sliders never freeze the others).
+YIELD_SECONDS = 0.002
+HOLD_SECONDS = 0.05
 
 
 @dataclasses.dataclass
@@ -47,6 +51,12 @@ class SessionStats:
     """Timings for the benchmark and the tests (seconds)."""
 
     frame_seconds: collections.deque = dataclasses.field(
+        default_factory=lambda: collections.deque(maxlen=2000)
+    )
+    #: CPU time of the session thread per loop pass that drew a frame: everything Poinsot
+    #: does for one client-frame (actions, physics, scene updates, plot and time readout, and
+    #: viser's setters that queue the messages), but not viser's transport thread.
+    frame_cpu_seconds: collections.deque = dataclasses.field(
         default_factory=lambda: collections.deque(maxlen=2000)
     )
     rebuild_seconds: collections.deque = dataclasses.field(
@@ -193,7 +203,7 @@ class Session:
 
     # -- frame thread --------------------------------------------------------------------
     def _run(self) -> None:
-        next_frame = time.monotonic()
+        next_frame = due = time.monotonic()
         last_plot = last_time = 0.0
         while not self._stop.is_set():
             delay = next_frame - time.monotonic()
@@ -202,14 +212,19 @@ class Session:
                 self._wake.clear()
             if self._stop.is_set():
                 break
+            cpu0 = time.thread_time()
+            drawn = False
             try:
                 self._drain()
                 if self._dirty:
                     self._rebuild()
                 now = time.monotonic()
-                if now >= next_frame:
-                    next_frame = now + 1.0 / min(self.max_fps, self.budget.fps)
+                if now >= next_frame and self.budget.rebuilding and now - due < HOLD_SECONDS:
+                    next_frame = now + YIELD_SECONDS  # a slider move elsewhere goes first
+                elif now >= next_frame:
+                    next_frame = due = now + 1.0 / min(self.max_fps, self.budget.fps)
                     self._advance()
+                    drawn = True
                     if now - last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
                         last_plot = now
                         self.panel.record_plot(self.frame.t, self.frame.omega)
@@ -222,8 +237,12 @@ class Session:
             except Exception as exc:  # the loop must survive anything; the user sees it
                 self._report(exc)
                 next_frame = time.monotonic() + 1.0 / self.max_fps
+            if drawn:
+                self.stats.frame_cpu_seconds.append(time.thread_time() - cpu0)
 
     def _drain(self) -> None:
+        if self._actions.empty():  # the usual frame: no exception raised and caught
+            return
         while True:
             try:
                 action = self._actions.get_nowait()
@@ -317,6 +336,10 @@ class Session:
     def _rebuild(self) -> None:
         """Build the body for the desired parameters and load it; on a ValueError keep the
         last valid scene and say why."""
+        with self.budget.rebuild():
+            self._rebuild_now()
+
+    def _rebuild_now(self) -> None:
         start = time.perf_counter()
         desired = self._desired
         self._dirty = False

@@ -11,7 +11,7 @@ import urllib.request
 
 import numpy as np
 import pytest
-from conftest import wait_until
+from conftest import session_of, wait_until
 from scipy.spatial.transform import Rotation
 
 from app import cli
@@ -318,6 +318,29 @@ def test_grid_step_keeps_trace_chords_short():
         kept = s.contact[s.k % sampler.stride == 0] * scale
         chords = np.linalg.norm(np.diff(kept, axis=0), axis=1)
         assert chords.max() <= 0.02 * 1.01
+
+
+def test_a_rebuild_holds_the_other_sessions_frames_for_a_bounded_time(probe, poinsot_app):
+    """While some session rebuilds (a slider moved), the others hold their frames so that the
+    rebuild runs alone; a rebuild that never ends holds them at most HOLD_SECONDS each."""
+    from app.session import HOLD_SECONDS
+
+    session = session_of(poinsot_app)
+    budget = poinsot_app.budget
+    assert not budget.rebuilding
+    assert wait_until(lambda: session.stats.frames > 5, 10)
+    with budget.rebuild():
+        assert budget.rebuilding
+        time.sleep(0.1)  # past a frame already in progress
+        before = session.stats.frames
+        time.sleep(0.5)
+        held = session.stats.frames - before
+    assert not budget.rebuilding
+    # At 60 fps 30 frames would have been drawn; held, one frame per hold (plus one period).
+    assert 1 <= held <= 0.5 / (HOLD_SECONDS + 1 / 60) + 2
+    before = session.stats.frames
+    time.sleep(0.5)
+    assert session.stats.frames - before > held  # free again
 
 
 def test_frame_budget_shares_one_cpu_among_sessions():
