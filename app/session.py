@@ -117,10 +117,11 @@ class Session:
 
     # -- lifecycle -----------------------------------------------------------------------
     def start(self) -> Session:
-        self._thread = threading.Thread(
+        thread = threading.Thread(
             target=self._run, name=f"poinsot-session-{self.client.client_id}", daemon=True
         )
-        self._thread.start()
+        thread.start()
+        self._thread = thread  # only a started thread is ever joined by close()
         return self
 
     def close(self, timeout: float | None = None) -> None:
