@@ -37,6 +37,15 @@ def decimal(x: Fraction | float | int) -> Decimal:
     return Decimal(x.numerator) / Decimal(x.denominator)
 
 
+def ratio(numerator: int, denominator: int) -> Decimal:
+    """``numerator / denominator`` of two exact integers, rounded once to the context precision.
+
+    The same value as ``decimal(Fraction(numerator, denominator))`` without reducing the
+    fraction first (a gcd of large integers costs more than the division).
+    """
+    return Decimal(numerator) / Decimal(denominator)
+
+
 def double_double(x: Decimal) -> tuple[float, float]:
     """``(hi, lo)`` with ``hi = round(x)`` and ``lo = round(x - hi)``."""
     hi = float(x)
@@ -95,10 +104,36 @@ class LinearPhase:
         r = ((p - j * c1) - j * c2) + ((self.offset - j * c3) + err)
         return r, j
 
+    def reduce_scalar(self, tau: float) -> tuple[float, float]:
+        """:meth:`reduce` for one float τ: the same operations in plain floats (same result).
+
+        Raises OverflowError or ValueError where the phase is not finite (the array version
+        returns NaN there); scalar callers fall back to the array version.
+        """
+        p = self.rate_hi * tau
+        j = float(round((p + self.offset) / self.period_hi))
+        c1, c2 = split(self.period_hi)
+        if abs(tau) < _SPLIT_LIMIT:
+            rh, rl = split(self.rate_hi)
+            th, tl = split(tau)
+            err = ((rh * th - p) + rh * tl + rl * th) + rl * tl
+            err = err + self.rate_lo * tau
+        else:
+            err = 0.0
+        r = ((p - j * c1) - j * c2) + ((self.offset - j * self.period_lo) + err)
+        return r, j
+
 
 def angle_phase(rate: tuple[float, float], offset: float = 0.0) -> LinearPhase:
     """A phase reduced modulo 2π (for angles such as the precession φ = ν τ)."""
+    return LinearPhase(offset, rate[0], rate[1], _TWO_PI[0], _TWO_PI[1])
+
+
+def _two_pi() -> tuple[float, float]:
     with localcontext() as ctx:
         ctx.prec = DIGITS
-        two_pi = double_double(2 * PI)
-    return LinearPhase(offset, rate[0], rate[1], two_pi[0], two_pi[1])
+        return double_double(2 * PI)
+
+
+#: 2π as a double-double pair (computed once: every angle phase shares it).
+_TWO_PI = _two_pi()
