@@ -3,6 +3,8 @@
 Solve once, evaluate many: :class:`FreeRigidBody` classifies the motion from the initial state
 (:class:`~physics.regime.Regime`), precomputes the constants of the closed form, and then
 evaluates ω(t) and the attitude R(t) on whole arrays of times with no integration and no drift.
+A single float time takes a plain-float path with the same operations (the same values), so
+that constructing a body and evaluating it once costs a fraction of a millisecond.
 
 Frames and conventions (see ``shared/PHYSICS.md``):
 
@@ -27,8 +29,7 @@ from __future__ import annotations
 
 import functools
 import math
-from decimal import localcontext
-from fractions import Fraction
+from decimal import Decimal, localcontext
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -55,14 +56,14 @@ def _vector3(value, name: str) -> np.ndarray:
         raise ValueError(f"{name} must be three real numbers, got {value!r}") from exc
     if arr.shape != (3,):
         raise ValueError(f"{name} must be three numbers (shape (3,)), got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
+    if not all(map(math.isfinite, arr.tolist())):
         raise ValueError(f"{name} must be finite, got {arr.tolist()}")
     return arr
 
 
 def _check_inertia(value) -> np.ndarray:
     inertia = _vector3(value, "the moments of inertia")
-    if np.any(inertia <= 0.0):
+    if min(inertia.tolist()) <= 0.0:
         raise ValueError(
             f"the moments of inertia must be positive, got {inertia.tolist()} "
             "(a principal moment is a sum of m·r², never zero or negative)"
@@ -70,8 +71,12 @@ def _check_inertia(value) -> np.ndarray:
     return inertia
 
 
-def _check_times(t) -> tuple[np.ndarray, bool]:
-    """Return the times as a 1-D float array and whether the caller passed a scalar."""
+def _check_times(t) -> float | np.ndarray:
+    """The times as a float if the caller passed one number, else as a 1-D float array."""
+    if isinstance(t, float):  # the common scalar (also numpy.float64): no array round trip
+        if not math.isfinite(t):
+            raise ValueError("time must be finite (got NaN or infinity)")
+        return float(t)
     try:
         arr = np.asarray(t, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -80,7 +85,7 @@ def _check_times(t) -> tuple[np.ndarray, bool]:
         raise ValueError(f"time must be a number or a 1-D array, got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise ValueError("time must be finite (got NaN or infinity)")
-    return arr.reshape(-1), arr.ndim == 0
+    return float(arr) if arr.ndim == 0 else arr
 
 
 def _pow2(x: float) -> float:
@@ -109,6 +114,9 @@ class _AxisMap:
             raise AssertionError("an axis relabelling must be a proper rotation")
         # Quaternion of the user->internal map, used on the right of the internal attitude.
         self.quat = Rotation.from_matrix(self.matrix).as_quat()
+        # Plain-float copies for the single-time path.
+        self.pairs = tuple((int(i), float(x)) for i, x in zip(index, sign, strict=True))
+        self.quat_tuple = tuple(float(x) for x in self.quat)
 
     def to_internal(self, x: np.ndarray) -> np.ndarray:
         return self.sign * x[..., self.index]
@@ -120,12 +128,25 @@ class _AxisMap:
             out[:, self.index[k]] = self.sign[k] * cols[k]
         return out
 
+    def to_user_tuple(self, cols: tuple[float, ...]) -> list[float]:
+        """:meth:`to_user_columns` for one sample of plain floats (a list in user order)."""
+        out = [0.0, 0.0, 0.0]
+        for (i, sign), col in zip(self.pairs, cols, strict=True):
+            out[i] = sign * col
+        return out
+
     def compose(self, other: _AxisMap) -> _AxisMap:
         """The map ``other ∘ self`` (apply self first)."""
-        return _axis_map(
-            tuple(int(i) for i in self.index[other.index]),
-            tuple(float(x) for x in other.sign * self.sign[other.index]),
-        )
+        return _compose(self, other)
+
+
+@functools.cache
+def _compose(first: _AxisMap, then: _AxisMap) -> _AxisMap:
+    """``then ∘ first`` (the maps are singletons, so this table has at most 24² entries)."""
+    return _axis_map(
+        tuple(int(i) for i in first.index[then.index]),
+        tuple(float(x) for x in then.sign * first.sign[then.index]),
+    )
 
 
 @functools.cache
@@ -135,7 +156,8 @@ def _axis_map(index: tuple[int, ...], sign: tuple[float, ...]) -> _AxisMap:
 
 def _sorting_map(inertia: np.ndarray) -> _AxisMap:
     """Proper relabelling that sorts the moments ascending (an odd permutation flips axis 1)."""
-    order = tuple(int(i) for i in np.argsort(inertia, kind="stable"))
+    values = inertia.tolist()
+    order = tuple(sorted(range(3), key=values.__getitem__))  # stable, as argsort(kind="stable")
     inversions = sum(order[i] > order[j] for i in range(3) for j in range(i + 1, 3))
     parity = -1.0 if inversions % 2 else 1.0  # an odd permutation gets axis 1 reversed
     return _axis_map(order, (parity, 1.0, 1.0))
@@ -215,28 +237,162 @@ def _zxz_from_momentum(
     )
 
 
+# The same four helpers for one sample in plain floats (tuples): a single time costs a few
+# microseconds this way instead of dozens of numpy calls on 1-element arrays. Same operations
+# in the same order, and numpy's own transcendental functions (on a float they run the same
+# kernel as on an array; libm's may differ by an ulp), so they agree with the array versions
+# to the last bit.
+
+
+def _qmul_scalar(p: tuple[float, ...], q: tuple[float, ...]) -> tuple[float, ...]:
+    """:func:`_qmul` for two single quaternions."""
+    px, py, pz, pw = p
+    qx, qy, qz, qw = q
+    return (
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+        pw * qw - px * qx - py * qy - pz * qz,
+    )
+
+
+def _rotate_scalar(q: tuple[float, ...], v: tuple[float, ...]) -> tuple[float, ...]:
+    """:func:`_rotate` for one quaternion and one vector."""
+    x, y, z, w = q
+    vx, vy, vz = v
+    tx = y * vz - z * vy + w * vx
+    ty = z * vx - x * vz + w * vy
+    tz = x * vy - y * vx + w * vz
+    return (
+        vx + 2.0 * (y * tz - z * ty),
+        vy + 2.0 * (z * tx - x * tz),
+        vz + 2.0 * (x * ty - y * tx),
+    )
+
+
+def _axis_angle_scalar(axis: tuple[float, ...], angle: float) -> tuple[float, ...]:
+    """:func:`_axis_angle_quat` for one angle."""
+    half = 0.5 * angle
+    s = float(np.sin(half))
+    return (axis[0] * s, axis[1] * s, axis[2] * s, float(np.cos(half)))
+
+
+def _zxz_scalar(m1: float, m2: float, m3: float, G: float, phi: float) -> tuple[float, ...]:
+    """:func:`_zxz_from_momentum` for one sample."""
+    rho = float(np.hypot(m1, m2))
+    psi = float(np.arctan2(m1, m2))
+    big = math.sqrt(0.5 * (G + abs(m3)) / G)
+    small = rho / (2.0 * G * big)
+    cos_half, sin_half = (big, small) if m3 >= 0.0 else (small, big)
+    sum_half = 0.5 * (phi + psi)
+    dif_half = 0.5 * (phi - psi)
+    return (
+        sin_half * float(np.cos(dif_half)),
+        sin_half * float(np.sin(dif_half)),
+        cos_half * float(np.sin(sum_half)),
+        cos_half * float(np.cos(sum_half)),
+    )
+
+
 # ---------------------------------------------------------------------------------------------
 # The three closed forms. Each works in its internal frame and dimensionless time τ = t·ω_ref.
 # ---------------------------------------------------------------------------------------------
 
 
-def _amplitudes(F: tuple[Fraction, ...], e1: Fraction, e3: Fraction) -> np.ndarray:
-    """``(A1, A2, A3)`` of Landau 37.10 from exact moments and Δ1, Δ3 (pole frame).
+def _dyadic(values) -> tuple[tuple[int, ...], int]:
+    """Exact integers ``n_k`` and one shift ``e`` with ``values[k] = n_k / 2^e``.
 
-    ``A1² = Δ3/(J1(J1-J3))``, ``A2² = Δ3/(J2(J2-J3))``, ``A3² = Δ1/(J3(J3-J1))``: each a quotient
-    of same-signed quantities in both families. Evaluated in decimal (call inside a
-    45-digit context) so that a spin a hair off an axis, with Δ ~ 1e-600, still gets its
-    representable amplitude ~1e-300 instead of 0/0.
+    Every finite double is a dyadic rational, so a few of them share a power-of-two
+    denominator; the shift is the smallest that serves them all, which keeps the integers
+    (and every product of them below) as short as the data allow.
     """
-    F1, F2, F3 = F
-    dec = precise.decimal
-    return np.array(
-        [
-            float(dec(e3 / (F1 * (F1 - F3))).sqrt()),
-            float(dec(e3 / (F2 * (F2 - F3))).sqrt()),
-            float(dec(e1 / (F3 * (F3 - F1))).sqrt()),
-        ]
-    )
+    ratios = [float(x).as_integer_ratio() for x in values]
+    bits = [d.bit_length() - 1 for _, d in ratios]  # each denominator is 2^bits
+    shift = max(bits)
+    return tuple(n << (shift - b) for (n, _), b in zip(ratios, bits, strict=True)), shift
+
+
+def _sqrt_ratio(num: int, den: int) -> float:
+    """``sqrt(num/den)`` correctly rounded, for integers of the same sign (or ``num = 0``).
+
+    ``q = isqrt(floor(num·4^k/den)) = floor(sqrt(num/den)·2^k)`` with k chosen so that q has
+    ~64 bits; when the root is inexact its lowest bit is set (a sticky bit below the rounding
+    position), so rounding q to a double rounds the exact root. A result outside the normal
+    range (not met by the amplitudes of scaled data) is left to decimal arithmetic.
+    """
+    if den < 0:
+        num, den = -num, -den
+    if num <= 0:
+        return 0.0 if num == 0 else math.nan
+    k = (128 - num.bit_length() + den.bit_length()) // 2
+    if k >= 0:
+        x, rem = divmod(num << (2 * k), den)
+    else:
+        x, rem = divmod(num, den << (-2 * k))
+    q = math.isqrt(x)
+    if rem or q * q != x:
+        q |= 1
+    if not -1020 <= q.bit_length() - k <= 1023:
+        with localcontext() as ctx:
+            ctx.prec = precise.DIGITS
+            return float(precise.ratio(num, den).sqrt())
+    return math.ldexp(float(q), -k)
+
+
+class _Exact:
+    """The scaled moments and ω of a body frame as exact integers, and its exact ``Δi``.
+
+    ``J_k = Jn_k / 2^S`` and ``ω_k = wn_k / 2^T``; ``Δi = G² - 2T·Ii = Σ_j Ij ωj² (Ij - Ii)``
+    (PHYSICS.md "Cancellation") is ``D_i / 2^(2S+2T)`` and ``G² = G2 / 2^(2S+2T)``. Δ2 is the
+    small difference that decides the regime and gives ``1 - m``; near the separatrix its two
+    terms cancel. In integers (a few scalars, once per body) the classification ``Δ2 == 0``
+    and every constant derived from the Δs are those of the exact data, rounded once: each
+    constant below is a quotient of two such integers, divided once, correctly rounded
+    (Python's ``int / int``, or :func:`physics.precise.ratio` at 45 digits).
+    """
+
+    def __init__(self, J, w):
+        self.Jn, self.S = _dyadic(J)
+        self.wn, self.T = _dyadic(w)
+        Jn, wn = self.Jn, self.wn
+        sq = [Jn[k] * wn[k] * wn[k] for k in range(3)]
+        self.D = (
+            sq[1] * (Jn[1] - Jn[0]) + sq[2] * (Jn[2] - Jn[0]),
+            sq[0] * (Jn[0] - Jn[1]) + sq[2] * (Jn[2] - Jn[1]),
+            sq[0] * (Jn[0] - Jn[2]) + sq[1] * (Jn[1] - Jn[2]),
+        )
+        self.G2 = sum((Jn[k] * wn[k]) ** 2 for k in range(3))
+
+    def reversed(self) -> _Exact:
+        """The same data in the minor family's pole frame ``x'' = (x3, x2, -x1)``."""
+        out = object.__new__(_Exact)
+        out.Jn, out.S, out.T = self.Jn[::-1], self.S, self.T
+        out.wn = (self.wn[2], self.wn[1], -self.wn[0])
+        out.D, out.G2 = self.D[::-1], self.G2
+        return out
+
+    def delta(self, i: int) -> float:
+        """``Δi`` (0-based ``i``) correctly rounded to a double."""
+        return self.D[i] / (1 << (2 * self.S + 2 * self.T))
+
+    def amplitudes(self) -> tuple[float, float, float]:
+        """``(A1, A2, A3)`` of Landau 37.10 in this frame.
+
+        ``A1² = Δ3/(J1(J1-J3))``, ``A2² = Δ3/(J2(J2-J3))``, ``A3² = Δ1/(J3(J3-J1))``: each a
+        quotient of same-signed quantities in both families, whose square root is taken
+        exactly (:func:`_sqrt_ratio`), so that a spin a hair off an axis, with Δ ~ 1e-600,
+        still gets its representable amplitude ~1e-300 instead of 0/0.
+        """
+        (J1, J2, J3), (D1, _, D3), sh = self.Jn, self.D, 2 * self.T
+        return (
+            _sqrt_ratio(D3, (J1 * (J1 - J3)) << sh),
+            _sqrt_ratio(D3, (J2 * (J2 - J3)) << sh),
+            _sqrt_ratio(D1, (J3 * (J3 - J1)) << sh),
+        )
+
+    def G_decimal(self) -> Decimal:
+        """``G = |m|`` at the context precision."""
+        return precise.ratio(self.G2, 1 << (2 * self.S + 2 * self.T)).sqrt()
 
 
 class _Elliptic:
@@ -247,36 +403,36 @@ class _Elliptic:
     the sign of every right-hand side of Euler's equations, so ``σ = -s λ``.
     """
 
-    def __init__(self, J: np.ndarray, w: np.ndarray, delta: tuple[Fraction, Fraction, Fraction]):
+    def __init__(self, J: np.ndarray, w: np.ndarray, exact: _Exact):
         J1, J2, J3 = (float(x) for x in J)
-        F1, F2, F3 = (Fraction(x) for x in (J1, J2, J3))
-        e1, e2, e3 = delta  # exact
+        (n1, n2, n3), (e1, e2, e3) = exact.Jn, exact.D  # exact integers (see _Exact)
+        S, sh = exact.S, 2 * exact.T
         self.J = J
+        self.J_tuple = (J1, J2, J3)
         # λ, m, 1 - m, K and the mean precession rate ν from the exact rationals of the data,
         # at 45 digits: m and mc correctly rounded (no subtraction near the separatrix), λ, K
         # and ν as double-double pairs so that the phases u = u0 + σ τ (mod 2K) and ν τ
         # (mod 2π) stay exact to the rounding of τ itself over long runs (physics.precise).
-        lam2 = (F3 - F2) * e1 / (F1 * F2 * F3)
-        m_exact = (F1 - F2) * e3 / ((F3 - F2) * e1)
-        mc_exact = (F3 - F1) * e2 / ((F3 - F2) * e1)
-        N_exact = -F3 * (F2 - F1) / (F1 * (F3 - F2))
-        wf = [Fraction(float(x)) for x in w]
-        G2 = sum((Fk * wk) ** 2 for Fk, wk in zip((F1, F2, F3), wf, strict=True))
-        m, mc = float(m_exact), float(mc_exact)
+        # Each is a quotient of integers: λ² = (J3-J2)Δ1/(J1 J2 J3), m = (J1-J2)Δ3/((J3-J2)Δ1),
+        # 1 - m = (J3-J1)Δ2/((J3-J2)Δ1), N = -J3(J2-J1)/(J1(J3-J2)), scales as in _Exact.
+        m = (n1 - n2) * e3 / ((n3 - n2) * e1)  # int / int: correctly rounded
+        mc_num, mc_den = (n3 - n1) * e2, (n3 - n2) * e1
+        mc = mc_num / mc_den
+        N_num, N_den = -n3 * (n2 - n1), n1 * (n3 - n2)
+        # Amplitudes (Landau 37.10, with Δi = G² - 2T Ii so that each ratio is a quotient of
+        # same-signed quantities in both families), exact square roots of exact ratios, so
+        # that a spin a hair off an axis (Δ ~ 1e-600) still gets its amplitude ~1e-300.
+        self.A = exact.amplitudes()
+        ratio = precise.ratio
         with localcontext() as ctx:
             ctx.prec = precise.DIGITS
-            dec = precise.decimal
-            # Amplitudes (Landau 37.10, with Δi = G² - 2T Ii so that each ratio is a quotient
-            # of same-signed quantities in both families); in decimal, so that a spin a hair
-            # off an axis (Δ ~ 1e-600) still gets its representable amplitude ~1e-300.
-            self.A = _amplitudes((F1, F2, F3), e1, e3)
-            sqrt_mc = float(dec(mc_exact).sqrt())
-            K_dec = elliptic.ellipk_decimal(mc_exact)
-            pi_dec = elliptic.ellippi_complete_decimal(N_exact, mc_exact)
-            G_dec = precise.decimal(G2).sqrt()
-            c_dec = G_dec * precise.decimal((F3 - F1) / (F1 * F3))
-            nu_dec = G_dec / precise.decimal(F3) + c_dec * pi_dec / K_dec
-            lam, lam_lo = precise.double_double(precise.decimal(lam2).sqrt())
+            sqrt_mc_dec = ratio(mc_num, mc_den).sqrt()
+            sqrt_mc = float(sqrt_mc_dec)
+            K_dec, pi_dec = elliptic.complete_integrals_decimal(ratio(N_num, N_den), sqrt_mc_dec)
+            G_dec = exact.G_decimal()
+            c_dec = G_dec * ratio((n3 - n1) << S, n1 * n3)
+            nu_dec = G_dec / ratio(n3, 1 << S) + c_dec * pi_dec / K_dec
+            lam, lam_lo = precise.double_double(ratio((n3 - n2) * e1, (n1 * n2 * n3) << sh).sqrt())
             K_hi, K_lo = precise.double_double(K_dec)
             nu = precise.double_double(nu_dec)
             pi_complete = float(pi_dec)
@@ -287,7 +443,7 @@ class _Elliptic:
         self.sigma = direction * self.s * lam
         K = K_hi
         # Initial phase u0 = F(φ0 | m), φ0 = atan2(sn0, cn0) (Landau after 37.10).
-        sn0, cn0 = w[1] / self.A[1], w[0] / self.A[0]
+        sn0, cn0 = float(w[1]) / self.A[1], float(w[0]) / self.A[0]
         self.u0 = elliptic.ellipf_from_angle(sn0, cn0, self.par, sqrt_mc)
         self.phase = precise.LinearPhase(
             self.u0, self.sigma, direction * self.s * lam_lo, 2.0 * K_hi, 2.0 * K_lo
@@ -295,15 +451,15 @@ class _Elliptic:
         # Precession (Landau 37.16): φ' = G/J3 + c / (1 - N sn²u), N < 0, c = G(J3-J1)/(J1 J3).
         # Π(N; am u) = (Πc/K) u + P(u) with P 2K-periodic: the secular part joins G/J3 in the
         # mean rate ν, the periodic part is evaluated on the reduced argument.
-        self.G = math.sqrt(float(G2))
-        self.N = float(N_exact)
+        self.G = math.sqrt(exact.G2 / (1 << (2 * S + sh)))
+        self.N = N_num / N_den
         self.c = self.G * ((J3 - J1) / J1 / J3)
         self.pi_slope = pi_complete / K
         self.nu = nu[0]
         self.precession = precise.angle_phase(nu)
         self.period = 4.0 * K / lam
         self.phase_scale = self.c / self.sigma
-        self.P0 = self._periodic_pi(np.array([self.u0]))[0]
+        self.P0 = self._periodic_pi_scalar(self.u0)
         self._series: np.ndarray | None | bool = False  # built on first long evaluation
 
     @property
@@ -328,6 +484,11 @@ class _Elliptic:
         sn, cn, dn = elliptic.sncndn_reduced(r, self.par)
         return elliptic.periodic_third_kind(self.N, self.pi_slope, self.par, r, sn, cn, dn)
 
+    def _periodic_pi_scalar(self, u: float) -> float:
+        r, _ = elliptic.reduce_argument_scalar(u, self.par.K)
+        sn, cn, dn = elliptic.sncndn_reduced_scalar(r, self.par)
+        return elliptic.periodic_third_kind_scalar(self.N, self.pi_slope, self.par, r, sn, cn, dn)
+
     def omega(self, tau: np.ndarray) -> tuple[np.ndarray, ...]:
         _, sign, sn, cn, dn = self._reduced(tau)
         A1, A2, A3 = self.A
@@ -340,6 +501,27 @@ class _Elliptic:
         J1, J2, J3 = self.J
         phi = self.precession.reduce(tau)[0] + self.precession_wobble(r, sn, cn, dn)
         return w, _zxz_from_momentum(J1 * w[0], J2 * w[1], J3 * w[2], self.G, phi)
+
+    # One time in plain floats: the operations of omega/quat above, in the same order.
+
+    def _reduced_scalar(self, tau: float) -> tuple[float, ...]:
+        r, j = self.phase.reduce_scalar(tau)
+        sn, cn, dn = elliptic.sncndn_reduced_scalar(r, self.par)
+        return r, 1.0 - 2.0 * (j % 2.0), sn, cn, dn
+
+    def omega_scalar(self, tau: float) -> tuple[float, ...]:
+        _, sign, sn, cn, dn = self._reduced_scalar(tau)
+        A1, A2, A3 = self.A
+        return (A1 * sign * cn, A2 * sign * sn, (self.s * A3) * dn)
+
+    def quat_scalar(self, tau: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        r, sign, sn, cn, dn = self._reduced_scalar(tau)
+        A1, A2, A3 = self.A
+        w = (A1 * sign * cn, A2 * sign * sn, (self.s * A3) * dn)
+        J1, J2, J3 = self.J_tuple
+        P = elliptic.periodic_third_kind_scalar(self.N, self.pi_slope, self.par, r, sn, cn, dn)
+        phi = self.precession.reduce_scalar(tau)[0] + self.phase_scale * (P - self.P0)
+        return w, _zxz_scalar(J1 * w[0], J2 * w[1], J3 * w[2], self.G, phi)
 
     def precession_wobble(self, r, sn, cn, dn) -> np.ndarray:
         """The periodic part of φ: ``(c/σ) (P(u) - P(u0))`` at the reduced argument ``r``.
@@ -417,13 +599,12 @@ class _Separatrix:
     with ``a = sqrt(-N)``.
     """
 
-    def __init__(self, J: np.ndarray, w: np.ndarray, delta: tuple[float, float, float]):
+    def __init__(self, J: np.ndarray, w: np.ndarray, exact: _Exact):
         J1, J2, J3 = (float(x) for x in J)
-        d1 = float(delta[0])
+        d1 = exact.delta(0)
         self.J = J
-        with localcontext() as ctx:
-            ctx.prec = precise.DIGITS
-            self.A = _amplitudes(tuple(Fraction(float(x)) for x in J), delta[0], delta[2])
+        self.J_tuple = (J1, J2, J3)
+        self.A = exact.amplitudes()
         lam = math.sqrt((J3 - J2) / J1 * (d1 / J2) / J3)
         self.s1 = 1.0 if w[0] > 0.0 else -1.0
         self.s3 = 1.0 if w[2] > 0.0 else -1.0
@@ -436,14 +617,14 @@ class _Separatrix:
         self.a = math.sqrt(-N)
         c = self.G * ((J3 - J1) / J1 / J3)
         # The mean rate ν = G/J3 + c/(1 - N) to double-double, as in _Elliptic.
-        F1, F2, F3 = (Fraction(float(x)) for x in J)
-        G2 = sum((Fk * Fraction(float(wk))) ** 2 for Fk, wk in zip((F1, F2, F3), w, strict=True))
+        n1, n2, n3 = exact.Jn
+        ratio = precise.ratio
         with localcontext() as ctx:
             ctx.prec = precise.DIGITS
-            G_dec = precise.decimal(G2).sqrt()
-            N_dec = precise.decimal(-F3 * (F2 - F1) / (F1 * (F3 - F2)))
-            nu_dec = G_dec / precise.decimal(F3) + G_dec * precise.decimal(
-                (F3 - F1) / (F1 * F3)
+            G_dec = exact.G_decimal()
+            N_dec = ratio(-n3 * (n2 - n1), n1 * (n3 - n2))
+            nu_dec = G_dec / ratio(n3, 1 << exact.S) + G_dec * ratio(
+                (n3 - n1) << exact.S, n1 * n3
             ) / (1 - N_dec)
             nu = precise.double_double(nu_dec)
         self.nu = nu[0]
@@ -464,6 +645,21 @@ class _Separatrix:
         phi = self.precession.reduce(tau)[0] + self.amp * (np.arctan(self.a * th) - self.atan0)
         J1, J2, J3 = self.J
         return w, _zxz_from_momentum(J1 * w[0], J2 * w[1], J3 * w[2], self.G, phi)
+
+    def omega_scalar(self, tau: float) -> tuple[float, ...]:
+        th, sech = elliptic.tanh_sech_scalar(self.u0 + self.sigma * tau)
+        A1, A2, A3 = self.A
+        return ((self.s1 * A1) * sech, A2 * th, (self.s3 * A3) * sech)
+
+    def quat_scalar(self, tau: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        th, sech = elliptic.tanh_sech_scalar(self.u0 + self.sigma * tau)
+        A1, A2, A3 = self.A
+        w = ((self.s1 * A1) * sech, A2 * th, (self.s3 * A3) * sech)
+        phi = self.precession.reduce_scalar(tau)[0] + self.amp * (
+            float(np.arctan(self.a * th)) - self.atan0
+        )
+        J1, J2, J3 = self.J_tuple
+        return w, _zxz_scalar(J1 * w[0], J2 * w[1], J3 * w[2], self.G, phi)
 
     def polhode(self, n: int) -> tuple[np.ndarray, ...]:
         # The heteroclinic arc from -e2 to +e2: with φ = gd(u), tanh u = sin φ, sech u = cos φ.
@@ -490,16 +686,26 @@ class _Circular:
         self.axis = axis
         self.G = float(np.linalg.norm(inertia * w))
         w_axial = float(w @ axis)
+        # Rodrigues' constants e·v and e × v (omega_rotated), also as plain floats.
+        self.ev = w_axial
+        self.exv = np.cross(axis, w)
+        self.w0_tuple = tuple(float(x) for x in w)
+        self.axis_tuple = tuple(float(x) for x in axis)
+        self.exv_tuple = tuple(float(x) for x in self.exv)
         # The two rates to double-double from the exact data, so that the angles p τ and s τ
-        # (reduced mod 2π) stay exact over long runs (physics.precise).
-        G2 = sum(
-            (Fraction(float(i)) * Fraction(float(x))) ** 2 for i, x in zip(inertia, w, strict=True)
-        )
-        It, Ja = Fraction(I_t), Fraction(J_a)
+        # (reduced mod 2π) stay exact over long runs (physics.precise): with exact integers
+        # I_k = In_k/2^S, ω_k = wn_k/2^T, G² = Σ (In wn)²/2^(2S+2T), p = G/I_t and
+        # s = (I_t - J_a) ω_e / I_t, each rounded once.
+        In, S = _dyadic(inertia)
+        wn, T = _dyadic(w)
+        (It, Ja), S2 = _dyadic((I_t, J_a))
+        (wa,), Ta = _dyadic((w_axial,))
+        G2 = sum((In[k] * wn[k]) ** 2 for k in range(3))
         with localcontext() as ctx:
             ctx.prec = precise.DIGITS
-            p = precise.double_double(precise.decimal(G2).sqrt() / precise.decimal(It))
-            spin = precise.double_double(precise.decimal((It - Ja) / It * Fraction(w_axial)))
+            G_dec = precise.ratio(G2, 1 << (2 * S + 2 * T)).sqrt()
+            p = precise.double_double(G_dec / precise.ratio(It, 1 << S2))
+            spin = precise.double_double(precise.ratio((It - Ja) * wa, It << Ta))
         self.p, self.spin = p[0], spin[0]
         self.precession = precise.angle_phase(p)
         self.spinning = precise.angle_phase(spin)
@@ -510,16 +716,22 @@ class _Circular:
 
     def omega_rotated(self, angle: np.ndarray) -> tuple[np.ndarray, ...]:
         # Rodrigues with a unit axis e: v cos a + (e × v) sin a + e (e·v)(1 - cos a).
-        e, v = self.axis, self.w0
+        e, v, ev, exv = self.axis, self.w0, self.ev, self.exv
         c, s = np.cos(angle), np.sin(angle)
-        ev = float(e @ v)
-        exv = np.cross(e, v)
         return tuple(v[k] * c + exv[k] * s + e[k] * ev * (1.0 - c) for k in range(3))
 
     def omega(self, tau: np.ndarray) -> tuple[np.ndarray, ...]:
         if self.spin == 0.0:
             return tuple(np.full(tau.shape, self.w0[k]) for k in range(3))
         return self.omega_rotated(-self.spinning.reduce(tau)[0])
+
+    def omega_scalar(self, tau: float) -> tuple[float, ...]:
+        if self.spin == 0.0:
+            return self.w0_tuple
+        angle = -self.spinning.reduce_scalar(tau)[0]
+        e, v, ev, exv = self.axis_tuple, self.w0_tuple, self.ev, self.exv_tuple
+        c, s = float(np.cos(angle)), float(np.sin(angle))
+        return tuple(v[k] * c + exv[k] * s + e[k] * ev * (1.0 - c) for k in range(3))
 
     def polhode(self, n: int) -> tuple[np.ndarray, ...]:
         if self.period == math.inf:
@@ -560,15 +772,17 @@ class FreeRigidBody:
         if not isinstance(attitude0, Rotation) or not attitude0.single:
             raise ValueError("attitude0 must be one scipy Rotation (body -> space) or None")
         self.attitude0 = attitude0
+        self._q0 = attitude0.as_quat().tolist()
 
-        if self.inertia.max() / 1e300 > self.inertia.min():
+        i_min, i_max = min(self.inertia.tolist()), max(self.inertia.tolist())
+        if i_max / 1e300 > i_min:
             raise ValueError(
                 "the moments of inertia span more than 300 decades "
-                f"({self.inertia.min():g} to {self.inertia.max():g}): beyond double precision"
+                f"({i_min:g} to {i_max:g}): beyond double precision"
             )
         # Exact power-of-two scaling: moments and ω near 1 whatever the caller's units.
-        self._I_ref = _pow2(float(self.inertia.max()))
-        w_max = float(np.abs(self.omega0).max())
+        self._I_ref = _pow2(i_max)
+        w_max = max(abs(x) for x in self.omega0.tolist())
         self._w_ref = _pow2(w_max) if w_max > 0.0 else 1.0
         inertia_s = self.inertia / self._I_ref
         omega_s = self.omega0 / self._w_ref
@@ -594,6 +808,7 @@ class FreeRigidBody:
             self.D = self._scaled_D * self._I_ref
             self.plane_distance = self._scaled_h * self._w_ref
             self.plane_normal = L_scaled / G_scaled
+        self._plane_normal_t = tuple(float(x) for x in self.plane_normal)
 
     # -- construction ---------------------------------------------------------------------
 
@@ -626,28 +841,29 @@ class FreeRigidBody:
             self.regime = regime
             self._solver = circ
             self._frame = None  # _Circular works in the caller's own body frame
-            self._q_space = self.attitude0.as_quat()
+            self._q_space_t = tuple(self._q0)
+            self._q_space = np.array(self._q_space_t)
             self.period = circ.period / self._w_ref
             self._finish_precession(circ.nu)
             return
 
-        # Triaxial and not a permanent rotation: Δi = G² - 2T·Ii, exactly rounded (below).
-        delta = _deltas(J, w)
-        if delta[1] == 0.0:
+        # Triaxial and not a permanent rotation: Δi = G² - 2T·Ii, exactly (_Exact).
+        exact = _Exact(J, w)
+        if exact.D[1] == 0:
             self.regime = Regime.SEPARATRIX
-            solver = _Separatrix(J, w, delta)
+            solver = _Separatrix(J, w, exact)
             self.parameter, self.complementary_parameter = 1.0, 0.0
         else:
-            if delta[1] > 0.0:
+            if exact.D[1] > 0:
                 self.regime = Regime.MAJOR_AXIS
                 pole = sort
-                Jp, wp, dp = J, w, delta
+                Jp, wp, ep = J, w, exact
             else:
                 self.regime = Regime.MINOR_AXIS
                 pole = sort.compose(_REVERSE)
                 Jp, wp = _REVERSE.to_internal(J) * _REVERSE.sign, _REVERSE.to_internal(w)
-                dp = (delta[2], delta[1], delta[0])
-            solver = _Elliptic(Jp, wp, dp)
+                ep = exact.reversed()
+            solver = _Elliptic(Jp, wp, ep)
             self._frame = pole
             self.parameter = solver.par.m
             self.complementary_parameter = solver.par.mc
@@ -658,13 +874,17 @@ class FreeRigidBody:
         # Anchor ω at t = 0: the closed form reproduces ω0 only to O(eps · amplitude) (through
         # u0 = F(φ0|m) and back through sn, cn, dn); adding the constant ω0 - f(0) makes
         # omega(0) return ω0 exactly and changes no other value by more than that rounding.
-        cols0, q0 = solver.quat(np.zeros(1))
-        self._anchor = omega_s - self._frame.to_user_columns(cols0)[0]
+        cols0, q0 = solver.quat_scalar(0.0)
+        user0 = self._frame.to_user_tuple(cols0)
+        self._anchor_t = tuple(float(omega_s[k]) - user0[k] for k in range(3))
+        self._anchor = np.array(self._anchor_t)
         # R_user(t) = S · R_int(t) · C with S fixed so that R_user(0) = attitude0.
-        conj = np.array([-1.0, -1.0, -1.0, 1.0])
-        self._q_space = _qmul(
-            _qmul(self.attitude0.as_quat(), self._frame.quat * conj), q0[0] * conj
+        fq = self._frame.quat_tuple
+        self._q_space_t = _qmul_scalar(
+            _qmul_scalar(self._q0, (-fq[0], -fq[1], -fq[2], fq[3])),
+            (-q0[0], -q0[1], -q0[2], q0[3]),
         )
+        self._q_space = np.array(self._q_space_t)
 
     def _circular_or_none(self, sort, J, w, zero, inertia_s, omega_s):
         """Permanent rotations and symmetric bodies: (regime, _Circular), else None."""
@@ -712,6 +932,48 @@ class FreeRigidBody:
             return np.stack(cols, axis=-1) * self._w_ref
         return (self._frame.to_user_columns(cols) + self._anchor) * self._w_ref
 
+    def _scalar(self, tau: float, attitude: bool) -> tuple[list[float], tuple[float, ...] | None]:
+        """ω (user axes, caller units) and, if asked, the attitude quaternion at one τ.
+
+        The single-time path: the operations of :meth:`_omega_user` and :meth:`_quat_block`
+        in plain floats, a few microseconds instead of dozens of numpy calls on 1-element
+        arrays. Where a phase leaves the float range (τ·rate beyond ~1e308) ``round`` raises
+        instead of returning NaN; then, and for any non-finite result, the array path gives
+        the value, so both paths return the same thing for every input.
+        """
+        try:
+            w, q = self._scalar_floats(tau, attitude)
+            if all(map(math.isfinite, w)) and (q is None or all(map(math.isfinite, q))):
+                return w, q
+        except (ArithmeticError, ValueError):
+            pass
+        arr = np.array([tau])
+        if attitude:
+            w_arr, q_arr = self._quat_user(arr)
+            return w_arr[0].tolist(), tuple(q_arr[0].tolist())
+        return self._omega_user(arr)[0].tolist(), None
+
+    def _scalar_floats(self, tau: float, attitude: bool):
+        solver = self._solver
+        w_ref = self._w_ref
+        if isinstance(solver, _Circular):
+            w = [x * w_ref for x in solver.omega_scalar(tau)]
+            if not attitude:
+                return w, None
+            angle = solver.precession.reduce_scalar(tau)[0]
+            q = _qmul_scalar(_axis_angle_scalar(self._plane_normal_t, angle), self._q_space_t)
+            if solver.spin != 0.0:
+                angle = solver.spinning.reduce_scalar(tau)[0]
+                q = _qmul_scalar(q, _axis_angle_scalar(solver.axis_tuple, angle))
+            return w, q
+        if attitude:
+            cols, q_int = solver.quat_scalar(tau)
+            q = _qmul_scalar(self._q_space_t, _qmul_scalar(q_int, self._frame.quat_tuple))
+        else:
+            cols, q = solver.omega_scalar(tau), None
+        user, anchor = self._frame.to_user_tuple(cols), self._anchor_t
+        return [(user[k] + anchor[k]) * w_ref for k in range(3)], q
+
     def omega(self, t):
         """Body-frame angular velocity ω(t) in the caller's axes [rad per time unit].
 
@@ -721,9 +983,10 @@ class FreeRigidBody:
         Returns:
             (3,) for a scalar ``t``, (N, 3) for an array.
         """
-        tt, scalar = _check_times(t)
-        out = self._omega_user(tt * self._w_ref)
-        return out[0] if scalar else out
+        tt = _check_times(t)
+        if isinstance(tt, float):
+            return np.array(self._scalar(tt * self._w_ref, False)[0])
+        return self._omega_user(tt * self._w_ref)
 
     def _quat_user(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(ω (N,3) in user axes and caller units, attitude quaternions (N, 4) scalar-last).
@@ -752,20 +1015,25 @@ class FreeRigidBody:
         q = _qmul(self._q_space, _qmul(q_int, self._frame.quat))
         return (self._frame.to_user_columns(cols) + self._anchor) * self._w_ref, q
 
+    def _evaluate(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """ω ((3,) or (N, 3)) and unnormalised attitude quaternions ((4,) or (N, 4))."""
+        tt = _check_times(t)
+        if isinstance(tt, float):
+            w, q = self._scalar(tt * self._w_ref, True)
+            return np.array(w), np.array(q)
+        return self._quat_user(tt * self._w_ref)
+
     def attitude(self, t) -> Rotation:
         """Attitude R(t), body -> space, as a scipy Rotation (single, or a stack of N).
 
         ``attitude(0)`` equals ``attitude0`` to rounding.
         """
-        tt, scalar = _check_times(t)
-        _, q = self._quat_user(tt * self._w_ref)
-        rot = Rotation.from_quat(q)
-        return rot[0] if scalar else rot
+        return Rotation.from_quat(self._evaluate(t)[1])
 
     def state(self, t) -> tuple[np.ndarray, Rotation]:
         """ω(t) and R(t) from one evaluation: ((N,3) or (3,), Rotation); see :meth:`sample`."""
-        w, rot, _ = self.sample(t)
-        return w, rot
+        w, q = self._evaluate(t)
+        return w, Rotation.from_quat(q)
 
     def contact_point(self, t) -> np.ndarray:
         """The tip of ω in space, ``R(t) ω(t)`` (the herpolhode): (3,) or (N, 3).
@@ -785,13 +1053,10 @@ class FreeRigidBody:
             stack); (3,) or (N, 3) space-frame contact point. This is what a renderer needs per
             frame, at the cost of one :meth:`attitude` call.
         """
-        tt, scalar = _check_times(t)
-        w, q = self._quat_user(tt * self._w_ref)
-        contact = _rotate(q, w)
-        rot = Rotation.from_quat(q)
-        if scalar:
-            return w[0], rot[0], contact[0]
-        return w, rot, contact
+        w, q = self._evaluate(t)
+        if q.ndim == 1:
+            return w, Rotation.from_quat(q), np.array(_rotate_scalar(q.tolist(), w.tolist()))
+        return w, Rotation.from_quat(q), _rotate(q, w)
 
     herpolhode = contact_point
 
@@ -821,36 +1086,6 @@ class FreeRigidBody:
             f"FreeRigidBody(inertia={self.inertia.tolist()}, omega0={self.omega0.tolist()}, "
             f"regime={self.regime.value!r})"
         )
-
-
-def _deltas(J: np.ndarray, w: np.ndarray) -> tuple[Fraction, Fraction, Fraction]:
-    """``Δi = G² - 2T·Ii = Σ_j Ij ωj² (Ij - Ii)`` (sorted axes, PHYSICS.md "Cancellation"), exactly.
-
-    Δ2 is the small difference that decides the regime and gives ``1 - m``; near the separatrix
-    its two terms cancel. Summed in rational arithmetic (a few scalars, once per body), the
-    classification ``Δ2 == 0`` and every constant derived from the Δs are those of the exact
-    data, rounded once.
-    """
-    # Every double is an integer multiple of 2^-1074: scaled by 2^_EXACT_SHIFT they become
-    # Python integers, and sums of products of integers are exact (and cheaper than Fractions).
-    Ji = [_exact_int(x) for x in J]
-    wi = [_exact_int(x) for x in w]
-    sq = [Ji[j] * wi[j] * wi[j] for j in range(3)]
-    scale = 1 << (4 * _EXACT_SHIFT)
-    return (
-        Fraction(sq[1] * (Ji[1] - Ji[0]) + sq[2] * (Ji[2] - Ji[0]), scale),
-        Fraction(sq[0] * (Ji[0] - Ji[1]) + sq[2] * (Ji[2] - Ji[1]), scale),
-        Fraction(sq[0] * (Ji[0] - Ji[2]) + sq[1] * (Ji[1] - Ji[2]), scale),
-    )
-
-
-_EXACT_SHIFT = 1100
-
-
-def _exact_int(x: float) -> int:
-    """``x · 2^_EXACT_SHIFT`` as an exact integer (finite doubles are multiples of 2^-1074)."""
-    n, d = float(x).as_integer_ratio()
-    return n * ((1 << _EXACT_SHIFT) // d)
 
 
 # ---------------------------------------------------------------------------------------------
