@@ -4,11 +4,16 @@ Prints, for 10⁶ times measured in this one run (so the ratios are meaningful o
 machine), the nanoseconds per point of ``omega(t)`` and ``attitude(t)`` next to bare
 ``ellipj`` on the same arguments, and the construction cost of a ``FreeRigidBody``.
 Targets (issue 2): omega ≤ 1.5× ellipj, attitude ≤ 4× ellipj.
+
+Then the single-time figure of the report's speed-up study (issue 4): constructing the
+generic body of ``poinsot report`` and evaluating ω and the attitude at the one time
+t = 1e4 (``FreeRigidBody(I, ω0).state(1e4)``), median of many runs. Target ≤ 0.3 ms.
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
 import time
 
 import numpy as np
@@ -65,6 +70,34 @@ def run(n: int = 1_000_000, repeat: int = 5) -> list[dict]:
     return rows
 
 
+# The generic body of the report's speed-up study (app.report.GENERIC) and its time.
+SINGLE_TIME_CASE = ((13.0, 10.0, 5.0), (0.3, 0.6, 0.9))
+SINGLE_TIME = 1e4
+
+
+def _median(fn, n: int) -> float:
+    samples = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        fn()
+        samples.append(time.perf_counter() - t0)
+    return statistics.median(samples)
+
+
+def single_time(n: int = 1000) -> dict:
+    """Medians [s] of construction, one ``state(t)`` and both together, at t = 1e4."""
+    inertia, omega0 = (np.array(v) for v in SINGLE_TIME_CASE)
+    body = FreeRigidBody(inertia, omega0)
+    for _ in range(20):  # warm up
+        FreeRigidBody(inertia, omega0).state(SINGLE_TIME)
+    return {
+        "n": n,
+        "construct": _median(lambda: FreeRigidBody(inertia, omega0), n),
+        "evaluate": _median(lambda: body.state(SINGLE_TIME), n),
+        "both": _median(lambda: FreeRigidBody(inertia, omega0).state(SINGLE_TIME), n),
+    }
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m physics.benchmark", description=__doc__)
     parser.add_argument("-n", type=int, default=1_000_000, help="times per evaluation")
@@ -88,6 +121,16 @@ def main(argv: list[str] | None = None) -> int:
     print(
         "note: for 1-m < 1e-9 bare ellipj takes a first-order tanh/sech shortcut that is wrong\n"
         "      for u beyond ~1 (PHYSICS.md), so that row's ratio compares against a wrong answer."
+    )
+    one = single_time()
+    print(
+        f"construct + one evaluation at t=1e4: {one['both'] * 1e3:.3f} ms "
+        f"(median of {one['n']}; target <= 0.3 ms)"
+    )
+    print(
+        f"  FreeRigidBody(I, omega0).state(1e4), I = {SINGLE_TIME_CASE[0]}, "
+        f"omega0 = {SINGLE_TIME_CASE[1]}: construction {one['construct'] * 1e3:.3f} ms, "
+        f"evaluation {one['evaluate'] * 1e3:.3f} ms"
     )
     return 0
 
