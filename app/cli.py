@@ -97,3 +97,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     return int(args.func(args))
+
+
+if __name__ == "__main__":  # python -m app.cli behaves as python -m app and poinsot
+    raise SystemExit(main())

@@ -272,11 +272,11 @@ def test_cli_serves_the_page_and_prints_the_url(argv):
     assert wait_until(lambda: proc.poll() is not None, 5)
 
 
-def test_console_script_is_installed():
-    scripts = [p for p in (sys.prefix + "/bin/poinsot",)]
-    out = subprocess.run(
-        [scripts[0], "serve", "--help"], capture_output=True, text=True, timeout=30
-    )
+@pytest.mark.parametrize(
+    "command", [[sys.prefix + "/bin/poinsot"], [sys.executable, "-m", "app.cli"]]
+)
+def test_console_script_and_module_forms_answer(command):
+    out = subprocess.run([*command, "serve", "--help"], capture_output=True, text=True, timeout=30)
     assert out.returncode == 0 and "--host" in out.stdout and "--port" in out.stdout
 
 
