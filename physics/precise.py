@@ -29,6 +29,8 @@ PI = Decimal("3.14159265358979323846264338327950288419716939937510582097494")
 _VELTKAMP = 134217729.0
 #: Beyond this |τ| the Veltkamp split would overflow; the phase is pure noise there anyway.
 _SPLIT_LIMIT = 1e290
+#: Phases beyond this many periods get a second reduction (LinearPhase.reduce).
+_REDUCE_LIMIT = 2.0**50
 
 
 def decimal(x: Fraction | float | int) -> Decimal:
@@ -94,7 +96,8 @@ class LinearPhase:
         j = np.round((p + self.offset) / self.period_hi)
         c1, c2 = split(self.period_hi)
         c3 = self.period_lo
-        if tau.size and float(np.abs(tau).max()) < _SPLIT_LIMIT:
+        t_max = float(np.abs(tau).max()) if tau.size else 0.0
+        if t_max < _SPLIT_LIMIT:
             rh, rl = split(self.rate_hi)
             th, tl = split(tau)
             err = ((rh * th - p) + rh * tl + rl * th) + rl * tl  # p + err == rate_hi·τ exactly
@@ -102,6 +105,15 @@ class LinearPhase:
         else:
             err = 0.0
         r = ((p - j * c1) - j * c2) + ((self.offset - j * c3) + err)
+        if t_max * abs(self.rate_hi) > _REDUCE_LIMIT * self.period_hi:
+            # Beyond ~2^50 periods j·c1 is no longer exact and r can come out as large as the
+            # rounding of p itself (1e27 for p ~ 1e43): the phase is noise there anyway, but
+            # every caller assumes |r| <= period/2. fmod is exact, and so is the final step
+            # (Sterbenz), whatever the size of r.
+            r = np.fmod(r, self.period_hi)
+            j2 = np.round(r / self.period_hi)
+            r = r - j2 * self.period_hi
+            j = j + j2
         return r, j
 
     def reduce_scalar(self, tau: float) -> tuple[float, float]:
@@ -113,7 +125,8 @@ class LinearPhase:
         p = self.rate_hi * tau
         j = float(round((p + self.offset) / self.period_hi))
         c1, c2 = split(self.period_hi)
-        if abs(tau) < _SPLIT_LIMIT:
+        t_abs = abs(tau)
+        if t_abs < _SPLIT_LIMIT:
             rh, rl = split(self.rate_hi)
             th, tl = split(tau)
             err = ((rh * th - p) + rh * tl + rl * th) + rl * tl
@@ -121,6 +134,11 @@ class LinearPhase:
         else:
             err = 0.0
         r = ((p - j * c1) - j * c2) + ((self.offset - j * self.period_lo) + err)
+        if t_abs * abs(self.rate_hi) > _REDUCE_LIMIT * self.period_hi:
+            r = math.fmod(r, self.period_hi)
+            j2 = float(round(r / self.period_hi))
+            r = r - j2 * self.period_hi
+            j = j + j2
         return r, j
 
 
