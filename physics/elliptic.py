@@ -35,14 +35,24 @@ from physics import precise
 # change a by (_AGM_TOL)^2 / 8 ~ 1e-17 relative: below double rounding (Numerical Recipes uses
 # the square root of the target accuracy, as here).
 _AGM_TOL = 2.0**-27
+# The AGM table's first steps are taken in decimal arithmetic while b is below this (a sqrt(mc)
+# near the bottom of the double range would lose its digits to gradual underflow).
+_AGM_DECIMAL_BELOW = 1e-280
 # Below this reduced phase the recurrence would divide by sin(phase) ~ 0 and overflow; the
 # Maclaurin series sn = u - (1+m) u³/6, cn = 1 - u²/2, dn = 1 - m u²/2 is exact to rounding
 # there (the first neglected terms are O(u^4) < 1e-32).
 _SMALL_U = 1e-8
 # sech²(r) stays above the smallest normal double for |r| below this (e^-600 ~ 1e-261).
 _UNDERFLOW_REACH = 300.0
+# The complementary branch of the periodic Π (v = K - |r|) is used only for v below this, so
+# that cn²v, dn²v >= 4e^-300 ~ 2e-130: scipy's elliprj returns NaN once all of x, y and p fall
+# below ~1e-154 (measured with scipy 1.17: elliprj(1e-160, 1e-160, 1, 1e-160) is NaN). Beyond
+# it, 1 - m is invisible to rounding (mc·e^{2|r|} < 16 e^-300) and the m = 1 form is exact.
+_COMPLEMENT_REACH = 150.0
 # Convergence test of the 45-digit AGM loops (three digits of margin on the working precision).
 _DECIMAL_TOL = Decimal(10) ** (3 - precise.DIGITS)
+# ThirdKindConstants: below this |m/n|, Π(n) - π/(2q) is taken from a series, not a difference.
+_TINY_DUAL = Decimal("-1e-10")
 
 
 @dataclass(frozen=True)
@@ -67,7 +77,11 @@ class JacobiParameter:
 
     @classmethod
     def from_pair(
-        cls, m: float, mc: float, sqrt_mc: float | None = None, K: float | None = None
+        cls,
+        m: float,
+        mc: float,
+        sqrt_mc: float | Decimal | None = None,
+        K: float | None = None,
     ) -> JacobiParameter:
         """Precompute the AGM table for ``(m, mc)``; ``mc`` must be the accurate one.
 
@@ -76,6 +90,11 @@ class JacobiParameter:
                 ``sqrt_mc`` is given).
             sqrt_mc: ``sqrt(1 - m)`` if known to more range than ``mc`` itself (``1 - m``
                 below 1e-308 still has a representable square root, the AGM's first term).
+                As a Decimal it may even lie below the double range (``1 - m < 1e-616``,
+                a start within 1e-308 of the separatrix): the first AGM steps are then taken
+                in decimal arithmetic until ``b`` is a normal double (``b_{k+1} = sqrt(a_k
+                b_k)`` squares the distance to the range at each step). The ``b_0`` that
+                underflows enters only the last ``dn`` step, as an absolute ~1e-308.
             K: the quarter period if already known more accurately.
 
         Raises:
@@ -83,12 +102,22 @@ class JacobiParameter:
         """
         m, mc = float(m), float(mc)
         b = math.sqrt(mc) if sqrt_mc is None else float(sqrt_mc)
+        positive = b > 0.0 or (isinstance(sqrt_mc, Decimal) and sqrt_mc > 0)
         # m itself may round to 1.0 when mc is tiny: sqrt(mc) is the one that must be positive.
-        if not (0.0 <= m <= 1.0 and 0.0 <= mc <= 1.0 and 0.0 < b <= 1.0):
+        if not (0.0 <= m <= 1.0 and 0.0 <= mc <= 1.0 and positive and b <= 1.0):
             raise ValueError(f"elliptic parameter must satisfy 0 <= m < 1, got m={m}, 1-m={mc}")
         a = 1.0
         agm_a: list[float] = []
         agm_b: list[float] = []
+        if isinstance(sqrt_mc, Decimal) and b < _AGM_DECIMAL_BELOW:
+            with localcontext() as ctx:
+                ctx.prec = precise.DIGITS
+                a_dec, b_dec = Decimal(1), +sqrt_mc
+                while b_dec < _AGM_DECIMAL_BELOW:
+                    agm_a.append(float(a_dec))
+                    agm_b.append(float(b_dec))
+                    a_dec, b_dec = (a_dec + b_dec) / 2, (a_dec * b_dec).sqrt()
+                a, b = float(a_dec), float(b_dec)
         c = 1.0
         for _ in range(16):  # quadratic convergence: 7 steps reach 1 - m = 1e-600
             agm_a.append(a)
@@ -162,32 +191,132 @@ def ellippi_complete_decimal(n: Fraction, mc: Fraction) -> Decimal:
         return complete_integrals_decimal(precise.decimal(n), precise.decimal(mc).sqrt())[1]
 
 
-def complete_integrals_decimal(n: Decimal, sqrt_mc: Decimal) -> tuple[Decimal, Decimal]:
+def complete_integrals_decimal(
+    n: Decimal, sqrt_mc: Decimal, m: Decimal | None = None
+) -> tuple[Decimal, Decimal]:
     """``(K(m), Π(n|m))`` to 45 digits from one AGM, given ``n < 1`` and ``sqrt(1 - m) > 0``.
 
     The AGM sequence ``a_k, g_k`` of :func:`ellippi_complete_decimal` (DLMF 19.8.6-19.8.8) is
     the one of :func:`ellipk_decimal`, so both integrals come out of a single loop; it runs
     until both the AGM and the ``Q_k`` series have converged to the working precision, and
     ``K = π/(2M)`` is read off the same limit ``M``. The arguments are decimals already at
-    (at least) the working precision, so a caller that has ``sqrt(1 - m)`` reuses it.
+    (at least) the working precision, so a caller that has ``sqrt(1 - m)`` reuses it; ``m``
+    itself (exact, if the caller has it) is only needed for ``n < -1``.
+
+    For ``n < -1`` the series form ``Π = K + π/(4M) n/(1-n) Σ Q`` cancels: ``Π(n|m) ~
+    π/(2 sqrt(-n))`` while both terms are O(K), so a moment ratio of 1e90 (``n ~ -1e90``) would
+    lose all 45 digits. There the transformation ``n -> m/n`` (DLMF 19.7.9 at ``φ = π/2``),
+    ``Π(n|m) = π/(2q) - (Π(m/n|m) - K)`` with ``q = sqrt((1 - n)(1 - m/n))``, is used: ``m/n``
+    lies in ``(-1, 0]``, where ``Π(m/n|m) - K`` comes straight out of the series, cancellation
+    free.
+    """
+    return complete_integrals_excess_decimal(n, sqrt_mc, m)[:2]
+
+
+@dataclass(frozen=True)
+class ThirdKindConstants:
+    """Complete integrals of a body's precession, each free of cancellation (45 digits).
+
+    Attributes:
+        K: ``K(m)``.
+        pi: ``Π(n|m)``.
+        excess: ``Π(n|m) - K`` (straight from the series for ``-1 <= n < 0``).
+        pole: ``Π(n|m) - π/(2q)``, ``q = sqrt((1 - n)(1 - m/n))``. By DLMF 19.7.9 at
+            ``φ = π/2`` it equals ``K - Π(m/n|m)``, taken from the series in ``m/n`` whenever
+            ``m/n >= -1`` (where ``Π(n)`` and ``π/(2q)`` nearly cancel).
+        copole: ``K - pole = π/(2q) - (Π(n|m) - K)``, equal to ``Π(m/n|m)`` in the same cases.
+
+    ``pole`` and ``copole`` are both >= 0 and each is formed without cancellation.
+    """
+
+    K: Decimal
+    pi: Decimal
+    excess: Decimal
+    pole: Decimal
+    copole: Decimal
+
+
+def third_kind_constants(n: Decimal, sqrt_mc: Decimal, m: Decimal) -> ThirdKindConstants:
+    """:class:`ThirdKindConstants` of ``n < 0`` and ``m = 1 - sqrt_mc²`` (exact decimals).
+
+    The series of DLMF 19.8.6-19.8.8 needs ``-1 <= n < 0``; the transformation ``n -> m/n``
+    (:func:`complete_integrals_decimal`) maps the rest into that range. ``Π(n) - π/(2q)`` as a
+    difference loses about ``log10(1/|m/n|)`` digits (it is ``~|m/n| K``): fine down to
+    ``|m/n| = 1e-10`` (35 digits left for a double-double); below, ``K - Π(m/n)`` comes from a
+    second series, on the same AGM.
     """
     with localcontext() as ctx:
         ctx.prec = precise.DIGITS
         one = Decimal(1)
-        a, g = one, +sqrt_mc
-        p = (one - n).sqrt()
-        q, total = one, Decimal(0)
-        for _ in range(200):
-            total += q
-            ag = a * g
+        n_dual = m / n
+        q = ((one - n) * (one - n_dual)).sqrt()
+        pole_term = precise.PI / (2 * q)
+        if n < -one:
+            K, (excess_dual,) = _k_and_pi_excesses((n_dual,), +sqrt_mc)
+            pi = pole_term - excess_dual
+            return ThirdKindConstants(K, pi, pi - K, -excess_dual, K + excess_dual)
+        if n_dual >= _TINY_DUAL:
+            K, (excess, excess_dual) = _k_and_pi_excesses((n, n_dual), +sqrt_mc)
+            return ThirdKindConstants(K, K + excess, excess, -excess_dual, K + excess_dual)
+        K, (excess,) = _k_and_pi_excesses((n,), +sqrt_mc)
+        pi = K + excess
+        return ThirdKindConstants(K, pi, excess, pi - pole_term, pole_term - excess)
+
+
+def complete_integrals_excess_decimal(
+    n: Decimal, sqrt_mc: Decimal, m: Decimal | None = None
+) -> tuple[Decimal, Decimal, Decimal]:
+    """``(K, Π(n|m), Π(n|m) - K)`` as :func:`complete_integrals_decimal`, with the difference
+    ``Π - K`` taken straight from the series for ``-1 <= n < 1`` (where ``Π - K ~ n K`` is
+    tiny for a tiny ``n`` and a subtraction would cancel); for ``n < -1`` it is ``Π - K``.
+    """
+    with localcontext() as ctx:
+        ctx.prec = precise.DIGITS
+        one = Decimal(1)
+        if n < -one:
+            if m is None:
+                m = one - sqrt_mc * sqrt_mc
+            n_dual = m / n
+            K, (excess,) = _k_and_pi_excesses((n_dual,), +sqrt_mc)
+            q = ((one - n) * (one - n_dual)).sqrt()
+            pi = precise.PI / (2 * q) - excess
+            return K, pi, pi - K
+        K, (excess,) = _k_and_pi_excesses((n,), +sqrt_mc)
+        return K, K + excess, excess
+
+
+def _k_and_pi_excesses(
+    ns: tuple[Decimal, ...], sqrt_mc: Decimal
+) -> tuple[Decimal, tuple[Decimal, ...]]:
+    """``K(m)`` and ``Π(n|m) - K(m)`` for each ``-1 <= n < 1``, from one AGM (DLMF 19.8.6-8).
+
+    ``Π - K = π/(4M) · n/(1-n) · Σ Q_k``, computed as it stands (no difference of O(K) terms);
+    the AGM ``a_k, g_k`` is shared, each ``n`` has its own ``p_k`` and ``Q_k``.
+    """
+    one = Decimal(1)
+    a, g = one, sqrt_mc
+    count = len(ns)
+    ps = [(one - n).sqrt() for n in ns]
+    qs = [one] * count
+    totals = [Decimal(0)] * count
+    for _ in range(200):
+        ag = a * g
+        converged = True
+        for i in range(count):
+            totals[i] += qs[i]
+            p = ps[i]
             pp = p * p
             eps = (pp - ag) / (pp + ag)
-            p = (pp + ag) / (2 * p)
-            q = q * eps / 2
-            a, g = (a + g) / 2, ag.sqrt()
-            if abs(q) <= _DECIMAL_TOL * abs(total) and abs(a - g) <= _DECIMAL_TOL * a:
-                break
-        return precise.PI / (2 * a), precise.PI / (4 * a) * (2 + n / (one - n) * total)
+            ps[i] = (pp + ag) / (2 * p)
+            qs[i] = qs[i] * eps / 2
+            converged = converged and abs(qs[i]) <= _DECIMAL_TOL * abs(totals[i])
+        a, g = (a + g) / 2, ag.sqrt()
+        if converged and abs(a - g) <= _DECIMAL_TOL * a:
+            break
+    quarter = precise.PI / (4 * a)
+    return 2 * quarter, tuple(
+        quarter * (n / (one - n) * total) for n, total in zip(ns, totals, strict=True)
+    )
 
 
 def sncndn_reduced(
@@ -283,17 +412,24 @@ def sncndn(u, m: float, mc: float | None = None):
 
 
 def tanh_sech(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(tanh u, sech u)`` without overflow warnings for large ``|u|`` (m = 1 limit)."""
-    e = np.exp(-2.0 * np.abs(u))  # in (0, 1], underflows gracefully to 0
+    """``(tanh u, sech u)`` without overflow warnings for large ``|u|`` (m = 1 limit).
+
+    ``sech u = 2h/(1 + h²)`` with ``h = e^{-|u|}``: from h itself, not from ``sqrt(e^{-2|u|})``,
+    whose argument underflows beyond |u| ~ 372 while sech stays representable to |u| ~ 745
+    (a separatrix start 1e-180 off the unstable axis has u0 ~ 414).
+    """
+    h = np.exp(-np.abs(u))  # in (0, 1], underflows gracefully to 0
+    e = h * h
     tanh = np.copysign((1.0 - e) / (1.0 + e), u)
-    sech = 2.0 * np.sqrt(e) / (1.0 + e)
+    sech = 2.0 * h / (1.0 + e)
     return tanh, sech
 
 
 def tanh_sech_scalar(u: float) -> tuple[float, float]:
     """:func:`tanh_sech` for one float (same operations, numpy's ``exp``)."""
-    e = float(np.exp(-2.0 * abs(u)))
-    return math.copysign((1.0 - e) / (1.0 + e), u), 2.0 * math.sqrt(e) / (1.0 + e)
+    h = float(np.exp(-abs(u)))
+    e = h * h
+    return math.copysign((1.0 - e) / (1.0 + e), u), 2.0 * h / (1.0 + e)
 
 
 def ellipk(m: float, mc: float | None = None) -> float:
@@ -305,19 +441,48 @@ def ellipk(m: float, mc: float | None = None) -> float:
     return float(special.elliprf(0.0, mc, 1.0))
 
 
-def ellippi_from_jacobi(n: float, sn: np.ndarray, cn: np.ndarray, dn: np.ndarray) -> np.ndarray:
+def ellippi_from_jacobi(
+    n: float, sn: np.ndarray, cn: np.ndarray, dn: np.ndarray, m: float = 0.0
+) -> np.ndarray:
     """Incomplete ``Π(n; am u | m)`` from ``sn, cn, dn`` of a reduced argument (``cn >= 0``).
 
     With ``φ = am u``: ``sin φ = sn``, ``cos φ = cn`` and ``1 - m sin²φ = dn²``, so Carlson's
     form (DLMF 19.25.14) needs no subtraction: ``Π = sn R_F(cn², dn², 1)
     + (n/3) sn³ R_J(cn², dn², 1, 1 - n sn²)``. Valid for ``|φ| <= π/2`` and ``n <= 0``
     (where ``1 - n sn² >= 1``).
+
+    For ``n < -1`` the two terms nearly cancel (``Π ~ atan(sqrt(-n) tan φ)/sqrt(-n)`` while each
+    term is O(F)): a body with moments 1e6 apart would lose six digits, one with 1e90 all of
+    them. There the transformation ``n -> m/n`` (DLMF 19.7.9, with ``c = 1/sn²``) is used,
+    ``Π(n; φ) = F(φ) - Π(m/n; φ) + atan2(q sn, cn dn)/q``, ``q = sqrt((1 - n)(1 - m/n))``, and
+    ``F - Π(m/n; φ) = -(m/(3n)) sn³ R_J(cn², dn², 1, 1 - (m/n) sn²)``: two terms of different
+    sizes, no cancellation (``m`` is needed only here).
     """
     c2 = cn * cn
     d2 = dn * dn
     s2 = sn * sn
+    if n < -1.0:
+        n_dual = m / n
+        q = math.sqrt((1.0 - n) * (1.0 - n_dual))
+        return np.arctan2(q * sn, cn * dn) / q - (n_dual / 3.0) * sn * s2 * special.elliprj(
+            c2, d2, 1.0, 1.0 - n_dual * s2
+        )
     return sn * special.elliprf(c2, d2, 1.0) + (n / 3.0) * sn * s2 * special.elliprj(
         c2, d2, 1.0, 1.0 - n * s2
+    )
+
+
+def _ellippi_from_jacobi_scalar(n: float, m: float, sn: float, cn: float, dn: float) -> float:
+    """:func:`ellippi_from_jacobi` for one sample (same branches and operations)."""
+    c2, d2, s2 = cn * cn, dn * dn, sn * sn
+    if n < -1.0:
+        n_dual = m / n
+        q = math.sqrt((1.0 - n) * (1.0 - n_dual))
+        return float(np.arctan2(q * sn, cn * dn)) / q - (n_dual / 3.0) * sn * s2 * float(
+            special.elliprj(c2, d2, 1.0, 1.0 - n_dual * s2)
+        )
+    return sn * float(special.elliprf(c2, d2, 1.0)) + (n / 3.0) * sn * s2 * float(
+        special.elliprj(c2, d2, 1.0, 1.0 - n * s2)
     )
 
 
@@ -349,9 +514,31 @@ def ellipf_from_angle(
     return math.copysign(2.0 * K, s) - f
 
 
+@dataclass(frozen=True)
+class PeriodicPi:
+    """Constants of ``P(r) = Π(n; am r | m) - (Π(n|m)/K) r`` (:func:`periodic_third_kind`).
+
+    Attributes:
+        n: the characteristic, ``n < 0``.
+        slope: ``Π(n|m)/K``.
+        slope_m1: ``(Π(n|m) - K)/K``, from the series difference (accurate for tiny ``n``).
+
+    ``P`` is evaluated in one of two cancellation-free ways. For ``-1 <= n < 0``,
+    ``P = [Π(n; am r) - r] - (slope - 1) r`` with ``Π - F = (n/3) sn³ R_J(cn², dn², 1,
+    1 - n sn²)``: both terms are O(n), where ``Π - slope·r`` would be a difference of two O(r)
+    numbers (a pole moment 1e-77 of the largest gives ``n ~ -1e-62`` and a precession factor
+    ~1e31 that multiplies the lost digits). For ``n < -1``, ``Π`` itself is small
+    (``~1/sqrt(-n)``) and ``P = Π - slope·r`` directly, Π by the ``n -> m/n`` transformation
+    (:func:`ellippi_from_jacobi`).
+    """
+
+    n: float
+    slope: float
+    slope_m1: float
+
+
 def periodic_third_kind(
-    n: float,
-    slope: float,
+    pp: PeriodicPi,
     par: JacobiParameter,
     r: np.ndarray,
     sn: np.ndarray,
@@ -360,33 +547,48 @@ def periodic_third_kind(
 ) -> np.ndarray:
     """``P(r) = Π(n; am r | m) - slope·r`` with ``slope = Π(n|m)/K``, ``|r| <= K``, ``n < 0``.
 
-    For ``|r| <= K/2`` Carlson's form with ``(sn, cn, dn)`` of r (:func:`ellippi_from_jacobi`).
+    For ``|r| <= K/2`` Carlson's form with ``(sn, cn, dn)`` of r (see :class:`PeriodicPi`).
     For ``|r| > K/2`` the complementary argument ``v = K - |r|``: with ``sn(K - v) = cd v``,
     ``1/(1 - n cd²v) = [m/n' + (1 - m/n')/(1 - n' sn²v)]/(1 - n)``, ``n' = (m - n)/(1 - n)``,
     so ``Π(n; am(K - v)) = Π(n) - m v/(m - n) + n mc Π(n'; am v)/((1 - n)(m - n))``. Its
     Carlson arguments are O(1) where ``cn² r`` and ``dn² r`` would underflow near the
-    separatrix, and ``Π(n) - (Π(n)/K) K`` cancels exactly by construction.
-    Only when ``1 - m < 1e-500`` (K > 575) does a middle stretch remain where both forms would
-    underflow; there ``1 - m`` is invisible (``mc e^{2r} < e^{-600}``) and the m = 1 form
+    separatrix, and ``Π(n) - (Π(n)/K) K`` cancels exactly by construction (for ``n >= -1`` the
+    coefficient ``slope - m/(m - n)`` is formed as ``(slope - 1) - n/(m - n)``).
+    Only when ``K > 300`` (``1 - m < 1e-260``) does a middle stretch remain,
+    ``min(K/2, 300) < |r| < K - 150``, where the first form would underflow and the second
+    would feed scipy's ``elliprj`` arguments below 1e-154 (where it returns NaN); there
+    ``1 - m`` is invisible (``mc e^{2|r|} < 16 e^{-300}``) and the m = 1 form
     ``Π = (r + a atan(a tanh r))/(1 - n)``, ``a = sqrt(-n)``, is exact to rounding.
     """
+    n = pp.n
+    dual = n < -1.0
     out = np.empty_like(r)
     reach = min(0.5 * par.K, _UNDERFLOW_REACH)
     near = np.abs(r) <= reach
     if near.any():
-        out[near] = ellippi_from_jacobi(n, sn[near], cn[near], dn[near]) - slope * r[near]
-    middle = (np.abs(r) > reach) & (par.K - np.abs(r) > _UNDERFLOW_REACH)
+        rn, sn_n, cn_n, dn_n = r[near], sn[near], cn[near], dn[near]
+        if dual:
+            out[near] = ellippi_from_jacobi(n, sn_n, cn_n, dn_n, par.m) - pp.slope * rn
+        else:
+            c2, d2, s2 = cn_n * cn_n, dn_n * dn_n, sn_n * sn_n
+            pi_minus_f = (n / 3.0) * sn_n * s2 * special.elliprj(c2, d2, 1.0, 1.0 - n * s2)
+            out[near] = pi_minus_f - pp.slope_m1 * rn
+    middle = (np.abs(r) > reach) & (par.K - np.abs(r) > _COMPLEMENT_REACH)
     if middle.any():
         a = math.sqrt(-n)
         rm = r[middle]
         th, _ = tanh_sech(rm)
-        out[middle] = (rm + a * np.arctan(a * th)) / (1.0 - n) - slope * rm
+        if dual:
+            out[middle] = (rm + a * np.arctan(a * th)) / (1.0 - n) - pp.slope * rm
+        else:
+            out[middle] = (n * rm + a * np.arctan(a * th)) / (1.0 - n) - pp.slope_m1 * rm
     far = ~(near | middle)
     if far.any():
         m, mc = par.m, par.mc
         v = par.K - np.abs(r[far])
         snv, cnv, dnv = sncndn_reduced(v, par)
-        body = (slope - m / (m - n)) * v
+        coef = pp.slope - m / (m - n) if dual else pp.slope_m1 - n / (m - n)
+        body = coef * v
         if mc > 0.0:  # the Π(n') term carries a factor 1 - m: exactly nothing when it underflows
             n_prime = (m - n) / (1.0 - n)
             c2, d2, s2 = cnv * cnv, dnv * dnv, snv * snv
@@ -401,25 +603,30 @@ def periodic_third_kind(
 
 
 def periodic_third_kind_scalar(
-    n: float, slope: float, par: JacobiParameter, r: float, sn: float, cn: float, dn: float
+    pp: PeriodicPi, par: JacobiParameter, r: float, sn: float, cn: float, dn: float
 ) -> float:
     """:func:`periodic_third_kind` for one float ``r`` (same branches, same operations)."""
+    n = pp.n
+    dual = n < -1.0
     reach = min(0.5 * par.K, _UNDERFLOW_REACH)
     ar = abs(r)
     if ar <= reach:
+        if dual:
+            return _ellippi_from_jacobi_scalar(n, par.m, sn, cn, dn) - pp.slope * r
         c2, d2, s2 = cn * cn, dn * dn, sn * sn
-        pi_r = sn * float(special.elliprf(c2, d2, 1.0)) + (n / 3.0) * sn * s2 * float(
-            special.elliprj(c2, d2, 1.0, 1.0 - n * s2)
-        )
-        return pi_r - slope * r
-    if par.K - ar > _UNDERFLOW_REACH:
+        pi_minus_f = (n / 3.0) * sn * s2 * float(special.elliprj(c2, d2, 1.0, 1.0 - n * s2))
+        return pi_minus_f - pp.slope_m1 * r
+    if par.K - ar > _COMPLEMENT_REACH:
         a = math.sqrt(-n)
         th, _ = tanh_sech_scalar(r)
-        return (r + a * float(np.arctan(a * th))) / (1.0 - n) - slope * r
+        if dual:
+            return (r + a * float(np.arctan(a * th))) / (1.0 - n) - pp.slope * r
+        return (n * r + a * float(np.arctan(a * th))) / (1.0 - n) - pp.slope_m1 * r
     m, mc = par.m, par.mc
     v = par.K - ar
     snv, cnv, dnv = sncndn_reduced_scalar(v, par)
-    body = (slope - m / (m - n)) * v
+    coef = pp.slope - m / (m - n) if dual else pp.slope_m1 - n / (m - n)
+    body = coef * v
     if mc > 0.0:
         n_prime = (m - n) / (1.0 - n)
         c2, d2, s2 = cnv * cnv, dnv * dnv, snv * snv
