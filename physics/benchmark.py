@@ -13,7 +13,6 @@ t = 1e4 (``FreeRigidBody(I, ω0).state(1e4)``), median of many runs. Target ≤ 
 from __future__ import annotations
 
 import argparse
-import statistics
 import time
 
 import numpy as np
@@ -81,7 +80,7 @@ def _median(fn, n: int) -> float:
         t0 = time.perf_counter()
         fn()
         samples.append(time.perf_counter() - t0)
-    return statistics.median(samples)
+    return float(np.median(samples))
 
 
 def single_time(n: int = 1000) -> dict:
