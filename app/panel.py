@@ -467,7 +467,7 @@ class ControlPanel:
         if self._plot_t and t == self._plot_t[-1]:
             return
         self._plot_t.append(float(t))
-        self._plot_w.append(np.asarray(omega, dtype=np.float64))
+        self._plot_w.append(np.array(omega, dtype=np.float64))  # a copy: not a batch's view
         if len(self._plot_t) > PLOT_SAMPLES:
             del self._plot_t[0], self._plot_w[0]
 

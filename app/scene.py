@@ -146,6 +146,7 @@ class _Batch:
     what frames send: a frame then only picks rows (no numpy work, no allocation per frame).
     Row ``i`` is grid index ``k0 + i``; the arrays are read-only."""
 
+    source: Samples  # the sampler's batch this was converted from
     k0: int
     t: np.ndarray  # (N,) simulation time
     omega: np.ndarray  # (N, 3) body frame, physical units
@@ -162,6 +163,7 @@ class _Batch:
         arrow = np.zeros((len(tip), 1, 2, 3), np.float32)
         arrow[:, 0, 1] = tip
         batch = cls(
+            samples,
             int(samples.k[0]),
             samples.t,
             samples.omega,
@@ -172,7 +174,7 @@ class _Batch:
             tip.astype(np.float32),
             samples.k % stride == 0,
         )
-        for field in dataclasses.fields(cls)[1:]:
+        for field in dataclasses.fields(cls)[2:]:
             getattr(batch, field.name).flags.writeable = False
         return batch
 
@@ -216,7 +218,6 @@ class PoinsotScene:
         self._k_last: int | None = None
         self._frame: Frame | None = None
         self._batch: _Batch | None = None
-        self._batch_source: Samples | None = None
         self._omega_arrow: viser.SceneNodeHandle | None = None
         # Rows drawn since the last trail flush: (batch, first row, end row, force last row).
         self._pending: list[tuple[_Batch, int, int, bool]] = []
@@ -298,7 +299,7 @@ class PoinsotScene:
         with self._atomic():
             self._body, self._solid, self._geometry = body, solid, geometry
             self._sampler = sampler
-            self._batch, self._batch_source = batch, source
+            self._batch = batch
             for element in sorted(self._elements):
                 if not self._nodes.get(element) and element not in self._trails:
                     self._build(element)
@@ -347,9 +348,8 @@ class PoinsotScene:
         sampler, geometry = self._sampler, self._geometry
         assert sampler is not None and geometry is not None
         source = sampler.batch(k_first, k_last)  # checked finite once per batch
-        if source is not self._batch_source or self._batch is None:
+        if self._batch is None or self._batch.source is not source:
             self._batch = _Batch.convert(source, geometry.scale, sampler.stride)
-            self._batch_source = source
         return self._batch
 
     def _draw(self, k_first: int, k: int, restart: bool) -> Frame:
