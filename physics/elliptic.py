@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from decimal import Decimal, localcontext
-from fractions import Fraction
 
 import numpy as np
 from scipy import special
@@ -163,56 +162,6 @@ def reduce_argument_scalar(u: float, K: float) -> tuple[float, float]:
     return (u - j * head) - j * tail, j
 
 
-def ellipk_decimal(mc: Fraction) -> Decimal:
-    """``K(m) = π / (2 AGM(1, sqrt(1 - m)))`` of an exact ``mc = 1 - m > 0``, to 45 digits.
-
-    The phase of a long run is ``u mod 2K``: K to double-double keeps that reduction exact to
-    ~1e-32 relative (see :mod:`physics.precise`).
-    """
-    with localcontext() as ctx:
-        ctx.prec = precise.DIGITS
-        a, g = Decimal(1), precise.decimal(mc).sqrt()
-        for _ in range(64):
-            a, g = (a + g) / 2, (a * g).sqrt()
-            if abs(a - g) <= _DECIMAL_TOL * a:
-                break
-        return precise.PI / (2 * a)
-
-
-def ellippi_complete_decimal(n: Fraction, mc: Fraction) -> Decimal:
-    """Complete ``Π(n|m)`` for ``n < 1``, ``0 < mc <= 1``, to 45 digits (AGM, quadratic).
-
-    DLMF 19.8.6-19.8.8: with ``a0 = 1``, ``g0 = sqrt(mc)``, ``p0² = 1 - n``, ``Q0 = 1``,
-    ``p_{k+1} = (p_k² + a_k g_k)/(2 p_k)``, ``ε_k = (p_k² - a_k g_k)/(p_k² + a_k g_k)``,
-    ``Q_{k+1} = Q_k ε_k / 2``: ``Π = π/(4 M) (2 + n/(1-n) Σ Q_k)``, M the AGM limit.
-    """
-    with localcontext() as ctx:
-        ctx.prec = precise.DIGITS
-        return complete_integrals_decimal(precise.decimal(n), precise.decimal(mc).sqrt())[1]
-
-
-def complete_integrals_decimal(
-    n: Decimal, sqrt_mc: Decimal, m: Decimal | None = None
-) -> tuple[Decimal, Decimal]:
-    """``(K(m), Π(n|m))`` to 45 digits from one AGM, given ``n < 1`` and ``sqrt(1 - m) > 0``.
-
-    The AGM sequence ``a_k, g_k`` of :func:`ellippi_complete_decimal` (DLMF 19.8.6-19.8.8) is
-    the one of :func:`ellipk_decimal`, so both integrals come out of a single loop; it runs
-    until both the AGM and the ``Q_k`` series have converged to the working precision, and
-    ``K = π/(2M)`` is read off the same limit ``M``. The arguments are decimals already at
-    (at least) the working precision, so a caller that has ``sqrt(1 - m)`` reuses it; ``m``
-    itself (exact, if the caller has it) is only needed for ``n < -1``.
-
-    For ``n < -1`` the series form ``Π = K + π/(4M) n/(1-n) Σ Q`` cancels: ``Π(n|m) ~
-    π/(2 sqrt(-n))`` while both terms are O(K), so a moment ratio of 1e90 (``n ~ -1e90``) would
-    lose all 45 digits. There the transformation ``n -> m/n`` (DLMF 19.7.9 at ``φ = π/2``),
-    ``Π(n|m) = π/(2q) - (Π(m/n|m) - K)`` with ``q = sqrt((1 - n)(1 - m/n))``, is used: ``m/n``
-    lies in ``(-1, 0]``, where ``Π(m/n|m) - K`` comes straight out of the series, cancellation
-    free.
-    """
-    return complete_integrals_excess_decimal(n, sqrt_mc, m)[:2]
-
-
 @dataclass(frozen=True)
 class ThirdKindConstants:
     """Complete integrals of a body's precession, each free of cancellation (45 digits).
@@ -240,10 +189,10 @@ def third_kind_constants(n: Decimal, sqrt_mc: Decimal, m: Decimal) -> ThirdKindC
     """:class:`ThirdKindConstants` of ``n < 0`` and ``m = 1 - sqrt_mc²`` (exact decimals).
 
     The series of DLMF 19.8.6-19.8.8 needs ``-1 <= n < 0``; the transformation ``n -> m/n``
-    (:func:`complete_integrals_decimal`) maps the rest into that range. ``Π(n) - π/(2q)`` as a
-    difference loses about ``log10(1/|m/n|)`` digits (it is ``~|m/n| K``): fine down to
-    ``|m/n| = 1e-10`` (35 digits left for a double-double); below, ``K - Π(m/n)`` comes from a
-    second series, on the same AGM.
+    (:func:`complete_integrals_excess_decimal`) maps the rest into that range.
+    ``Π(n) - π/(2q)`` as a difference loses about ``log10(1/|m/n|)`` digits (it is
+    ``~|m/n| K``): fine down to ``|m/n| = 1e-10`` (35 digits left for a double-double); below,
+    ``K - Π(m/n)`` comes from a second series, on the same AGM.
     """
     with localcontext() as ctx:
         ctx.prec = precise.DIGITS
@@ -266,9 +215,22 @@ def third_kind_constants(n: Decimal, sqrt_mc: Decimal, m: Decimal) -> ThirdKindC
 def complete_integrals_excess_decimal(
     n: Decimal, sqrt_mc: Decimal, m: Decimal | None = None
 ) -> tuple[Decimal, Decimal, Decimal]:
-    """``(K, Π(n|m), Π(n|m) - K)`` as :func:`complete_integrals_decimal`, with the difference
-    ``Π - K`` taken straight from the series for ``-1 <= n < 1`` (where ``Π - K ~ n K`` is
-    tiny for a tiny ``n`` and a subtraction would cancel); for ``n < -1`` it is ``Π - K``.
+    """``(K(m), Π(n|m), Π(n|m) - K)`` to 45 digits from one AGM, given ``n < 1`` and
+    ``sqrt(1 - m) > 0`` (decimals at the working precision; ``m`` itself, exact if the caller
+    has it, is only needed for ``n < -1``).
+
+    The AGM ``a_k, g_k`` with ``a0 = 1``, ``g0 = sqrt(1 - m)`` gives ``K = π/(2M)``, M its
+    limit, and with ``p0² = 1 - n``, ``p_{k+1} = (p_k² + a_k g_k)/(2 p_k)``,
+    ``ε_k = (p_k² - a_k g_k)/(p_k² + a_k g_k)``, ``Q0 = 1``, ``Q_{k+1} = Q_k ε_k / 2`` also
+    ``Π - K = π/(4M) n/(1-n) Σ Q_k`` (DLMF 19.8.6-19.8.8): both come out of a single loop.
+    ``Π - K`` is taken straight from that series for ``-1 <= n < 1`` (``Π - K ~ n K`` is tiny
+    for a tiny ``n``, where a subtraction would cancel).
+
+    For ``n < -1`` the series cancels: ``Π(n|m) ~ π/(2 sqrt(-n))`` while its terms are O(K),
+    so a moment ratio of 1e90 (``n ~ -1e90``) would lose all 45 digits. There the
+    transformation ``n -> m/n`` (DLMF 19.7.9 at ``φ = π/2``), ``Π(n|m) = π/(2q) - (Π(m/n|m) -
+    K)`` with ``q = sqrt((1 - n)(1 - m/n))``, is used: ``m/n`` lies in ``(-1, 0]``, where
+    ``Π(m/n|m) - K`` comes straight out of the series, cancellation free.
     """
     with localcontext() as ctx:
         ctx.prec = precise.DIGITS
