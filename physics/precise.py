@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from decimal import Decimal, localcontext
-from fractions import Fraction
 
 import numpy as np
 
@@ -33,18 +32,9 @@ _SPLIT_LIMIT = 1e290
 _REDUCE_LIMIT = 2.0**50
 
 
-def decimal(x: Fraction | float | int) -> Decimal:
-    """An exact rational as a Decimal at the current context's precision."""
-    x = Fraction(x)
-    return Decimal(x.numerator) / Decimal(x.denominator)
-
-
 def ratio(numerator: int, denominator: int) -> Decimal:
-    """``numerator / denominator`` of two exact integers, rounded once to the context precision.
-
-    The same value as ``decimal(Fraction(numerator, denominator))`` without reducing the
-    fraction first (a gcd of large integers costs more than the division).
-    """
+    """``numerator / denominator`` of two exact integers, rounded once to the context precision
+    (not reduced first: a gcd of large integers costs more than the division)."""
     return Decimal(numerator) / Decimal(denominator)
 
 
@@ -54,13 +44,6 @@ def double_double(x: Decimal) -> tuple[float, float]:
     if not math.isfinite(hi):
         return hi, 0.0
     return hi, float(x - Decimal(hi))
-
-
-def sqrt_dd(x: Fraction) -> tuple[float, float]:
-    """``sqrt(x)`` of an exact non-negative rational, as ``hi + lo`` (~1e-32 relative)."""
-    with localcontext() as ctx:
-        ctx.prec = DIGITS
-        return double_double(decimal(x).sqrt())
 
 
 def split(x):

@@ -184,8 +184,9 @@ def test_complete_integrals_decimal_against_mpmath(mc: str, n: str) -> None:
     mc_q, n_q = Fraction(mc), Fraction(n)
     with localcontext() as ctx:
         ctx.prec = precise.DIGITS
-        sqrt_mc = precise.decimal(mc_q).sqrt()
-        K, Pi, _ = elliptic.complete_integrals_excess_decimal(precise.decimal(n_q), sqrt_mc)
+        sqrt_mc = precise.ratio(mc_q.numerator, mc_q.denominator).sqrt()
+        n_dec = precise.ratio(n_q.numerator, n_q.denominator)
+        K, Pi, _ = elliptic.complete_integrals_excess_decimal(n_dec, sqrt_mc)
     with mp.workdps(60 + int(-math.log10(mc_q))):  # 1 - 1e-300 must not round to 1
         m = 1 - mp.mpf(mc_q.numerator) / mc_q.denominator
         nn = mp.mpf(n_q.numerator) / n_q.denominator
