@@ -442,11 +442,6 @@ class ControlPanel:
             pause.label = "Play" if paused else "Pause"
             pause.icon = viser.Icon.PLAYER_PLAY if paused else viser.Icon.PLAYER_PAUSE
 
-    def show_visibility(self, element: Element, visible: bool) -> None:
-        box = self.handles.get(f"show_{element.value}")
-        if box is not None:
-            box.value = visible
-
     def show_readouts(self, text: str) -> None:
         self.handles["readouts"].content = text
 

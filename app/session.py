@@ -164,13 +164,6 @@ class Session:
     def toggle_pause(self) -> None:
         self._post(self._toggle_pause)
 
-    def set_paused(self, paused: bool) -> None:
-        def action() -> None:
-            self.clock.paused = paused
-            self._show_playback()
-
-        self._post(action)
-
     def step(self) -> None:
         self._post(self._step)
 
