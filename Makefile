@@ -25,10 +25,11 @@ install: $(VENV)/.installed
 install-test: $(VENV)/.installed-test
 
 # Debian's Chromium drives the real-browser tests (playwright uses it via executable_path).
+# strace lets a test prove that the browser reaches nothing past loopback.
 chromium:
-	@if [ -x "$(CHROMIUM)" ]; then echo "chromium: $(CHROMIUM)"; else \
-		echo "installing Debian's chromium"; \
-		$(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y chromium; fi
+	@if [ -x "$(CHROMIUM)" ] && command -v strace >/dev/null; then echo "chromium: $(CHROMIUM)"; else \
+		echo "installing Debian's chromium and strace"; \
+		$(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y chromium strace; fi
 
 run: install
 	$(VENV)/bin/poinsot serve --host $(HOST) --port $(PORT)

@@ -54,17 +54,37 @@ MAX_SIDE = 8192
 #: Where Chromium is looked for (the same variable as the test suite's), then the PATH.
 CHROMIUM_ENV = "POINSOT_CHROMIUM"
 DEFAULT_CHROMIUM = "/usr/bin/chromium"
-#: Flags for headless Chromium here: root, a closed network, WebGL through SwiftShader.
+#: Flags for headless Chromium here: root, WebGL through SwiftShader, and nothing past loopback.
+#: Every host name but 127.0.0.1 resolves to nothing, so no DNS query leaves the machine, and
+#: the background services that would phone home (component and safe-browsing updates, sync,
+#: metrics, domain reliability, translation, media router, network prediction) are off.
+#: What remains is Chromium's IPv6 route probe, a UDP connect() that sends no datagram (no flag
+#: turns it off); the loopback test checks that it stays silent.
+LOOPBACK_ONLY = "MAP * ~NOTFOUND , EXCLUDE 127.0.0.1"
 CHROMIUM_ARGS = (
     "--no-sandbox",
     "--disable-gpu",
     "--use-angle=swiftshader",
     "--enable-unsafe-swiftshader",
+    f"--host-resolver-rules={LOOPBACK_ONLY}",
+    "--no-proxy-server",
     "--disable-quic",
+    "--dns-prefetch-disable",
     "--no-first-run",
+    "--no-default-browser-check",
+    "--no-pings",
     "--disable-background-networking",
     "--disable-component-update",
     "--disable-sync",
+    "--disable-default-apps",
+    "--disable-extensions",
+    "--disable-breakpad",
+    "--disable-domain-reliability",
+    "--disable-client-side-phishing-detection",
+    "--safebrowsing-disable-auto-update",
+    "--metrics-recording-only",
+    "--disable-features=NetworkPrediction,OptimizationHints,MediaRouter,DialMediaRouteProvider,"
+    "Translate,AutofillServerCommunication,CertificateTransparencyComponentUpdater,AsyncDns",
 )
 INSTALL_HINT = (
     "Install it with `sudo apt-get install chromium` (Debian/Ubuntu; `make chromium` does the "
@@ -257,8 +277,13 @@ def capture(
 
         def render(w: int, h: int, fov_: float) -> np.ndarray:
             return client.get_render(
-                h, w, wxyz=orientation, position=position, fov=fov_,
-                transport_format="png", timeout=RENDER_TIMEOUT,
+                h,
+                w,
+                wxyz=orientation,
+                position=position,
+                fov=fov_,
+                transport_format="png",
+                timeout=RENDER_TIMEOUT,
             )
 
         # The browser decodes meshes asynchronously: render until two probes agree.
@@ -278,8 +303,9 @@ def capture(
         raise RuntimeError(
             f"the browser returned {rgba.shape[1]}x{rgba.shape[0]}, not {width}x{height}"
         )
-    return Shot(png_bytes(rgba, background), width, height, math.degrees(fov),
-                time.perf_counter() - start)
+    return Shot(
+        png_bytes(rgba, background), width, height, math.degrees(fov), time.perf_counter() - start
+    )
 
 
 # -- the command ----------------------------------------------------------------------------
@@ -305,20 +331,28 @@ def add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
         "--scene", metavar="NAME", help="scene by preset key or label, e.g. 'Sphere (a cube)'"
     )
     parser.add_argument(
-        "--time", type=float, default=None,
+        "--time",
+        type=float,
+        default=None,
         help="simulation time of the picture (default: one period of omega)",
     )
     parser.add_argument("--size", default="1920x1080", help="WIDTHxHEIGHT in pixels")
     parser.add_argument(
-        "--view", choices=CAMERA_NAMES, default="default",
+        "--view",
+        choices=CAMERA_NAMES,
+        default="default",
         help="camera: the scene's default view, along L (top), side, or fixed in the body",
     )
     parser.add_argument(
-        "--background", choices=("dark", "light", "transparent"), default="dark",
+        "--background",
+        choices=("dark", "light", "transparent"),
+        default="dark",
         help="opaque dark or light theme background, or a transparent PNG",
     )
     parser.add_argument(
-        "--no-fit", dest="fit", action="store_false",
+        "--no-fit",
+        dest="fit",
+        action="store_false",
         help="keep the view's field of view instead of framing the construction",
     )
     parser.add_argument("--out", required=True, help="output .png file")
@@ -347,10 +381,14 @@ def screenshot_command(args: argparse.Namespace) -> int:
             frame = stage.seek(t)
             view = space_view(args.view, frame.wxyz)
             stage.set_initial_camera(view)
-            background = None if args.background == "transparent" else THEME_BACKGROUND[
-                args.background == "dark"]
-            shot = capture(stage, view, size, chromium=chromium, background=background,
-                           fit=args.fit)
+            background = (
+                None
+                if args.background == "transparent"
+                else THEME_BACKGROUND[args.background == "dark"]
+            )
+            shot = capture(
+                stage, view, size, chromium=chromium, background=background, fit=args.fit
+            )
         except BrowserMissing as exc:
             print(f"poinsot screenshot: {exc}", file=sys.stderr)
             return EXIT_NO_BROWSER

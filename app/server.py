@@ -28,6 +28,12 @@ class PoinsotApp:
         self.max_fps = max_fps
         self._lock = threading.Lock()
         self._sessions: dict[int, Session] = {}
+        # Clients whose disconnect arrived while their session was still being built: viser runs
+        # sync callbacks on a thread pool, so the disconnect handler may run before (or while)
+        # the connect handler builds the session. Both handlers decide under ``_lock``.
+        self._departed: set[int] = set()
+        #: Sessions built for a client that had already left, closed before they started.
+        self.discarded = 0
         self._connected = threading.Condition(self._lock)
         self.budget = FrameBudget(max_fps=max_fps)
         self.server = viser.ViserServer(host=host, port=port, verbose=verbose)
@@ -61,19 +67,41 @@ class PoinsotApp:
             return list(self._sessions.values())
 
     def _connect(self, client: viser.ClientHandle) -> None:
+        """Build the session outside the lock (30-300 ms), then register and start it under
+        the lock, unless the client left meanwhile: then it is closed and never started."""
+        with self._lock:
+            if client.client_id in self._departed:
+                self._departed.discard(client.client_id)
+                self.discarded += 1
+                return
         session = Session(client, self.preset, max_fps=self.max_fps, budget=self.budget)
         with self._connected:
-            self._sessions[client.client_id] = session
-            self.budget.set_sessions(len(self._sessions))
-            self._connected.notify_all()
-        session.start()
+            if client.client_id in self._departed:
+                self._departed.discard(client.client_id)
+                self.discarded += 1
+                left = True
+            else:
+                left = False
+                self._sessions[client.client_id] = session
+                self.budget.set_sessions(len(self._sessions))
+                session.start()
+                self._connected.notify_all()
+        if left:
+            session.close()
 
     def _disconnect(self, client: viser.ClientHandle) -> None:
         with self._lock:
             session = self._sessions.pop(client.client_id, None)
+            if session is None:  # its connect handler has not registered it (yet)
+                self._departed.add(client.client_id)
             self.budget.set_sessions(len(self._sessions))
         if session is not None:
             session.close()
+
+    def pending_departures(self) -> int:
+        """Clients that left before their session was registered, not yet reconciled."""
+        with self._lock:
+            return len(self._departed)
 
     def stop(self) -> None:
         for session in self.sessions().values():

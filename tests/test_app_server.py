@@ -348,3 +348,31 @@ def test_slider_to_redraw_is_fast(poinsot_app, probe):
         assert time.perf_counter() - start < 0.5
     slider_rebuilds = list(session.stats.rebuild_seconds)[-3:]  # not the first, full build
     assert max(slider_rebuilds) < 0.1, slider_rebuilds
+
+
+def _session_threads() -> list[str]:
+    import threading
+
+    return [t.name for t in threading.enumerate() if t.name.startswith("poinsot-session-")]
+
+
+def test_clients_that_leave_during_connect_leave_no_session(poinsot_app):
+    """Connect and drop at once, 100 times (some drops land while the session is being built,
+    some after it started): afterwards no session, no frame thread and no pending departure."""
+    from app.probe import Probe
+
+    before = len(_session_threads())
+    for i in range(100):
+        probe = Probe(poinsot_app.port)
+        if i % 10 == 9:  # a few stay until their session runs, then leave
+            wait_until(lambda: len(poinsot_app.sessions()) > 0, 5)
+        probe.close()
+    assert wait_until(
+        lambda: (
+            not poinsot_app.sessions()
+            and poinsot_app.pending_departures() == 0
+            and len(_session_threads()) <= before
+        ),
+        60,
+    ), (len(poinsot_app.sessions()), poinsot_app.pending_departures(), _session_threads())
+    assert poinsot_app.server.get_clients() == {}
