@@ -13,7 +13,6 @@ from __future__ import annotations
 import re
 import shutil
 import stat
-from collections import defaultdict
 
 import pytest
 from conftest import chromium_or_fail, in_ci
