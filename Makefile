@@ -7,7 +7,7 @@ PORT   ?= 8080
 CHROMIUM ?= /usr/bin/chromium
 SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: run test install install-test chromium bench report lint clean
+.PHONY: run test install install-test chromium bench lint clean
 
 $(VENV)/bin/activate:
 	$(PYTHON) -m venv $(VENV)
@@ -20,6 +20,10 @@ $(VENV)/.installed: pyproject.toml | $(VENV)/bin/activate
 $(VENV)/.installed-test: pyproject.toml | $(VENV)/bin/activate
 	$(PY) -m pip install -e '.[test,report]'
 	touch $@ $(VENV)/.installed
+
+$(VENV)/.installed-dev: pyproject.toml | $(VENV)/bin/activate
+	$(PY) -m pip install -e '.[dev]'
+	touch $@ $(VENV)/.installed-test $(VENV)/.installed
 
 install: $(VENV)/.installed
 install-test: $(VENV)/.installed-test
@@ -38,11 +42,18 @@ test: install-test chromium
 	$(PY) -m pytest
 
 bench: install
-	$(PY) -m physics.benchmark
+	$(PY) -m poinsot.physics.benchmark
 
-lint: install-test
-	$(PY) -m pip install -q ruff
+# mypy checks the folders under their installed names: poinsot.physics, poinsot.app.
+TYPECHECK := $(VENV)/typecheck
+lint: $(VENV)/.installed-dev
 	$(VENV)/bin/ruff check physics app tests
+	$(VENV)/bin/ruff format --check physics app tests
+	mkdir -p $(TYPECHECK)/poinsot
+	ln -sfn "$(CURDIR)/physics" $(TYPECHECK)/poinsot/physics
+	ln -sfn "$(CURDIR)/app" $(TYPECHECK)/poinsot/app
+	MYPYPATH=$(TYPECHECK) $(VENV)/bin/mypy -p poinsot.physics -p poinsot.app
+	$(VENV)/bin/lint-imports
 
 clean:
 	rm -rf $(VENV) .pytest_cache build *.egg-info

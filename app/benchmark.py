@@ -1,4 +1,4 @@
-"""Benchmark of the live app: ``python -m app.benchmark [--clients 1 20] [--seconds 5]``.
+"""Benchmark of the live app: ``python -m poinsot.app.benchmark [--clients 1 20] [--seconds 5]``.
 
 For each number of connected clients it starts a real Poinsot server in this process and the
 clients in a *separate* process (so that their decoding does not count as server time). The
@@ -47,7 +47,7 @@ def _percentile(values: list[float], q: float) -> float:
 # -- the client process ----------------------------------------------------------------------
 def _clients_main(port: int, count: int, seconds: float, redraws: int, conn) -> None:
     """Runs in a child process: connect, measure traffic, then measure slider round trips."""
-    from app.probe import Probe
+    from poinsot.app.live.probe import Probe
 
     probes = [Probe(port, keep_batches=True) for _ in range(count)]
     for probe in probes:
@@ -123,7 +123,7 @@ class Result:
 
 
 def run(clients: int, seconds: float = 5.0, redraws: int = 30) -> Result:
-    from app.server import PoinsotApp
+    from poinsot.app.live.server import PoinsotApp
 
     app = PoinsotApp("127.0.0.1", 0)
     ctx = mp.get_context("spawn")
@@ -181,7 +181,7 @@ def run(clients: int, seconds: float = 5.0, redraws: int = 30) -> Result:
 
 def _probe_main(port: int, seconds: float) -> None:
     """Child process of :func:`viser_floor`: one headless client that just listens."""
-    from app.probe import Probe
+    from poinsot.app.live.probe import Probe
 
     Probe(port)
     time.sleep(seconds)
@@ -255,7 +255,7 @@ def format_result(r: Result) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m app.benchmark", description=__doc__.split("\n")[0]
+        prog="python -m poinsot.app.benchmark", description=__doc__.split("\n")[0]
     )
     parser.add_argument("--clients", type=int, nargs="+", default=[1, 20])
     parser.add_argument("--seconds", type=float, default=5.0, help="steady-state window")

@@ -10,7 +10,7 @@ import argparse
 import time
 from collections.abc import Sequence
 
-from app.presets import PRESETS, preset_by_key
+from poinsot.app.presets import PRESETS, preset_by_key
 
 
 def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
@@ -27,7 +27,7 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
 
 def serve(args: argparse.Namespace) -> int:
     """Serve until interrupted (Ctrl-C)."""
-    from app.server import PoinsotApp
+    from poinsot.app.live.server import PoinsotApp
 
     app = PoinsotApp(args.host, args.port, preset=preset_by_key(args.preset))
     print(f"Poinsot is running at {app.url}  (Ctrl-C to stop)", flush=True)
@@ -43,21 +43,21 @@ def serve(args: argparse.Namespace) -> int:
 
 def report(args: argparse.Namespace) -> int:
     """Write the work-precision report into ``args.out`` (see :mod:`app.report`)."""
-    from app.report import main as report_main
+    from poinsot.app.report.study import main as report_main
 
     return report_main(args)
 
 
 def screenshot(args: argparse.Namespace) -> int:
     """Write a PNG of a scene through headless Chromium (see :mod:`app.screenshot`)."""
-    from app.screenshot import screenshot_command
+    from poinsot.app.exports.screenshot import screenshot_command
 
     return screenshot_command(args)
 
 
 def export_html(args: argparse.Namespace) -> int:
     """Write a standalone animated HTML page (see :mod:`app.export`)."""
-    from app.export import export_html_command
+    from poinsot.app.exports.export import export_html_command
 
     return export_html_command(args)
 
@@ -78,8 +78,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     report_parser.add_argument("--out", default="out/report", help="output directory (created)")
     report_parser.set_defaults(func=report)
-    from app.export import add_export_html_arguments
-    from app.screenshot import add_screenshot_arguments
+    from poinsot.app.exports.export import add_export_html_arguments
+    from poinsot.app.exports.screenshot import add_screenshot_arguments
 
     screenshot_parser = sub.add_parser(
         "screenshot", help="a PNG of a scene, rendered by headless Chromium"
@@ -99,5 +99,5 @@ def main(argv: Sequence[str] | None = None) -> int:
     return int(args.func(args))
 
 
-if __name__ == "__main__":  # python -m app.cli behaves as python -m app and poinsot
+if __name__ == "__main__":  # python -m poinsot.app.cli behaves as python -m poinsot.app and poinsot
     raise SystemExit(main())

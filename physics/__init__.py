@@ -9,9 +9,9 @@ regime, plus the geometry of Poinsot's construction (polhode, herpolhode, invari
     (2, 3)
 """
 
-from physics.regime import Regime
-from physics.rigid_body import FreeRigidBody, attitude_with_L_along_z, omega_from_energy
-from physics.solids import box_dimensions, check_real_body
+from poinsot.physics.regime import Regime
+from poinsot.physics.rigid_body import FreeRigidBody, attitude_with_L_along_z, omega_from_energy
+from poinsot.physics.solids import box_dimensions, check_real_body
 
 __all__ = [
     "FreeRigidBody",

@@ -42,8 +42,8 @@ import numpy as np
 from scipy import special
 from scipy.spatial.transform import Rotation
 
-from physics import elliptic, precise
-from physics.regime import Regime
+from poinsot.physics import elliptic, precise
+from poinsot.physics.regime import Regime
 
 __all__ = ["FreeRigidBody", "omega_from_energy", "attitude_with_L_along_z"]
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from physics.rigid_body import _check_inertia
+from poinsot.physics.rigid_body import _check_inertia
 
 __all__ = ["check_real_body", "box_dimensions"]
 

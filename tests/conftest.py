@@ -25,12 +25,12 @@ from collections.abc import Callable, Iterator
 
 import numpy as np
 import pytest
-
-from app.presets import DEFAULT_PRESET, Preset
-from app.probe import Probe
-from app.screenshot import CHROMIUM_ARGS, CHROMIUM_ENV, DEFAULT_CHROMIUM
-from app.server import PoinsotApp
-from app.session import Session
+from poinsot.app.exports.screenshot import CHROMIUM_ARGS, CHROMIUM_ENV, DEFAULT_CHROMIUM
+from poinsot.app.live.lecture import LectureControls
+from poinsot.app.live.probe import Probe
+from poinsot.app.live.server import PoinsotApp
+from poinsot.app.live.session import Session
+from poinsot.app.presets import DEFAULT_PRESET, Preset
 
 CHROMIUM = os.environ.get(CHROMIUM_ENV, DEFAULT_CHROMIUM)
 #: Console messages that are not errors of ours (they are emitted at "warning" level anyway;
@@ -116,6 +116,13 @@ def session_of(app: PoinsotApp, count: int = 1, timeout: float = 10.0) -> Sessio
     sessions = app.wait_for_sessions(count, timeout)
     assert len(sessions) >= count, f"only {len(sessions)} sessions"
     return max(sessions, key=lambda s: s.client.client_id)
+
+
+def lecture_of(session: Session) -> LectureControls:
+    """The session's lecture controls (mounted by the session itself)."""
+    lecture = getattr(session, "lecture", None)
+    assert isinstance(lecture, LectureControls), "the session did not mount the lecture panel"
+    return lecture
 
 
 def wait_until(predicate: Callable[[], bool], timeout: float = 10.0, poll: float = 0.02) -> bool:

@@ -9,7 +9,7 @@ Three references, each built without any code from ``physics/``:
   exactly and no digit is lost to cancellation near the separatrix. Jacobi functions come from
   ``mpmath.ellipfun`` after an explicit argument reduction modulo ``2K`` done at high precision;
   the precession angle from ``mpmath.ellippi`` (Landau 37.16 integrated in closed form).
-  ``tests/test_physics_reference.py`` proves this reference by (a) plugging it into Euler's
+  ``tests/physics/test_reference.py`` proves this reference by (a) plugging it into Euler's
   equations and ``R' = R [omega]x`` with high-precision numerical derivatives, (b) comparing it
   with DOP853, and (c) comparing the ``ellippi`` precession angle with a direct quadrature.
 * :func:`integrate_dop853` -- scipy's DOP853 on Euler's equations plus the rotation-matrix
@@ -106,7 +106,7 @@ scaled by |omega0|, R entries <= 1)."""
 
 DOP853_FEW_PERIODS_ATOL = 3e-11
 """What DOP853 at rtol 1e-13 actually achieves over ~3 periods on a generic body, measured
-against the mpmath reference (self-test ``test_physics_reference.py``): a few 1e-12 growing with
+against the mpmath reference (self-test ``physics/test_reference.py``): a few 1e-12 growing with
 t (PHYSICS.md: error ~ t^2). Omega relative to |omega0| and attitude in rad."""
 
 

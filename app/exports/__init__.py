@@ -1,0 +1,1 @@
+"""Offline exports: CSV, GLB, standalone HTML and PNG screenshots."""

@@ -1,0 +1,406 @@
+"""PNG pictures of the scene: the renders themselves, and ``poinsot screenshot``.
+
+A picture is rendered by a browser (viser's ``get_render``: WebGL, at any size, without the
+control panel or notices), comes back RGBA with a transparent background, and is laid on the
+theme's background colour unless a transparent PNG is asked for (:func:`png_bytes`).
+
+``poinsot screenshot`` starts a :class:`app.stage.Stage` (the app's own scene construction on a
+viser server at a free port), seeks it to the requested time, opens it in headless Chromium
+through playwright, renders, and writes the PNG. The camera is a named view
+(:mod:`app.cameras`); unless ``--no-fit`` is given, its field of view is then narrowed so that
+the construction fills the picture (narrowing the field of view scales the image about its
+centre, so one small probe render tells the exact factor). Chromium and the server are
+stopped in ``finally`` blocks, and SIGTERM is turned into a normal exit so that they are also
+stopped when the command is killed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import io
+import math
+import os
+import pathlib
+import re
+import shutil
+import signal
+import sys
+import time
+from collections.abc import Iterator
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from poinsot.app.scene.cameras import CAMERA_NAMES, space_view
+from poinsot.app.scene.frames import wxyz as to_wxyz
+from poinsot.app.presets import PRESETS, Preset, preset_by_key
+from poinsot.app.scene.view import View
+
+RGB = tuple[int, int, int]
+
+#: The canvas background of viser's themes (measured in Chromium: dark #141414, light white).
+THEME_BACKGROUND: dict[bool, RGB] = {True: (20, 20, 20), False: (255, 255, 255)}
+#: Size choices of the in-app button: label -> (width, height), None = the browser's view.
+SIZE_CHOICES: dict[str, tuple[int, int] | None] = {
+    "current view": None,
+    "1920×1080": (1920, 1080),
+    "3840×2160": (3840, 2160),
+}
+#: Largest picture a render may ask for (WebGL drawing buffers beyond this fail on most GPUs).
+MAX_SIDE = 8192
+
+#: Where Chromium is looked for (the same variable as the test suite's), then the PATH.
+CHROMIUM_ENV = "POINSOT_CHROMIUM"
+DEFAULT_CHROMIUM = "/usr/bin/chromium"
+#: Flags for headless Chromium here: root, WebGL through SwiftShader, and nothing past loopback.
+#: Every host name but 127.0.0.1 resolves to nothing, so no DNS query leaves the machine, and
+#: the background services that would phone home (component and safe-browsing updates, sync,
+#: metrics, domain reliability, translation, media router, network prediction) are off.
+#: What remains is Chromium's IPv6 route probe, a UDP connect() that sends no datagram (no flag
+#: turns it off); the loopback test checks that it stays silent.
+LOOPBACK_ONLY = "MAP * ~NOTFOUND , EXCLUDE 127.0.0.1"
+CHROMIUM_ARGS = (
+    "--no-sandbox",
+    "--disable-gpu",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    f"--host-resolver-rules={LOOPBACK_ONLY}",
+    "--no-proxy-server",
+    "--disable-quic",
+    "--dns-prefetch-disable",
+    "--no-first-run",
+    "--no-default-browser-check",
+    "--no-pings",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--disable-default-apps",
+    "--disable-extensions",
+    "--disable-breakpad",
+    "--disable-domain-reliability",
+    "--disable-client-side-phishing-detection",
+    "--safebrowsing-disable-auto-update",
+    "--metrics-recording-only",
+    "--disable-features=NetworkPrediction,OptimizationHints,MediaRouter,DialMediaRouteProvider,"
+    "Translate,AutofillServerCommunication,CertificateTransparencyComponentUpdater,AsyncDns",
+)
+INSTALL_HINT = (
+    "Install it with `sudo apt-get install chromium` (Debian/Ubuntu; `make chromium` does the "
+    f"same), or set {CHROMIUM_ENV} to a Chromium or Chrome executable."
+)
+#: Exit code when Chromium (or playwright) is missing.
+EXIT_NO_BROWSER = 3
+
+#: The browser's window height in CSS pixels. Labels are sized in screen pixels of the live
+#: window, so in a render they take (label size / window height) of the picture, whatever its
+#: resolution: 720 gives the proportions of the app on a laptop screen. The device scale factor
+#: follows the picture's height (up to 2) so that the labels' textures stay sharp.
+WINDOW_HEIGHT = 720
+MAX_WINDOW_SCALE = 2.0
+#: Probe renders (to wait until the scene is complete, and to measure the framing) have at
+#: most this width.
+PROBE_WIDTH = 480
+#: The construction fills this fraction of the picture's half-width or half-height.
+FIT_FILL = 0.9
+#: Seconds to wait for the page, for one render, and for the scene to settle.
+PAGE_TIMEOUT = 60.0
+RENDER_TIMEOUT = 120.0
+SETTLE_TIMEOUT = 90.0
+
+
+# -- pictures -------------------------------------------------------------------------------
+def png_bytes(rgba: np.ndarray, background: RGB | None) -> bytes:
+    """Encode a render as PNG: laid on ``background`` (opaque RGB), or kept RGBA (None)."""
+    from PIL import Image
+
+    image = Image.fromarray(np.ascontiguousarray(rgba, dtype=np.uint8), mode="RGBA")
+    if background is not None:
+        ground = Image.new("RGBA", image.size, (*background, 255))
+        image = Image.alpha_composite(ground, image).convert("RGB")
+    out = io.BytesIO()
+    image.save(out, format="PNG", optimize=False)
+    return out.getvalue()
+
+
+def filename(scene: str, t: float, suffix: str = "png") -> str:
+    """``poinsot_<scene>_t<time>.<suffix>``, safe on every file system."""
+    safe = re.sub(r"[^A-Za-z0-9_-]+", "-", scene).strip("-") or "scene"
+    return f"poinsot_{safe}_t{t:.2f}.{suffix}"
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``"1920x1080"`` (or with ×) -> (1920, 1080)."""
+    match = re.fullmatch(r"\s*(\d+)\s*[x×X]\s*(\d+)\s*", text)
+    if not match:
+        raise ValueError(f"size must look like 1920x1080, got {text!r}")
+    width, height = int(match.group(1)), int(match.group(2))
+    if not (16 <= width <= MAX_SIDE and 16 <= height <= MAX_SIDE):
+        raise ValueError(f"each side must be between 16 and {MAX_SIDE} pixels")
+    return width, height
+
+
+def camera_wxyz(view: View) -> np.ndarray:
+    """Orientation of a camera at ``view`` in viser's (OpenCV) convention: camera x right,
+    y down, z forward; the columns of its matrix are these axes in world coordinates."""
+    forward = np.subtract(view.look_at, view.position).astype(np.float64)
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, view.up)
+    if np.linalg.norm(right) < 1e-9:
+        raise ValueError("the camera's up direction is parallel to its view direction")
+    right /= np.linalg.norm(right)
+    down = np.cross(forward, right)
+    return to_wxyz(Rotation.from_matrix(np.column_stack([right, down, forward])))
+
+
+def content_extent(rgba: np.ndarray) -> float:
+    """How far the drawn content reaches from the picture's centre: the largest of its
+    horizontal and vertical reach, as a fraction of the half-width and half-height (0 for an
+    empty picture)."""
+    alpha = rgba[..., 3] > 8
+    if not alpha.any():
+        return 0.0
+    height, width = alpha.shape
+    rows = np.flatnonzero(alpha.any(axis=1))
+    cols = np.flatnonzero(alpha.any(axis=0))
+    x = max(abs(cols[0] - width / 2), abs(cols[-1] + 1 - width / 2)) / (width / 2)
+    y = max(abs(rows[0] - height / 2), abs(rows[-1] + 1 - height / 2)) / (height / 2)
+    return float(max(x, y))
+
+
+def fitted_fov(fov: float, extent: float, fill: float = FIT_FILL) -> float:
+    """The vertical field of view that scales content reaching ``extent`` to ``fill``: image
+    coordinates scale with 1 / tan(fov / 2) about the centre."""
+    if extent <= 0.0:
+        return fov
+    return 2.0 * math.atan(math.tan(fov / 2.0) * extent / fill)
+
+
+# -- headless Chromium ----------------------------------------------------------------------
+class BrowserMissing(RuntimeError):
+    """Chromium or the playwright package is not installed."""
+
+
+def find_chromium() -> str:
+    """The Chromium executable, or BrowserMissing with how to install it."""
+    wanted = os.environ.get(CHROMIUM_ENV, DEFAULT_CHROMIUM)
+    candidates = [wanted] if os.environ.get(CHROMIUM_ENV) else [wanted, "chromium"]
+    for candidate in candidates:
+        path = candidate if os.path.isabs(candidate) else shutil.which(candidate)
+        if path and os.path.isfile(path) and os.access(path, os.X_OK):
+            return path
+    raise BrowserMissing(f"Chromium was not found (looked for {wanted}). {INSTALL_HINT}")
+
+
+@contextlib.contextmanager
+def sigterm_exits() -> Iterator[None]:
+    """Turn SIGTERM into SystemExit for the duration, so that ``finally`` blocks (which stop
+    Chromium and the server) run when the command is killed. Main thread only."""
+    previous = signal.getsignal(signal.SIGTERM)
+
+    def handler(signum, frame):
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextlib.contextmanager
+def headless_chromium(executable: str) -> Iterator[object]:
+    """A launched playwright Browser; closed (and its processes gone) on exit."""
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError as exc:
+        raise BrowserMissing(
+            "the playwright Python package is missing: pip install playwright "
+            "(no `playwright install` needed; it drives the system Chromium)"
+        ) from exc
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(
+            executable_path=executable, headless=True, args=list(CHROMIUM_ARGS)
+        )
+        try:
+            yield browser
+        finally:
+            browser.close()
+
+
+@dataclasses.dataclass
+class Shot:
+    """What :func:`capture` did (printed by the CLI, checked by tests)."""
+
+    png: bytes
+    width: int
+    height: int
+    fov_degrees: float
+    seconds: float
+
+
+def _wait_for_client(stage, timeout: float):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        clients = stage.server.get_clients()
+        if clients:
+            return next(iter(clients.values()))
+        time.sleep(0.05)
+    raise TimeoutError("the browser did not connect to the scene server")
+
+
+def capture(
+    stage,
+    view: View,
+    size: tuple[int, int],
+    *,
+    chromium: str,
+    background: RGB | None,
+    fit: bool = True,
+) -> Shot:
+    """Open ``stage`` in headless Chromium and render it from ``view`` at ``size``."""
+    start = time.perf_counter()
+    width, height = size
+    probe_w = min(width, PROBE_WIDTH)
+    probe_h = max(16, round(height * probe_w / width))
+    position = np.asarray(view.position, dtype=np.float64)
+    orientation = camera_wxyz(view)
+    fov = math.radians(view.fov_degrees)
+    with headless_chromium(chromium) as browser:
+        window = {"width": max(16, round(WINDOW_HEIGHT * width / height)), "height": WINDOW_HEIGHT}
+        scale = min(MAX_WINDOW_SCALE, max(1.0, height / WINDOW_HEIGHT))
+        context = browser.new_context(viewport=window, device_scale_factor=scale)  # type: ignore[attr-defined]
+        page = context.new_page()
+        page.goto(stage.url, timeout=PAGE_TIMEOUT * 1000)
+        client = _wait_for_client(stage, PAGE_TIMEOUT)
+
+        def render(w: int, h: int, fov_: float) -> np.ndarray:
+            return client.get_render(
+                h,
+                w,
+                wxyz=orientation,
+                position=position,
+                fov=fov_,
+                transport_format="png",
+                timeout=RENDER_TIMEOUT,
+            )
+
+        # The browser decodes meshes asynchronously: render until two probes agree.
+        deadline = time.monotonic() + SETTLE_TIMEOUT
+        previous = render(probe_w, probe_h, fov)
+        while True:
+            current = render(probe_w, probe_h, fov)
+            if np.array_equal(current, previous) and current[..., 3].any():
+                break
+            if time.monotonic() > deadline:
+                raise TimeoutError("the scene did not settle in the browser")
+            previous = current
+        if fit:
+            fov = fitted_fov(fov, content_extent(current))
+        rgba = render(width, height, fov)
+    if rgba.shape[:2] != (height, width):
+        raise RuntimeError(
+            f"the browser returned {rgba.shape[1]}x{rgba.shape[0]}, not {width}x{height}"
+        )
+    return Shot(
+        png_bytes(rgba, background), width, height, math.degrees(fov), time.perf_counter() - start
+    )
+
+
+# -- the command ----------------------------------------------------------------------------
+def resolve_scene(name: str) -> Preset:
+    """A scene by preset key or label (case-insensitive)."""
+    for preset in PRESETS:
+        if name.lower() in (preset.key.lower(), preset.label.lower()):
+            return preset
+    return preset_by_key(name)  # raises KeyError listing the choices
+
+
+def default_time(period: float) -> float:
+    """One period of omega (the polhode closes), or 20 time units where there is none."""
+    return period if math.isfinite(period) and 0 < period <= 120 else 20.0
+
+
+def add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument(
+        "--preset", choices=[p.key for p in PRESETS], help="scene to draw (default: the first)"
+    )
+    which.add_argument(
+        "--scene", metavar="NAME", help="scene by preset key or label, e.g. 'Sphere (a cube)'"
+    )
+    parser.add_argument(
+        "--time",
+        type=float,
+        default=None,
+        help="simulation time of the picture (default: one period of omega)",
+    )
+    parser.add_argument("--size", default="1920x1080", help="WIDTHxHEIGHT in pixels")
+    parser.add_argument(
+        "--view",
+        choices=CAMERA_NAMES,
+        default="default",
+        help="camera: the scene's default view, along L (top), side, or fixed in the body",
+    )
+    parser.add_argument(
+        "--background",
+        choices=("dark", "light", "transparent"),
+        default="dark",
+        help="opaque dark or light theme background, or a transparent PNG",
+    )
+    parser.add_argument(
+        "--no-fit",
+        dest="fit",
+        action="store_false",
+        help="keep the view's field of view instead of framing the construction",
+    )
+    parser.add_argument("--out", required=True, help="output .png file")
+
+
+def screenshot_command(args: argparse.Namespace) -> int:
+    """``poinsot screenshot``: 0 on success, EXIT_NO_BROWSER without Chromium, 1 on failure."""
+    from poinsot.app.exports.stage import Stage
+
+    try:
+        chromium = find_chromium()
+    except BrowserMissing as exc:
+        print(f"poinsot screenshot: {exc}", file=sys.stderr)
+        return EXIT_NO_BROWSER
+    try:
+        size = parse_size(args.size)
+        preset = resolve_scene(args.scene or args.preset or PRESETS[0].key)
+    except (ValueError, KeyError) as exc:
+        print(f"poinsot screenshot: {exc}", file=sys.stderr)
+        return 2
+    out = pathlib.Path(args.out)
+    with sigterm_exits():
+        stage = Stage.from_preset(preset, dark_mode=args.background != "light")
+        try:
+            t = args.time if args.time is not None else default_time(float(stage.body.period))
+            frame = stage.seek(t)
+            view = space_view(args.view, frame.wxyz)
+            stage.set_initial_camera(view)
+            background = (
+                None
+                if args.background == "transparent"
+                else THEME_BACKGROUND[args.background == "dark"]
+            )
+            shot = capture(
+                stage, view, size, chromium=chromium, background=background, fit=args.fit
+            )
+        except BrowserMissing as exc:
+            print(f"poinsot screenshot: {exc}", file=sys.stderr)
+            return EXIT_NO_BROWSER
+        except Exception as exc:  # the command's boundary: say what failed, exit non-zero
+            print(f"poinsot screenshot: failed: {type(exc).__name__}: {exc}", file=sys.stderr)
+            return 1
+        finally:
+            stage.stop()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_bytes(shot.png)
+    print(
+        f"wrote {out} ({shot.width}x{shot.height}, scene {preset.key}, t = {t:g}, "
+        f"view {args.view}, fov {shot.fov_degrees:.1f} deg) in {shot.seconds:.1f} s"
+    )
+    return 0

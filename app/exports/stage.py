@@ -1,0 +1,121 @@
+"""A stage: one body drawn by the app's own construction on a viser server's *shared* scene,
+with no control panel and no session.
+
+What the standalone HTML export records and what ``poinsot screenshot`` photographs: the same
+:class:`app.scene.PoinsotScene` the live app draws for each browser, driven here by explicit
+times instead of a clock, so that a picture at time T or a clip of S seconds is reproducible.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import warnings
+
+import numpy as np
+import viser
+
+from poinsot.app.parameters import Parameters
+from poinsot.app.presets import Element, Preset, Solid
+from poinsot.app.scene.construction import Frame, PoinsotScene
+from poinsot.app.scene.view import View, apply_lighting, configure_theme
+
+#: Largest step of simulation time between two trail updates while seeking [time units]. The
+#: scene resamples every step by chord length (at most 48 points a step), so this only bounds
+#: how much motion one step may cover.
+SEEK_STEP = 0.05
+#: Seeking to time T replays at most this much simulation time before T: enough to fill any
+#: trail the presets declare (up to 6000 points at chord 0.02 display units).
+SEEK_WINDOW = 250.0
+
+
+class Stage:
+    """Create, :meth:`seek` or :meth:`advance`, then :meth:`stop` (or use ``with``)."""
+
+    def __init__(
+        self,
+        params: Parameters,
+        solid: Solid | None,
+        elements: frozenset[Element],
+        *,
+        trail_points: int = 1200,
+        dark_mode: bool = True,
+        host: str = "127.0.0.1",
+        port: int = 0,
+    ) -> None:
+        """Raises ValueError (from physics or the scene) for parameters that describe no body."""
+        body = params.build()
+        self.params = params
+        self.dark_mode = dark_mode
+        # viser prints a "listening" banner (and "Server stopped"): noise from a stage, which
+        # nobody browses by hand, so it is swallowed.
+        with contextlib.redirect_stdout(io.StringIO()):
+            self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        try:
+            warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection")
+            configure_theme(self.server.gui, dark_mode=dark_mode)
+            self.server.scene.world_axes.visible = False
+            apply_lighting(self.server.scene)  # as each browser of the app is lit
+            self.scene = PoinsotScene(
+                self.server.scene, elements, trail_points, atomic=self.server.atomic
+            )
+            self.frame: Frame = self.scene.load(body, solid, t=0.0)
+        except BaseException:
+            self.stop()
+            raise
+        self.body = body
+        self.solid = solid
+
+    @classmethod
+    def from_preset(cls, preset: Preset, **kwargs) -> Stage:
+        kwargs.setdefault("trail_points", preset.trail_points)
+        return cls(Parameters.from_preset(preset), preset.solid, preset.elements, **kwargs)
+
+    # -- context manager -----------------------------------------------------------------
+    def __enter__(self) -> Stage:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    def stop(self) -> None:
+        with contextlib.redirect_stdout(io.StringIO()):
+            self.server.stop()
+
+    @property
+    def url(self) -> str:
+        return f"http://{self.server.get_host()}:{self.server.get_port()}"
+
+    # -- time ----------------------------------------------------------------------------
+    @property
+    def t(self) -> float:
+        return self.frame.t
+
+    def advance(self, t: float) -> Frame:
+        """Pose the body at ``t`` and extend the traces (one animation frame)."""
+        self.frame = self.scene.advance(float(t))
+        return self.frame
+
+    def seek(self, t: float) -> Frame:
+        """Show time ``t`` as a running app would: the traces drawn up to ``t``."""
+        t = float(t)
+        if not math.isfinite(t) or t < 0.0:
+            raise ValueError(f"the time must be a finite number >= 0, got {t}")
+        start = max(0.0, t - SEEK_WINDOW)
+        if t < self.frame.t or start > self.frame.t:
+            # Restart the traces at ``start`` instead of drawing one long chord to it.
+            self.frame = self.scene.load(self.body, self.solid, t=start)
+        steps = max(1, math.ceil((t - self.frame.t) / SEEK_STEP))
+        for tt in np.linspace(self.frame.t, t, steps + 1)[1:]:
+            self.advance(float(tt))
+        return self.frame
+
+    # -- camera --------------------------------------------------------------------------
+    def set_initial_camera(self, view: View) -> None:
+        """The camera every browser opening the stage (or a recording of it) starts with."""
+        camera = self.server.initial_camera
+        camera.up = view.up
+        camera.position = view.position
+        camera.look_at = view.look_at
+        camera.fov = math.radians(view.fov_degrees)

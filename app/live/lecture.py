@@ -1,0 +1,251 @@
+"""Lecture comfort and exports in one session's panel: screenshot, CSV and GLB downloads, camera
+presets (along L, side, ride-along in the body frame), dark/light theme, projector-sized text
+and keyboard shortcuts.
+
+A session mounts everything with one call, :func:`add_lecture_controls`, and calls
+:meth:`LectureControls.on_frame` after drawing each frame (the ride-along camera follows the
+attitude there).
+
+Keyboard shortcuts use viser 1.1's command palette (``GuiApi.add_command(hotkey=...)``): the
+browser fires them while the page has focus and no text field is being edited. Space
+plays/pauses, 1-4 choose the camera views. The commands are also listed in the palette
+(Ctrl/Cmd+K).
+
+Threads: button callbacks run on viser's thread pool. A screenshot waits there for the
+browser's render, bounded by ``render_timeout``; one render at a time per session, and every
+failure ends in a message in the panel, never in a hang. The data come from the session's
+body and clock (physics), never from the drawing.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Protocol
+
+import viser
+
+from poinsot.app.exports import export
+from poinsot.app.scene.cameras import BODY_VIEW, CAMERA_LABELS, ride_along, space_view
+from poinsot.app.live.clock import SimClock
+from poinsot.app.presets import Preset
+from poinsot.app.scene.construction import Frame, PoinsotScene
+from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
+from poinsot.app.scene.view import View, configure_theme
+from poinsot.physics import FreeRigidBody
+
+#: Seconds a screenshot waits for the browser's render. A GPU browser answers a 4K render in
+#: about a second; software WebGL on a loaded machine has been measured at up to 30 s.
+RENDER_TIMEOUT = 60.0
+#: Root font size of the "large text" mode: every panel size is in rem, so all text scales.
+LARGE_TEXT_PERCENT = 130
+#: Order of the lecture folder in the panel (after the session's own groups).
+FOLDER_ORDER = 70.0
+#: Hotkeys of the camera views, in CAMERA_LABELS order.
+CAMERA_HOTKEYS = ("1", "2", "3", "4")
+
+
+class LectureSession(Protocol):
+    """What the lecture controls use of a session."""
+
+    client: viser.ClientHandle
+    clock: SimClock
+    preset: Preset
+    body: FreeRigidBody | None
+    frame: Frame | None
+    scene: PoinsotScene
+
+    def toggle_pause(self) -> None: ...
+
+
+def large_text_css(enabled: bool) -> str:
+    """A style element that scales the page's root font size (empty when disabled)."""
+    if not enabled:
+        return ""
+    return f"<style>html {{ font-size: {LARGE_TEXT_PERCENT}% !important; }}</style>"
+
+
+class LectureControls:
+    def __init__(
+        self,
+        session: LectureSession,
+        *,
+        render_timeout: float = RENDER_TIMEOUT,
+        order: float = FOLDER_ORDER,
+    ) -> None:
+        self.session = session
+        self.client = session.client
+        self.render_timeout = float(render_timeout)
+        self.dark_mode = True
+        self.large_text = False
+        self.camera = "default"
+        self._render_lock = threading.Lock()
+        self.last_download: str = ""  # name of the last file handed to the browser
+        gui = self.client.gui
+        labels = list(CAMERA_LABELS.values())
+        with gui.add_folder("Lecture: views and export", order=order):
+            self.views = gui.add_button_group(
+                "Camera", labels, hint="¾ view, along L (top), side, or riding on the body. "
+                "Keys 1-4."
+            )
+            self.size = gui.add_dropdown(
+                "Picture size", tuple(SIZE_CHOICES), initial_value=next(iter(SIZE_CHOICES)),
+                hint="Pixels of the PNG; 'current view' is the size of the 3D view.",
+            )
+            self.transparent = gui.add_checkbox(
+                "Transparent PNG", False, hint="Leave the background transparent (for slides)."
+            )
+            self.screenshot = gui.add_button("Screenshot (PNG)", icon=viser.Icon.CAMERA)
+            self.csv = gui.add_button(
+                "Data: t, ω, q (CSV)", icon=viser.Icon.TABLE_EXPORT,
+                hint="The run so far (one period if it has just started), exact solution.",
+            )
+            self.glb = gui.add_button(
+                "Mesh: ellipsoid, plane, curves (GLB)", icon=viser.Icon.CUBE,
+                hint="For Blender or any glTF viewer.",
+            )
+            self.dark = gui.add_checkbox("Dark theme", True)
+            self.large = gui.add_checkbox(
+                "Large text (projector)", False, hint="Scales every text of the panel."
+            )
+            self.message = gui.add_markdown("")
+            gui.add_markdown("<small>Keys: **space** play/pause · **1-4** camera views</small>")
+            self.style = gui.add_html("")
+
+        self.views.on_click(lambda event: self._on_view(event))
+        self.screenshot.on_click(lambda event: self.take_screenshot())
+        self.csv.on_click(lambda event: self.download_csv())
+        self.glb.on_click(lambda event: self.download_glb())
+        self.dark.on_update(lambda event: self.set_theme(dark=bool(event.target.value)))
+        self.large.on_update(lambda event: self.set_theme(large=bool(event.target.value)))
+
+        self.commands = [gui.add_command("Play / pause", hotkey="space",
+                                         icon=viser.Icon.PLAYER_PLAY)]
+        self.commands[0].on_trigger(lambda event: session.toggle_pause())
+        for key, (name, label) in zip(CAMERA_HOTKEYS, CAMERA_LABELS.items(), strict=True):
+            command = gui.add_command(f"Camera: {label}", hotkey=key, icon=viser.Icon.CAMERA)
+            command.on_trigger(lambda event, name=name: self.set_camera(name))
+            self.commands.append(command)
+
+    # -- messages ------------------------------------------------------------------------
+    def show(self, text: str, error: bool = False) -> None:
+        self.message.content = f"**⚠ {text}**" if error else text
+
+    # -- camera --------------------------------------------------------------------------
+    def _on_view(self, event: viser.GuiEvent) -> None:
+        for name, label in CAMERA_LABELS.items():
+            if label == event.target.value:
+                self.set_camera(name)
+
+    def set_camera(self, name: str) -> None:
+        """Move this browser's camera to a preset; "body" rides along from now on."""
+        if name not in CAMERA_LABELS:
+            raise ValueError(f"no camera view {name!r}")
+        self.camera = name
+        if name == "body":
+            frame = self.session.frame
+            if frame is not None:
+                self._apply(ride_along(BODY_VIEW, frame.wxyz))
+            return
+        self._apply(space_view(name))
+
+    def _apply(self, view: View) -> None:
+        with self.client.atomic():
+            view.apply(self.client.camera)
+
+    def on_frame(self, frame: Frame) -> None:
+        """Per frame (the session's frame thread): carry the ride-along camera."""
+        if self.camera == "body":
+            self._apply(ride_along(BODY_VIEW, frame.wxyz))
+
+    # -- theme ---------------------------------------------------------------------------
+    def set_theme(self, dark: bool | None = None, large: bool | None = None) -> None:
+        if dark is not None:
+            self.dark_mode = dark
+        if large is not None:
+            self.large_text = large
+        configure_theme(self.client.gui, dark_mode=self.dark_mode, large_controls=self.large_text)
+        self.style.content = large_text_css(self.large_text)
+
+    # -- exports -------------------------------------------------------------------------
+    def _now(self) -> tuple[FreeRigidBody, float, str]:
+        body = self.session.scene.body or self.session.body
+        if body is None:
+            raise RuntimeError("no body is loaded yet")
+        return body, float(self.session.clock.now()), self.session.preset.key
+
+    def picture_size(self) -> tuple[int, int]:
+        """(width, height) chosen in the dropdown; the 3D view's size for 'current view'."""
+        size = SIZE_CHOICES.get(self.size.value)
+        if size is not None:
+            return size
+        camera = self.client.camera
+        try:
+            width, height = int(camera.image_width), int(camera.image_height)
+        except AssertionError:  # the browser has not reported its view yet
+            width = height = 0
+        if width <= 0 or height <= 0:
+            raise RuntimeError("the browser has not reported the size of its view yet")
+        return width, height
+
+    def take_screenshot(self) -> str | None:
+        """Render the current view at the chosen size and hand the PNG to the browser. Returns
+        the file name, or None (with a message in the panel) on failure."""
+        if not self._render_lock.acquire(blocking=False):
+            self.show("A screenshot is already being rendered.")
+            return None
+        self.screenshot.disabled = True
+        try:
+            width, height = self.picture_size()
+            _, t, key = self._now()
+            self.show(f"Rendering {width}×{height} …")
+            start = time.perf_counter()
+            rgba = self.client.get_render(
+                height, width, transport_format="png", timeout=self.render_timeout
+            )
+            background = None if self.transparent.value else THEME_BACKGROUND[self.dark_mode]
+            name = filename(key, t)
+            self.client.send_file_download(name, png_bytes(rgba, background), save_immediately=True)
+            self.last_download = name
+            self.show(f"Saved **{name}** ({width}×{height}, {time.perf_counter() - start:.1f} s).")
+            return name
+        except TimeoutError:
+            self.show(
+                f"Screenshot failed: the browser did not return the picture within "
+                f"{self.render_timeout:g} s. Try a smaller size.", error=True,
+            )
+        except Exception as exc:  # the GUI boundary: report, never raise into viser
+            self.show(f"Screenshot failed: {type(exc).__name__}: {exc}", error=True)
+        finally:
+            self.screenshot.disabled = False
+            self._render_lock.release()
+        return None
+
+    def download_csv(self) -> str | None:
+        return self._download("csv", lambda body, t, key: export.run_csv(
+            body, export.run_span(body, t), name=key, source=self.session.preset.source
+        ).encode("utf-8"))
+
+    def download_glb(self) -> str | None:
+        return self._download("glb", lambda body, t, key: export.scene_glb(
+            body, t, geometry=self.session.scene.geometry
+        ))
+
+    def _download(self, suffix: str, make) -> str | None:
+        try:
+            body, t, key = self._now()
+            data = make(body, t, key)
+            name = filename(key, t, suffix)
+            self.client.send_file_download(name, data, save_immediately=True)
+            self.last_download = name
+            self.show(f"Saved **{name}** ({len(data) / 1e3:.0f} kB).")
+            return name
+        except Exception as exc:  # the GUI boundary: report, never raise into viser
+            self.show(f"{suffix.upper()} export failed: {type(exc).__name__}: {exc}", error=True)
+            return None
+
+
+def add_lecture_controls(session: LectureSession, **kwargs) -> LectureControls:
+    """Mount the lecture folder and hotkeys on ``session``'s panel; keep the returned object
+    and call its ``on_frame(frame)`` after each frame."""
+    return LectureControls(session, **kwargs)

@@ -1,0 +1,109 @@
+"""The viser server and its sessions: one :class:`~app.session.Session` per browser."""
+
+from __future__ import annotations
+
+import threading
+import warnings
+
+import viser
+
+from poinsot.app.live.budget import FrameBudget
+from poinsot.app.presets import DEFAULT_PRESET, Preset
+from poinsot.app.live.session import MAX_FPS, Session
+
+
+class PoinsotApp:
+    """Serve the Poinsot scene: each connecting browser gets its own session."""
+
+    def __init__(
+        self,
+        host: str = "127.0.0.1",
+        port: int = 8080,
+        *,
+        preset: Preset = DEFAULT_PRESET,
+        max_fps: float = MAX_FPS,
+        verbose: bool = False,
+    ) -> None:
+        self.preset = preset
+        self.max_fps = max_fps
+        self._lock = threading.Lock()
+        self._sessions: dict[int, Session] = {}
+        # Clients whose disconnect arrived while their session was still being built: viser runs
+        # sync callbacks on a thread pool, so the disconnect handler may run before (or while)
+        # the connect handler builds the session. Both handlers decide under ``_lock``.
+        self._departed: set[int] = set()
+        #: Sessions built for a client that had already left, closed before they started.
+        self.discarded = 0
+        self._connected = threading.Condition(self._lock)
+        self.budget = FrameBudget(max_fps=max_fps)
+        self.server = viser.ViserServer(host=host, port=port, verbose=verbose)
+        self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
+        self.server.scene.world_axes.visible = False
+        # A session's frame thread may draw one last frame between the browser leaving and the
+        # disconnect callback stopping it; viser then warns once that the message is dropped.
+        # That is expected here, not a leak: the thread stops right after.
+        warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection")
+        self.server.on_client_connect(self._connect)
+        self.server.on_client_disconnect(self._disconnect)
+
+    @property
+    def port(self) -> int:
+        return self.server.get_port()
+
+    @property
+    def url(self) -> str:
+        host = self.server.get_host()
+        shown = "localhost" if host in ("0.0.0.0", "::") else host
+        return f"http://{shown}:{self.port}"
+
+    def sessions(self) -> dict[int, Session]:
+        with self._lock:
+            return dict(self._sessions)
+
+    def wait_for_sessions(self, count: int, timeout: float = 10.0) -> list[Session]:
+        """Block until at least ``count`` sessions exist (tests, benchmark)."""
+        with self._connected:
+            self._connected.wait_for(lambda: len(self._sessions) >= count, timeout)
+            return list(self._sessions.values())
+
+    def _connect(self, client: viser.ClientHandle) -> None:
+        """Build the session outside the lock (30-300 ms), then register and start it under
+        the lock, unless the client left meanwhile: then it is closed and never started."""
+        with self._lock:
+            if client.client_id in self._departed:
+                self._departed.discard(client.client_id)
+                self.discarded += 1
+                return
+        session = Session(client, self.preset, max_fps=self.max_fps, budget=self.budget)
+        with self._connected:
+            if client.client_id in self._departed:
+                self._departed.discard(client.client_id)
+                self.discarded += 1
+                left = True
+            else:
+                left = False
+                self._sessions[client.client_id] = session
+                self.budget.set_sessions(len(self._sessions))
+                session.start()
+                self._connected.notify_all()
+        if left:
+            session.close()
+
+    def _disconnect(self, client: viser.ClientHandle) -> None:
+        with self._lock:
+            session = self._sessions.pop(client.client_id, None)
+            if session is None:  # its connect handler has not registered it (yet)
+                self._departed.add(client.client_id)
+            self.budget.set_sessions(len(self._sessions))
+        if session is not None:
+            session.close()
+
+    def pending_departures(self) -> int:
+        """Clients that left before their session was registered, not yet reconciled."""
+        with self._lock:
+            return len(self._departed)
+
+    def stop(self) -> None:
+        for session in self.sessions().values():
+            session.close(timeout=2.0)
+        self.server.stop()

@@ -1,0 +1,378 @@
+"""One browser's session: its parameters, clock, scene, control panel and frame thread.
+
+Threads: viser runs GUI callbacks on its thread pool; they only post small actions to this
+session's queue and wake its frame thread, which alone touches the scene and the body. So a
+callback never blocks and never raises into viser, a slider drag is coalesced into one rebuild
+per wake-up, and a slow or departed browser never stalls another (each session has its own
+thread; viser gives each client its own send buffer, where newer poses replace unsent ones).
+"""
+
+from __future__ import annotations
+
+import collections
+import dataclasses
+import logging
+import queue
+import threading
+import time
+from collections.abc import Callable
+
+import viser
+
+from poinsot.app.live import readouts
+from poinsot.app.live.budget import FrameBudget
+from poinsot.app.live.clock import SimClock
+from poinsot.app.live.ghost import add_ghost_controls
+from poinsot.app.live.lecture import add_lecture_controls
+from poinsot.app.live.panel import ControlPanel
+from poinsot.app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters
+from poinsot.app.presets import ALL_ELEMENTS, CUSTOM, DEFAULT_PRESET, Element, Preset, Solid
+from poinsot.app.scene.construction import Frame, PoinsotScene
+from poinsot.app.scene.view import DEFAULT_VIEW, View, apply_theme
+from poinsot.physics import FreeRigidBody, box_dimensions
+
+log = logging.getLogger(__name__)
+
+#: The animation rate cap per client [frames per second].
+MAX_FPS = 60.0
+#: Plot and time-readout refresh rates [Hz]: the plot resends its whole window.
+PLOT_HZ = 10.0
+TIME_HZ = 5.0
+#: "Step" advances this many wall seconds' worth of simulation time.
+STEP_SECONDS = 0.1
+#: While another session rebuilds, a due frame is retried after this long [s], and held for
+#: at most HOLD_SECONDS (so that many students dragging sliders never freeze the others).
+YIELD_SECONDS = 0.002
+HOLD_SECONDS = 0.05
+
+
+@dataclasses.dataclass
+class SessionStats:
+    """Timings for the benchmark and the tests (seconds)."""
+
+    frame_seconds: collections.deque = dataclasses.field(
+        default_factory=lambda: collections.deque(maxlen=2000)
+    )
+    #: CPU time of the session thread per loop pass that drew a frame: everything Poinsot
+    #: does for one client-frame (actions, physics, scene updates, plot and time readout, and
+    #: viser's setters that queue the messages), but not viser's transport thread.
+    frame_cpu_seconds: collections.deque = dataclasses.field(
+        default_factory=lambda: collections.deque(maxlen=2000)
+    )
+    rebuild_seconds: collections.deque = dataclasses.field(
+        default_factory=lambda: collections.deque(maxlen=500)
+    )
+    frames: int = 0
+    rebuilds: int = 0
+    errors: int = 0
+    last_error: str = ""
+
+
+class Session:
+    """Create on client connect (:meth:`start` launches the frame thread), :meth:`close` on
+    disconnect."""
+
+    def __init__(
+        self,
+        client: viser.ClientHandle,
+        preset: Preset = DEFAULT_PRESET,
+        *,
+        max_fps: float = MAX_FPS,
+        view: View = DEFAULT_VIEW,
+        budget: FrameBudget | None = None,
+    ) -> None:
+        """``budget``: the server's shared frame-rate governor (one per session if None)."""
+        self.client = client
+        self.max_fps = float(max_fps)
+        self.budget = budget if budget is not None else FrameBudget(max_fps=max_fps)
+        self.stats = SessionStats()
+        self.clock = SimClock(speed=preset.speed)
+        self.preset = preset
+        self._base = preset  # the last named preset: it supplies the solid
+        self.params = Parameters.from_preset(preset)
+        self._desired = self.params
+        self._dirty = True
+        self.body: FreeRigidBody | None = None
+        self.frame: Frame | None = None
+        self.status = ""
+        self._actions: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        self._wake = threading.Event()
+        self._stop = threading.Event()
+        self._applied = threading.Condition()
+        self._generation = 0  # bumped after each rebuild (tests wait on it)
+        self._thread: threading.Thread | None = None
+
+        apply_theme(client)
+        view.apply(client.camera)
+        self.scene = PoinsotScene(
+            client.scene, preset.elements, preset.trail_points, atomic=client.atomic
+        )
+        self.panel = ControlPanel(client.gui, self, preset)
+        self._apply_preset(preset)
+        self._rebuild()
+        # Exports, camera views, theme and hotkeys (issue 5) mount on the session's panel.
+        self.lecture = add_lecture_controls(self)
+        # The numerical ghost (issue 4): its controls now, the ghost itself only when switched on.
+        self.ghost = add_ghost_controls(self)
+
+    # -- lifecycle -----------------------------------------------------------------------
+    def start(self) -> Session:
+        thread = threading.Thread(
+            target=self._run, name=f"poinsot-session-{self.client.client_id}", daemon=True
+        )
+        thread.start()
+        self._thread = thread  # only a started thread is ever joined by close()
+        return self
+
+    def close(self, timeout: float | None = None) -> None:
+        """Stop the frame thread (never called from it). Safe to call twice."""
+        self._stop.set()
+        self._wake.set()
+        if timeout is not None and self._thread is not None:
+            if self._thread is not threading.current_thread():
+                self._thread.join(timeout)
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    # -- actions (any thread; never block) -----------------------------------------------
+    def _post(self, action: Callable[[], None]) -> None:
+        self._actions.put(action)
+        self._wake.set()
+
+    def choose_preset(self, preset: Preset) -> None:
+        self._post(lambda: self._apply_preset(preset))
+
+    def edit(self, change: Callable[[Parameters], Parameters]) -> None:
+        self._post(lambda: self._edit(change))
+
+    def set_speed(self, speed: float) -> None:
+        speed = min(max(float(speed), SPEED_RANGE[0]), SPEED_RANGE[1])
+
+        def action() -> None:
+            self.clock.speed = speed
+            self.scene.set_frame_time(self.frame_time)
+
+        self._post(action)
+
+    @property
+    def frame_time(self) -> float:
+        """Simulation time one frame advances at full frame rate."""
+        return self.clock.speed / self.max_fps
+
+    def toggle_pause(self) -> None:
+        self._post(self._toggle_pause)
+
+    def step(self) -> None:
+        self._post(self._step)
+
+    def reset(self) -> None:
+        self._post(self._reset)
+
+    def set_trail(self, points: int) -> None:
+        points = min(max(int(points), TRAIL_RANGE[0]), TRAIL_RANGE[1])
+
+        def action() -> None:
+            self.scene.trail_points = points
+
+        self._post(action)
+
+    def set_visible(self, element: Element, visible: bool) -> None:
+        self._post(lambda: self.scene.set_visible(element, visible))
+
+    def report(self, error: BaseException) -> None:
+        """Show an error raised outside the frame thread (a GUI callback)."""
+        self._post(lambda: self._report(error))
+
+    def wait_applied(self, generation: int, timeout: float = 5.0) -> int:
+        """Block (tests, benchmark) until a rebuild after ``generation`` was applied."""
+        with self._applied:
+            self._applied.wait_for(lambda: self._generation > generation, timeout)
+            return self._generation
+
+    @property
+    def generation(self) -> int:
+        return self._generation
+
+    # -- frame thread --------------------------------------------------------------------
+    def _run(self) -> None:
+        next_frame = due = time.monotonic()
+        last_plot = last_time = 0.0
+        while not self._stop.is_set():
+            delay = next_frame - time.monotonic()
+            if delay > 0:
+                self._wake.wait(delay)
+                self._wake.clear()
+            if self._stop.is_set():
+                break
+            cpu0 = time.thread_time()
+            drawn = False
+            try:
+                self._drain()
+                if self._dirty:
+                    self._rebuild()
+                now = time.monotonic()
+                if now >= next_frame and self.budget.rebuilding and now - due < HOLD_SECONDS:
+                    next_frame = now + YIELD_SECONDS  # a slider move elsewhere goes first
+                elif now >= next_frame:
+                    next_frame = due = now + 1.0 / min(self.max_fps, self.budget.fps)
+                    self._advance()
+                    drawn = True
+                    if now - last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
+                        last_plot = now
+                        self.panel.record_plot(self.frame.t, self.frame.omega)
+                        self.panel.send_plot()
+                    if now - last_time >= 1.0 / TIME_HZ:
+                        last_time = now
+                        shown = self.frame.t if self.frame is not None else 0.0
+                        self.panel.show_time(shown, self.clock.paused)
+                        self.panel.collect(now)
+            except Exception as exc:  # the loop must survive anything; the user sees it
+                self._report(exc)
+                next_frame = time.monotonic() + 1.0 / self.max_fps
+            if drawn:
+                self.stats.frame_cpu_seconds.append(time.thread_time() - cpu0)
+
+    def _drain(self) -> None:
+        if self._actions.empty():  # the usual frame: no exception raised and caught
+            return
+        while True:
+            try:
+                action = self._actions.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                action()
+            except Exception as exc:
+                self._report(exc)
+
+    def _advance(self) -> None:
+        if self.body is None:
+            return
+        start = time.perf_counter()
+        self.frame = self.scene.advance(self.clock.now())
+        self.lecture.on_frame(self.frame)
+        self.ghost.on_frame(self.frame)
+        self.stats.frame_seconds.append(time.perf_counter() - start)
+        self.stats.frames += 1
+        self.budget.frame_done()
+
+    def _report(self, exc: BaseException) -> None:
+        self.stats.errors += 1
+        message = f"{type(exc).__name__}: {exc}"
+        if message != self.stats.last_error:
+            log.exception("session %s: %s", self.client.client_id, message, exc_info=exc)
+            self.stats.last_error = message
+        try:
+            self._set_status(f"Internal error ({message}); the last valid scene is kept.")
+        except Exception:  # the GUI itself may be gone (client left)
+            pass
+
+    # -- state changes (frame thread only) -----------------------------------------------
+    def _set_status(self, message: str) -> None:
+        self.status = message
+        self.panel.show_status(message)
+
+    def _apply_preset(self, preset: Preset) -> None:
+        self.preset = preset
+        if preset is not CUSTOM:
+            self._base = preset
+            self._desired = Parameters.from_preset(preset)
+            self.clock.speed = preset.speed
+            self.scene.trail_points = preset.trail_points
+            self._dirty = True
+        self.scene.declare(preset.elements)
+        self.panel.declare(
+            preset.controls,
+            preset.plots,
+            preset.elements,
+            self._desired,
+            self.clock.speed,
+            self.scene.trail_points,
+            self.scene.is_visible,
+        )
+        self.panel.show_preset(preset)
+        self._show_playback()
+
+    def _edit(self, change: Callable[[Parameters], Parameters]) -> None:
+        new = change(self._desired)
+        if new == self._desired:
+            return
+        self._desired = new
+        self._dirty = True
+        if self.preset is not CUSTOM and not new.matches(self.preset):
+            # Edited by hand: the scene becomes "Custom", which declares everything. Only
+            # additions happen here, so the slider being dragged stays in place.
+            self.preset = CUSTOM
+            self.scene.declare(ALL_ELEMENTS)
+            self.panel.declare(
+                CUSTOM.controls,
+                CUSTOM.plots,
+                CUSTOM.elements,
+                new,
+                self.clock.speed,
+                self.scene.trail_points,
+                self.scene.is_visible,
+            )
+            self.panel.show_preset(CUSTOM)
+
+    def _solid(self, params: Parameters) -> Solid | None:
+        """The base preset's solid while the moments are still the preset's, otherwise the
+        homogeneous box with the same moments (:func:`physics.box_dimensions`); a flat lamina
+        is drawn with a thin (2 %) side."""
+        base = Parameters.from_preset(self._base)
+        if params.inertia == base.inertia and self._base.solid is not None:
+            return self._base.solid
+        sides = box_dimensions(params.inertia)
+        return Solid("box", tuple(float(max(a, 0.02 * sides.max())) for a in sides))
+
+    def _rebuild(self) -> None:
+        """Build the body for the desired parameters and load it; on a ValueError keep the
+        last valid scene and say why."""
+        with self.budget.rebuild():
+            self._rebuild_now()
+
+    def _rebuild_now(self) -> None:
+        start = time.perf_counter()
+        desired = self._desired
+        self._dirty = False
+        try:
+            body = desired.build()
+            self.clock.reset(0.0)
+            self.frame = self.scene.load(
+                body, self._solid(desired), t=0.0, frame_time=self.frame_time
+            )
+        except ValueError as exc:
+            reason = str(exc)
+            self._set_status(f"{reason[:1].upper()}{reason[1:]}. Showing the last valid body.")
+        else:
+            self.body, self.params = body, desired
+            self.panel.show_parameters(desired)
+            self.panel.show_readouts(readouts.markdown(body))
+            self.panel.clear_plot()
+            self.panel.record_plot(0.0, self.frame.omega)
+            self._set_status("")
+            # Send now: viser otherwise batches outgoing messages for up to a frame (1/60 s).
+            self.client.flush()
+        self.stats.rebuild_seconds.append(time.perf_counter() - start)
+        self.stats.rebuilds += 1
+        with self._applied:
+            self._generation += 1
+            self._applied.notify_all()
+
+    def _toggle_pause(self) -> None:
+        self.clock.paused = not self.clock.paused
+        self._show_playback()
+
+    def _step(self) -> None:
+        self.clock.paused = True
+        self.clock.step(STEP_SECONDS * self.clock.speed)
+        self._show_playback()
+
+    def _reset(self) -> None:
+        self.clock.reset(0.0)
+        self.panel.clear_plot()
+
+    def _show_playback(self) -> None:
+        self.panel.show_playback(self.clock.speed, self.clock.paused, self.scene.trail_points)

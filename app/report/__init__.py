@@ -1,0 +1,1 @@
+"""The work-precision study behind ``poinsot report`` (never imports viser)."""

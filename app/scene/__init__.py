@@ -1,0 +1,1 @@
+"""Poinsot's construction as viser nodes: geometry, sampling, trails, meshes, colours, cameras."""

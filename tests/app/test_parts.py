@@ -1,0 +1,370 @@
+"""The app's parts on their own: presets (data and sources), parameters, clock, the one
+quaternion conversion, the chunked trail, and the command line."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import time
+import urllib.request
+
+import numpy as np
+import pytest
+from conftest import session_of, wait_until
+from poinsot.app import cli
+from poinsot.app.live.clock import SimClock
+from poinsot.app.parameters import Parameters
+from poinsot.app.presets import (
+    ALL_ELEMENTS,
+    CUSTOM,
+    PRESETS,
+    Element,
+    preset_by_key,
+    preset_by_label,
+)
+from poinsot.app.scene.frames import rotation_from_wxyz, wxyz
+from poinsot.app.scene.meshes import solid_mesh
+from poinsot.app.scene.trail import Trail
+from poinsot.physics import Regime
+from scipy.spatial.transform import Rotation
+
+EXPECTED_REGIME = {
+    "major": Regime.MAJOR_AXIS,
+    "minor": Regime.MINOR_AXIS,
+    "t_handle": Regime.MAJOR_AXIS,
+    "near_separatrix": Regime.MAJOR_AXIS,
+    "separatrix": Regime.SEPARATRIX,
+    "oblate": Regime.SYMMETRIC,
+    "prolate": Regime.SYMMETRIC,
+    "sphere": Regime.SPHERE,
+}
+
+
+# -- presets ---------------------------------------------------------------------------
+def test_the_issue_s_presets_are_all_there():
+    assert [p.key for p in PRESETS] == list(EXPECTED_REGIME)
+    assert len({p.label for p in (*PRESETS, CUSTOM)}) == len(PRESETS) + 1
+    assert CUSTOM.elements == ALL_ELEMENTS
+
+
+@pytest.mark.parametrize("preset", PRESETS, ids=[p.key for p in PRESETS])
+def test_each_preset_is_a_real_body_with_a_source(preset):
+    assert len(preset.source) > 40 and re.search(r"[A-Z][a-z]+", preset.source)
+    params = Parameters.from_preset(preset)
+    params.check()  # triangle inequality: a real body
+    body = params.build()
+    assert body.D == pytest.approx(preset.D, rel=1e-12)
+    assert np.linalg.norm(body.omega0) == pytest.approx(preset.omega_norm)
+    assert np.allclose(body.plane_normal, (0, 0, 1), atol=1e-12)  # L vertical
+    assert body.regime is EXPECTED_REGIME[preset.key], body.regime
+    assert params.matches(preset)
+
+
+WITH_SOLID = [p for p in PRESETS if p.solid is not None]
+
+
+@pytest.mark.parametrize("preset", WITH_SOLID, ids=[p.key for p in WITH_SOLID])
+def test_a_preset_s_solid_has_the_preset_s_moments(preset):
+    """The drawn solid is the body: trimesh's mass properties of the exact mesh the app sends
+    (centre of mass at the origin, principal axes = body axes) give the preset's moments."""
+    mesh = solid_mesh(preset.solid)
+    assert mesh.is_watertight
+    assert np.allclose(mesh.center_mass, 0.0, atol=2e-4 * mesh.scale)
+    tensor = mesh.moment_inertia
+    assert np.allclose(tensor - np.diag(np.diag(tensor)), 0.0, atol=1e-9 * np.trace(tensor))
+    moments = np.diag(tensor)
+    # Ratios (the mass is a free scale); polygonal cylinders differ from circles by ~0.2 %.
+    assert np.allclose(
+        moments / moments.max(), np.divide(preset.inertia, max(preset.inertia)), rtol=5e-3
+    )
+
+
+def test_a_body_without_a_preset_solid_is_drawn_as_the_physics_box(make_app, make_probe):
+    """The separatrix preset (exact data, no solid of its own) and any hand-edited body show
+    the homogeneous box with the same moments, from physics.box_dimensions."""
+    from poinsot.physics import box_dimensions
+
+    preset = preset_by_key("separatrix")
+    assert preset.solid is None and len(WITH_SOLID) == len(PRESETS) - 1
+    app = make_app(preset)
+    probe = make_probe(app)
+    assert probe.wait_for(lambda p: "/space/body/solid" in p.nodes, 15)
+    session = app.wait_for_sessions(1)[0]
+    sides = np.asarray(probe.snapshot()[0]["/space/body/solid"].props["scale"])
+    expected = box_dimensions(preset.inertia)
+    assert np.allclose(sides / sides.max(), expected / expected.max())
+    assert session.body.regime is Regime.SEPARATRIX
+
+
+def test_presets_are_found_by_key_and_label():
+    assert preset_by_key("t_handle").label == "Intermediate-axis flip (T-handle)"
+    assert preset_by_label(CUSTOM.label) is CUSTOM
+    with pytest.raises(KeyError, match="no preset named"):
+        preset_by_key("nope")
+
+
+# -- parameters ------------------------------------------------------------------------
+def test_an_impossible_body_is_named_in_the_message():
+    bad = Parameters((1.0, 1.0, 2.5), 1.5)
+    with pytest.raises(ValueError, match=r"no real body .* I3 = 2\.5 is larger than I1 \+ I2 = 2"):
+        bad.check()
+    with pytest.raises(ValueError, match="no real body"):
+        bad.build()
+    Parameters((1.0, 1.0, 2.0), 1.5).check()  # a flat lamina is a real body
+
+
+def test_editing_a_moment_keeps_D_in_range_and_sides_mirror():
+    p = Parameters((1.0, 2.0, 2.6), 2.45)
+    q = p.with_inertia(2, 2.2)
+    assert q.D == 2.2 and q.inertia == (1.0, 2.0, 2.2)
+    assert p.side() == "major"
+    m = p.mirrored("minor")
+    assert m.side() == "minor" and 1.0 <= m.D < 2.0
+    assert m.mirrored("major").D == pytest.approx(p.D)
+    assert p.mirrored("major") == p
+
+
+# -- clock -----------------------------------------------------------------------------
+class FakeTime:
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_clock_speed_pause_step_reset():
+    wall = FakeTime()
+    clock = SimClock(speed=2.0, monotonic=wall)
+    wall.now += 1.5
+    assert clock.now() == pytest.approx(3.0)
+    clock.speed = 0.5  # continuous across the change
+    assert clock.now() == pytest.approx(3.0)
+    wall.now += 2.0
+    assert clock.now() == pytest.approx(4.0)
+    clock.paused = True
+    wall.now += 10.0
+    assert clock.now() == pytest.approx(4.0)
+    clock.step(0.25)
+    assert clock.now() == pytest.approx(4.25)
+    clock.paused = False
+    wall.now += 1.0
+    assert clock.now() == pytest.approx(4.75)
+    clock.reset()
+    assert clock.now() == 0.0
+
+
+# -- the one quaternion conversion -----------------------------------------------------
+def test_wxyz_is_scalar_first_and_round_trips():
+    rotations = Rotation.random(50, random_state=3)
+    q = wxyz(rotations)
+    assert q.shape == (50, 4) and np.all(q[:, 0] >= 0)
+    assert np.allclose(np.abs(q[:, 0]), np.abs(rotations.as_quat()[:, 3]))
+    for r, qi in zip(rotations, q, strict=True):
+        assert (rotation_from_wxyz(qi) * r.inv()).magnitude() < 1e-12
+    single = wxyz(Rotation.from_rotvec([0.0, 0.0, np.pi / 2]))
+    assert np.allclose(single, [np.cos(np.pi / 4), 0, 0, np.sin(np.pi / 4)])
+
+
+# -- trail -----------------------------------------------------------------------------
+class FakeHandle:
+    def __init__(self, api, name, points) -> None:
+        # Kept by reference, as viser's add_line_segments keeps a float32 array it is given.
+        self.api, self.name, self._points = api, name, np.asarray(points)
+        self.visible = True
+        api.sent_bytes += self._points.nbytes
+
+    @property
+    def points(self):
+        return self._points
+
+    @points.setter
+    def points(self, value) -> None:
+        self._points = np.array(value)
+        self.api.sent_bytes += self._points.nbytes
+
+    def remove(self) -> None:
+        self.api.live.discard(self.name)
+
+
+class FakeApi:
+    """Records what a Trail sends, in place of a viser SceneApi."""
+
+    def __init__(self) -> None:
+        self.live: set[str] = set()
+        self.sent_bytes = 0
+
+    def add_frame(self, name, **kwargs):
+        return FakeHandle(self, name, np.zeros((0, 3)))
+
+    def add_line_segments(self, name, points, color, **kwargs):
+        self.live.add(name)
+        return FakeHandle(self, name, points)
+
+
+def test_trail_is_bounded_and_sends_increments_only():
+    api = FakeApi()
+    trail = Trail(api, "/t", (255, 0, 0), 2.0, max_points=200, chunk=16)
+    points = np.cumsum(np.ones((1000, 3)), axis=0).astype(np.float32)
+    worst = 0
+    for p in points:
+        before = api.sent_bytes
+        trail.append(p[None])
+        worst = max(worst, api.sent_bytes - before)
+    assert worst <= 16 * 2 * 3 * 4  # at most one chunk per frame
+    assert 200 - 16 <= trail.segment_count <= 200
+    drawn = trail.points()
+    assert np.array_equal(drawn, points[-len(drawn) :])  # contiguous, oldest first
+    assert len(api.live) <= 200 // 16 + 1
+    trail.max_points = 50
+    assert trail.segment_count <= 50
+    trail.clear()
+    assert trail.segment_count == 0 and api.live == set()
+    trail.append(points[:5])
+    assert np.array_equal(trail.points(), points[:5])
+
+
+def test_trail_appends_of_any_size_draw_one_unbroken_polyline():
+    """Batches that straddle chunks (as a frame after a stall does) keep every point once,
+    in order, and a chunk already sent is never rewritten by later appends."""
+    api = FakeApi()
+    trail = Trail(api, "/t", (0, 0, 255), 2.0, max_points=10_000, chunk=8)
+    rng = np.random.default_rng(7)
+    points = rng.normal(size=(400, 3)).astype(np.float32)
+    start = 0
+    for size in rng.integers(1, 30, size=200):
+        if start >= len(points):
+            break
+        trail.append(points[start : start + size])
+        start += size
+    assert np.array_equal(trail.points(), points)
+    segments = np.concatenate([h.points for h, _ in trail._frozen])
+    assert np.array_equal(segments[1:, 0], segments[:-1, 1])  # chunks join end to end
+
+
+# -- command line ----------------------------------------------------------------------
+def test_cli_serve_forms_parse_alike():
+    parser = cli.build_parser()
+    bare = parser.parse_args([])
+    assert (bare.host, bare.port, bare.func) == ("127.0.0.1", 8080, cli.serve)
+    flags = parser.parse_args(["--host", "0.0.0.0", "--port", "9000"])
+    assert (flags.host, flags.port, flags.func) == ("0.0.0.0", 9000, cli.serve)
+    sub = parser.parse_args(["serve", "--host", "0.0.0.0", "--port", "9001", "--preset", "sphere"])
+    assert (sub.command, sub.host, sub.port, sub.preset) == ("serve", "0.0.0.0", 9001, "sphere")
+
+
+@pytest.mark.parametrize("argv", [["-m", "poinsot.app", "serve"], ["-m", "poinsot.app"]])
+def test_cli_serves_the_page_and_prints_the_url(argv):
+    proc = subprocess.Popen(
+        [sys.executable, *argv, "--port", "0", "--preset", "minor"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    try:
+        url = None
+        deadline = time.monotonic() + 30
+        while url is None and time.monotonic() < deadline:
+            line = proc.stdout.readline()
+            match = re.search(r"Poinsot is running at (http://\S+)", line)
+            url = match.group(1) if match else None
+        assert url, "no URL printed"
+        with urllib.request.urlopen(url, timeout=10) as response:
+            assert response.status == 200 and b"<html" in response.read().lower()
+    finally:
+        proc.terminate()
+        proc.wait(10)
+    assert wait_until(lambda: proc.poll() is not None, 5)
+
+
+@pytest.mark.parametrize(
+    "command", [[sys.prefix + "/bin/poinsot"], [sys.executable, "-m", "poinsot.app.cli"]]
+)
+def test_console_script_and_module_forms_answer(command):
+    out = subprocess.run([*command, "serve", "--help"], capture_output=True, text=True, timeout=30)
+    assert out.returncode == 0 and "--host" in out.stdout and "--port" in out.stdout
+
+
+def test_element_enum_matches_labels():
+    from poinsot.app.live.panel import ELEMENT_LABELS
+
+    assert set(ELEMENT_LABELS) == set(Element)
+
+
+# -- motion sampling and the frame budget ------------------------------------------------
+def test_motion_sampler_gives_the_exact_solution_at_grid_times_in_batches():
+    from poinsot.app.scene.sampling import BATCH, MotionSampler
+
+    body = Parameters.from_preset(preset_by_key("t_handle")).build()
+    sampler = MotionSampler(body, step=0.01, stride=2, t0=0.5)
+    assert sampler.index(0.5) == 0 and sampler.index(0.5 + 0.0349) == 3
+    assert sampler.time(3) == pytest.approx(0.53)
+    first = sampler.samples(0, 0)
+    later = sampler.samples(5, 40)
+    assert sampler.evaluations == 1  # one physics call for a whole batch of frames
+    omega, rotation, contact = body.sample(later.t)
+    assert np.array_equal(later.omega, omega) and np.array_equal(later.contact, contact)
+    assert np.array_equal(later.quat_xyzw, rotation.as_quat())  # exact values, no interpolation
+    assert np.allclose(first.t, [0.5])
+    sampler.samples(BATCH + 3, BATCH + 10)
+    assert sampler.evaluations == 2
+
+
+def test_grid_step_keeps_trace_chords_short():
+    from poinsot.app.scene.sampling import STEPS_PER_FRAME, MotionSampler, trace_speed
+
+    body = Parameters.from_preset(preset_by_key("major")).build()
+    scale = 1.0 / float(np.max(body.semi_axes))
+    speed = trace_speed(body, scale)
+    for frame_time in (1 / 60, 4 / 60):
+        sampler = MotionSampler.for_body(body, speed, frame_time, 0.02)
+        assert sampler.step <= frame_time / STEPS_PER_FRAME
+        s = sampler.samples(0, 400)
+        kept = s.contact[s.k % sampler.stride == 0] * scale
+        chords = np.linalg.norm(np.diff(kept, axis=0), axis=1)
+        assert chords.max() <= 0.02 * 1.01
+
+
+def test_a_rebuild_holds_the_other_sessions_frames_for_a_bounded_time(probe, poinsot_app):
+    """While some session rebuilds (a slider moved), the others hold their frames so that the
+    rebuild runs alone; a rebuild that never ends holds them at most HOLD_SECONDS each."""
+    from poinsot.app.live.session import HOLD_SECONDS
+
+    session = session_of(poinsot_app)
+    budget = poinsot_app.budget
+    assert not budget.rebuilding
+    assert wait_until(lambda: session.stats.frames > 5, 10)
+    with budget.rebuild():
+        assert budget.rebuilding
+        time.sleep(0.1)  # past a frame already in progress
+        before = session.stats.frames
+        time.sleep(0.5)
+        held = session.stats.frames - before
+    assert not budget.rebuilding
+    # At 60 fps 30 frames would have been drawn; held, one frame per hold (plus one period).
+    assert 1 <= held <= 0.5 / (HOLD_SECONDS + 1 / 60) + 2
+    before = session.stats.frames
+    time.sleep(0.5)
+    assert session.stats.frames - before > held  # free again
+
+
+def test_frame_budget_shares_one_cpu_among_sessions():
+    from poinsot.app.live.budget import FrameBudget
+
+    budget = FrameBudget(max_fps=60, min_fps=10, share=0.5, recalibrate_seconds=0.0)
+    assert budget.fps == 60
+    budget._cost = 1e-3  # as if measured: 1 ms per client-frame
+    budget.set_sessions(1)
+    assert budget.fps == 60  # 1 client x 60 fps x 1 ms = 6 % of a CPU
+    budget.set_sessions(20)
+    assert budget.fps == pytest.approx(25)  # 0.5 CPU / (20 x 1 ms)
+    budget.set_sessions(200)
+    assert budget.fps == 10  # never below min_fps
+    budget.set_sessions(1)
+    start = time.process_time()
+    while time.process_time() - start < 0.05:
+        pass
+    for _ in range(20):
+        budget.frame_done()
+    assert budget.cost > 0.0 and budget.fps == 60

@@ -1,0 +1,385 @@
+"""Server-side behaviour on a real ViserServer(port=0), observed through websocket probes that
+speak viser's protocol like a browser (app/probe.py): what is created, what is sent per
+frame, the frame rate, sessions, invalid input, and robustness."""
+
+from __future__ import annotations
+
+import random
+import time
+
+import numpy as np
+import pytest
+from conftest import session_of, wait_until
+from poinsot.app.live.panel import ELEMENT_LABELS
+from poinsot.app.live.session import MAX_FPS, STEP_SECONDS
+from poinsot.app.presets import (
+    CUSTOM,
+    DEFAULT_PRESET,
+    PRESETS,
+    Control,
+    Element,
+    Plot,
+    preset_by_key,
+)
+from poinsot.app.scene.trail import CHUNK_SEGMENTS
+from test_scene_geometry import check_finite
+
+#: Nodes each element creates (trail chunks "…/c<n>" come and go under their group).
+ELEMENT_NODES: dict[Element, set[str]] = {
+    Element.ELLIPSOID: {"/space/body/ellipsoid"},
+    Element.AXES: {f"/space/body/axis{i}" for i in (1, 2, 3)}
+    | {f"/space/body/axis{i}/label" for i in (1, 2, 3)}
+    | {"/space/origin"},
+    Element.PLANE: {"/space/plane", "/space/plane/disc", "/space/plane/grid", "/space/plane/rim"},
+    Element.CONTACT: {"/space/tip/contact"},
+    Element.OMEGA: {"/space/omega", "/space/tip/omega_label"},
+    Element.L: {"/space/L", "/space/L_label"},
+    Element.POLHODE: {"/space/body/polhode"},
+    Element.POLHODE_FULL: {"/space/body/polhode_full"},
+    Element.HERPOLHODE: {"/space/herpolhode"},
+    Element.SOLID: {"/space/body/solid"},
+}
+ALWAYS = {"/WorldAxes", "/space", "/space/body", "/space/tip", "/lights", "/lights/fill"}
+TRAIL_GROUPS = ("/space/body/polhode/", "/space/herpolhode/")
+
+#: Widget labels per control group.
+CONTROL_LABELS: dict[Control, set[str]] = {
+    Control.INERTIA: {"I₁", "I₂", "I₃"},
+    Control.ENERGY: {"D = |L|²/2T"},
+    Control.SIDE: {"Side of separatrix", "Polhode"},
+    Control.OMEGA_NORM: {"|ω₀|"},
+    Control.SPEED: {"Speed"},
+    Control.PLAYBACK: {"Pause", "Step", "Reset"},
+    Control.TRAIL: {"Trail length"},
+}
+
+
+def scene_names(probe) -> set[str]:
+    nodes, _ = probe.snapshot()
+    return {n for n in nodes if not any(n.startswith(g) for g in TRAIL_GROUPS)}
+
+
+def visible_labels(probe) -> set[str]:
+    _, widgets = probe.snapshot()
+    return {
+        w.props["label"]
+        for w in widgets.values()
+        if w.props.get("label") and w.props.get("visible", True)
+    }
+
+
+def has_plot(probe) -> bool:
+    _, widgets = probe.snapshot()
+    return any(
+        w.type == "GuiUplotMessage" and w.props.get("visible", True) for w in widgets.values()
+    )
+
+
+def markdown_texts(probe) -> list[str]:
+    """The markdown the browser shows (the probe's model is read under its lock)."""
+    return [
+        str(w.props.get("_markdown", ""))
+        for w in probe.widgets.values()
+        if w.type == "GuiMarkdownMessage"
+    ]
+
+
+def expected_nodes(preset) -> set[str]:
+    names = set(ALWAYS)
+    for element in preset.elements:
+        names |= ELEMENT_NODES[element]  # a preset without a solid gets the physics box
+    return names
+
+
+@pytest.mark.parametrize("preset", PRESETS, ids=[p.key for p in PRESETS])
+def test_only_what_the_preset_declares_is_created(preset, make_app, make_probe):
+    app = make_app(preset)
+    probe = make_probe(app)
+    session = session_of(app)
+    assert wait_until(lambda: session.stats.frames > 3, 10)
+    assert probe.wait_for(lambda p: scene_names(p) == expected_nodes(preset), 10), scene_names(
+        probe
+    ) ^ expected_nodes(preset)
+    labels = visible_labels(probe)
+    for control, names in CONTROL_LABELS.items():
+        assert (names <= labels) == (control in preset.controls), control
+        assert (names & labels == set()) == (control not in preset.controls), control
+    shown = {ELEMENT_LABELS[e] for e in preset.elements}
+    hidden = {ELEMENT_LABELS[e] for e in Element if e not in preset.elements}
+    assert shown <= labels and not hidden & labels
+    assert has_plot(probe) == (Plot.OMEGA in preset.plots)
+
+
+def test_switching_preset_creates_and_removes_exactly(poinsot_app, probe):
+    session = session_of(poinsot_app)
+    uuid, _ = probe.widget("Preset")
+    for key in ("sphere", "t_handle", "sphere", "oblate"):
+        preset = preset_by_key(key)
+        probe.set_value(uuid, preset.label)
+        assert wait_until(
+            lambda p=preset: session.preset is p and session.params.inertia == p.inertia, 10
+        )
+        expected = expected_nodes(preset)
+        assert probe.wait_for(lambda p, e=expected: scene_names(p) == e, 10)
+        assert probe.wait_for(lambda p, pr=preset: has_plot(p) == (Plot.OMEGA in pr.plots), 10)
+    assert session.stats.errors == 0, session.stats.last_error
+
+
+def frame_traffic(probe, seconds: float) -> list:
+    start = len(probe.batches)
+    time.sleep(seconds)
+    return probe.batches[start:]
+
+
+PER_FRAME_TYPES = {
+    "SetOrientationMessage",
+    "SetPositionMessage",
+    "SceneNodeUpdateMessage",
+    "LineSegmentsMessage",
+    "RemoveSceneNodeMessage",
+    "SetSceneNodeVisibilityMessage",
+    "GuiUpdateMessage",
+}
+
+
+def test_per_frame_only_poses_and_trail_increments_are_sent(poinsot_app, probe):
+    session = session_of(poinsot_app)
+    assert wait_until(lambda: session.stats.frames > 30, 10)
+    frames_before = session.stats.frames
+    batches = frame_traffic(probe, 1.5)
+    frames = session.stats.frames - frames_before
+    assert frames > 30
+    for batch in batches:
+        for kind, name in zip(batch.types, batch.names, strict=True):
+            assert kind in PER_FRAME_TYPES, (kind, name)
+            if kind in ("LineSegmentsMessage", "RemoveSceneNodeMessage"):
+                assert name.startswith(TRAIL_GROUPS), name  # trail chunks only
+            elif kind == "SetOrientationMessage":
+                assert name == "/space/body" or name.startswith(TRAIL_GROUPS), name
+            elif kind == "SetPositionMessage":
+                assert name == "/space/tip" or name.startswith(TRAIL_GROUPS), name
+            elif kind == "SceneNodeUpdateMessage":
+                assert name == "/space/omega" or name.startswith(TRAIL_GROUPS), name
+    # Bytes: poses plus at most a chunk of trail per trace per frame (the plot, at 10 Hz,
+    # resends its 300-sample window; it is counted separately).
+    scene_bytes = sum(b.nbytes for b in batches if "GuiUpdateMessage" not in b.types)
+    per_frame = scene_bytes / frames
+    assert per_frame < 400 + 2 * CHUNK_SEGMENTS * 24 + 600, per_frame
+
+
+def test_the_loop_runs_at_most_60_hz(poinsot_app, probe):
+    session = session_of(poinsot_app)
+    assert wait_until(lambda: session.stats.frames > 10, 10)
+    f0, t0 = session.stats.frames, time.monotonic()
+    time.sleep(2.0)
+    rate = (session.stats.frames - f0) / (time.monotonic() - t0)
+    assert rate <= MAX_FPS * 1.03, rate
+    assert rate > 20, rate  # and it does animate
+
+
+def test_the_loop_stops_when_the_client_leaves(poinsot_app, make_probe):
+    probe = make_probe(poinsot_app)
+    session = session_of(poinsot_app)
+    assert wait_until(lambda: session.running and session.stats.frames > 5, 10)
+    probe.close()
+    assert wait_until(lambda: not session.running, 5)
+    assert poinsot_app.sessions() == {}
+    frames = session.stats.frames
+    time.sleep(0.3)
+    assert session.stats.frames == frames
+
+
+def test_a_stalled_client_does_not_stall_the_others(poinsot_app, make_probe):
+    slow = make_probe(poinsot_app)
+    slow_session = session_of(poinsot_app, 1)
+    fast = make_probe(poinsot_app)
+    fast_session = session_of(poinsot_app, 2)
+    assert fast_session is not slow_session
+    assert wait_until(lambda: fast_session.stats.frames > 10, 10)
+    slow.stall()
+    time.sleep(1.0)  # let the stalled socket's buffers fill
+    f_fast, f_slow = fast_session.stats.frames, slow_session.stats.frames
+    n_batches = len(fast.batches)
+    time.sleep(2.0)
+    assert fast_session.stats.frames - f_fast > 60  # the other session keeps animating
+    assert len(fast.batches) - n_batches > 60  # and its browser keeps receiving
+    assert slow_session.stats.frames - f_slow > 60  # the stalled one never blocks its thread
+    slow.stall(False)
+    assert slow.wait_for(lambda p: p.messages_received > 0, 5)
+
+
+def test_two_clients_have_independent_sessions(poinsot_app, make_probe):
+    a = make_probe(poinsot_app)
+    sa = session_of(poinsot_app, 1)
+    b = make_probe(poinsot_app)
+    sb = session_of(poinsot_app, 2)
+    for p in (a, b):
+        assert p.wait_for(lambda p: "/space/body/ellipsoid" in p.nodes and p.has_widget("I₂"), 15)
+    uuid, _ = a.widget("I₂")
+    a.set_value(uuid, 1.7)
+    assert wait_until(lambda: sa.params.inertia[1] == 1.7, 10)
+    assert a.wait_for(
+        lambda p: np.allclose(
+            p.nodes["/space/body/ellipsoid"].props["scale"], sa.scene.geometry.semi_axes
+        ),
+        10,
+    )
+    time.sleep(0.3)
+    assert sb.params.inertia == DEFAULT_PRESET.inertia and sb.preset is DEFAULT_PRESET
+    a_scale = a.snapshot()[0]["/space/body/ellipsoid"].props["scale"]
+    b_scale = b.snapshot()[0]["/space/body/ellipsoid"].props["scale"]
+    assert not np.allclose(a_scale, b_scale)
+    assert np.allclose(b_scale, sb.scene.geometry.semi_axes)
+
+
+def test_an_impossible_body_is_refused_and_the_last_scene_kept(poinsot_app, probe):
+    session = session_of(poinsot_app)
+    scale_before = probe.snapshot()[0]["/space/body/ellipsoid"].props["scale"]
+    body_before = session.body
+    uuid, _ = probe.widget("I₃")
+    generation = session.generation
+    probe.set_value(uuid, 3.5)  # I1 = 1, I2 = 2: 3.5 > 1 + 2
+    session.wait_applied(generation)
+    assert "No real body has these moments" in session.status
+    assert "I3 = 3.5 is larger than I1 + I2 = 3" in session.status
+    assert probe.wait_for(lambda p: any("No real body" in t for t in markdown_texts(p)), 5)
+    assert session.body is body_before
+    time.sleep(0.3)
+    assert np.allclose(probe.snapshot()[0]["/space/body/ellipsoid"].props["scale"], scale_before)
+    assert session.stats.errors == 0
+    check_finite(probe)
+    generation = session.generation
+    probe.set_value(uuid, 2.9)  # valid again
+    session.wait_applied(generation)
+    assert session.status == "" and session.body is not body_before
+    assert probe.wait_for(lambda p: not any("No real body" in t for t in markdown_texts(p)), 5)
+    assert probe.wait_for(
+        lambda p: not np.allclose(p.nodes["/space/body/ellipsoid"].props["scale"], scale_before), 5
+    )
+
+
+def test_random_input_never_raises_nor_sends_nan(poinsot_app, probe):
+    """A storm of user input, including extremes and impossible bodies: no callback raises,
+    the frame thread reports no error, and nothing non-finite reaches the browser."""
+    session = session_of(poinsot_app)
+    rng = random.Random(1234)
+    sliders = {
+        "I₁": (0.1, 5.0),
+        "I₂": (0.1, 5.0),
+        "I₃": (0.1, 5.0),
+        "|ω₀|": (0.2, 4.0),
+        "Speed": (0.05, 4.0),
+        "Trail length": (100, 6000),
+    }
+    presets = [p.label for p in (*PRESETS, CUSTOM)]
+    for _ in range(150):
+        choice = rng.random()
+        if choice < 0.6:
+            label, (lo, hi) = rng.choice(list(sliders.items()))
+            if not probe.has_widget(label):
+                continue
+            value = rng.choice([lo, hi, rng.uniform(lo, hi)])
+            uuid, _ = probe.widget(label)
+            probe.set_value(uuid, int(value) if label == "Trail length" else round(value, 2))
+        elif choice < 0.7 and probe.has_widget("D = |L|²/2T"):
+            uuid, w = probe.widget("D = |L|²/2T")
+            probe.set_value(uuid, rng.uniform(w.props["min"], w.props["max"]))
+        elif choice < 0.8:
+            uuid, _ = probe.widget("Preset")
+            probe.set_value(uuid, rng.choice(presets))
+        else:
+            label = rng.choice(["Pause", "Step", "Reset", "Side of separatrix", "Polhode"])
+            if probe.has_widget(label):
+                uuid, w = probe.widget(label)
+                value = rng.choice(w.props["options"]) if "options" in w.props else True
+                probe.set_value(uuid, value)
+        time.sleep(rng.choice([0.0, 0.0, 0.01, 0.05]))
+    time.sleep(1.0)
+    assert session.stats.errors == 0, session.stats.last_error
+    assert session.status in ("",) or "No real body" in session.status
+    check_finite(probe)
+
+
+def test_visibility_trail_length_and_time_controls(poinsot_app, probe):
+    session = session_of(poinsot_app)
+    assert wait_until(lambda: session.stats.frames > 10, 10)
+    uuid, _ = probe.widget(ELEMENT_LABELS[Element.POLHODE_FULL])
+    probe.set_value(uuid, False)
+    assert probe.wait_for(lambda p: not p.nodes["/space/body/polhode_full"].visible, 5)
+    uuid, _ = probe.widget("Trail length")
+    probe.set_value(uuid, 100)
+    assert wait_until(lambda: session.scene.trail_points == 100, 5)
+    time.sleep(2.0)
+    for element in (Element.POLHODE, Element.HERPOLHODE):
+        trail = session.scene.trail(element)
+        assert trail.segment_count <= max(100, 2 * CHUNK_SEGMENTS) + CHUNK_SEGMENTS
+    # On the wire too: the chunks the browser holds are bounded.
+    chunks = [n for n in probe.snapshot()[0] if n.startswith("/space/herpolhode/c")]
+    assert len(chunks) <= max(100, 2 * CHUNK_SEGMENTS) // CHUNK_SEGMENTS + 2
+    # Pause freezes time; Step advances it by STEP_SECONDS x speed; Reset goes back to 0.
+    probe.set_value(probe.widget("Pause")[0], True)
+    assert wait_until(lambda: session.clock.paused, 5)
+    t = session.clock.now()
+    time.sleep(0.3)
+    assert session.clock.now() == t
+    probe.set_value(probe.widget("Step")[0], True)
+    assert wait_until(lambda: session.clock.now() > t, 5)
+    assert session.clock.now() == pytest.approx(t + STEP_SECONDS * session.clock.speed)
+    probe.set_value(probe.widget("Speed")[0], 2.0)
+    assert wait_until(lambda: session.clock.speed == 2.0, 5)
+    probe.set_value(probe.widget("Reset")[0], True)
+    assert wait_until(lambda: session.clock.now() == 0.0, 5)
+    probe.set_value(probe.widget("Play")[0], True)
+    assert wait_until(lambda: not session.clock.paused and session.clock.now() > 0.2, 5)
+    assert session.stats.errors == 0, session.stats.last_error
+
+
+def test_slider_to_redraw_is_fast(poinsot_app, probe):
+    """A slider change is rebuilt and on the wire quickly (the benchmark measures it
+    precisely; this bound is loose for a loaded CI machine)."""
+    session = session_of(poinsot_app)
+    uuid, _ = probe.widget("I₂")
+    for value in (1.7, 1.8, 1.9):  # valid bodies: I3 = 2.6 <= I1 + I2
+        start = time.perf_counter()
+        probe.set_value(uuid, value)
+        assert probe.wait_for(
+            lambda p, v=value: (
+                session.params.inertia[1] == v
+                and np.allclose(
+                    p.nodes["/space/body/ellipsoid"].props["scale"],
+                    session.scene.geometry.semi_axes,
+                )
+            ),
+            5,
+        )
+        assert time.perf_counter() - start < 0.5
+    slider_rebuilds = list(session.stats.rebuild_seconds)[-3:]  # not the first, full build
+    assert max(slider_rebuilds) < 0.1, slider_rebuilds
+
+
+def _session_threads() -> list[str]:
+    import threading
+
+    return [t.name for t in threading.enumerate() if t.name.startswith("poinsot-session-")]
+
+
+def test_clients_that_leave_during_connect_leave_no_session(poinsot_app):
+    """Connect and drop at once, 100 times (some drops land while the session is being built,
+    some after it started): afterwards no session, no frame thread and no pending departure."""
+    from poinsot.app.live.probe import Probe
+
+    before = len(_session_threads())
+    for i in range(100):
+        probe = Probe(poinsot_app.port)
+        if i % 10 == 9:  # a few stay until their session runs, then leave
+            wait_until(lambda: len(poinsot_app.sessions()) > 0, 5)
+        probe.close()
+    assert wait_until(
+        lambda: (
+            not poinsot_app.sessions()
+            and poinsot_app.pending_departures() == 0
+            and len(_session_threads()) <= before
+        ),
+        60,
+    ), (len(poinsot_app.sessions()), poinsot_app.pending_departures(), _session_threads())
+    assert poinsot_app.server.get_clients() == {}

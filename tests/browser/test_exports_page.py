@@ -1,0 +1,348 @@
+"""Exports and lecture controls in a real browser (Debian's Chromium via playwright, WebGL
+through SwiftShader):
+
+- the standalone HTML opened from a ``file://`` URL, with every network request refused,
+  renders the scene and animates it;
+- ``poinsot screenshot`` writes a PNG of the requested size with the scene on it, and leaves no
+  process behind, neither when it finishes nor when it is killed;
+- the in-app screenshot button hands the browser a PNG of the chosen size (current view,
+  opaque on the theme's background; 1920×1080 transparent);
+- space pauses, 1-4 move the camera (4 rides along with the body), the theme and text-size
+  toggles change the page.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+import uuid
+
+import numpy as np
+import pytest
+from conftest import chromium_or_fail, lecture_of, session_of, wait_until
+from PIL import Image
+from poinsot.app.exports import export
+from poinsot.app.exports.screenshot import THEME_BACKGROUND
+from poinsot.app.live.lecture import LARGE_TEXT_PERCENT
+from poinsot.app.presets import preset_by_key
+from poinsot.app.scene.cameras import BODY_VIEW, ride_along
+from poinsot.app.scene.view import VIEWS
+
+pytestmark = pytest.mark.browser
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+#: The scene counts as visible when this fraction of the picture has the ellipsoid's amber.
+MIN_AMBER = 0.02
+
+
+def amber_fraction(rgb: np.ndarray) -> float:
+    """Fraction of pixels with the ellipsoid's hue (amber, 22-45 degrees), saturated and not
+    dark (the translucent amber ellipsoid is the only amber thing in the scene)."""
+    px = rgb[..., :3].reshape(-1, 3).astype(np.float64) / 255.0
+    hi, lo = px.max(axis=1), px.min(axis=1)
+    chroma = hi - lo
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r, g, b = px.T
+        hue = (
+            np.where(
+                hi == r,
+                ((g - b) / chroma) % 6,
+                np.where(hi == g, (b - r) / chroma + 2, (r - g) / chroma + 4),
+            )
+            * 60.0
+        )
+        saturation = np.where(hi > 0, chroma / hi, 0.0)
+    amber = (hue > 22) & (hue < 45) & (saturation > 0.3) & (hi > 0.18) & (chroma > 0)
+    return float(amber.mean())
+
+
+def without_notice(page, rgb: np.ndarray) -> np.ndarray:
+    """Black out viser's "software WebGL" notice (shown by SwiftShader, never by a GPU)."""
+    notice = page.locator("#webgl-software-rendering")
+    if notice.count() and notice.first.is_visible():
+        box = notice.first.bounding_box()
+        if box:
+            y0, x0 = int(box["y"]), int(box["x"])
+            rgb = rgb.copy()
+            rgb[
+                max(0, y0 - 4) : int(y0 + box["height"]) + 4,
+                max(0, x0 - 4) : int(x0 + box["width"]) + 4,
+            ] = 0
+    return rgb
+
+
+def screenshot_rgb(page) -> np.ndarray:
+    return np.asarray(Image.open(io.BytesIO(page.screenshot(type="png"))).convert("RGB"))
+
+
+# -- standalone HTML ---------------------------------------------------------------------------
+def test_html_export_plays_from_a_file_url_without_any_server(chromium, tmp_path):
+    path = tmp_path / "poinsot.html"
+    path.write_text(export.preset_html(preset_by_key("major"), 3.0, fps=20), encoding="utf-8")
+    context = chromium.new_context(viewport={"width": 960, "height": 540})
+    refused: list[str] = []
+
+    def only_local(route) -> None:
+        url = route.request.url
+        if url.startswith(("file:", "data:", "blob:")):
+            route.continue_()
+        else:
+            refused.append(url)
+            route.abort()
+
+    context.route("**/*", only_local)
+    try:
+        page = context.new_page()
+        sockets: list[str] = []
+        errors: list[str] = []
+        page.on("websocket", lambda ws: sockets.append(ws.url))
+        page.on("pageerror", lambda e: errors.append(str(e)))
+        page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+        page.goto(path.as_uri())
+        page.locator("canvas").first.wait_for(state="visible", timeout=30000)
+        assert wait_until(
+            lambda: amber_fraction(without_notice(page, screenshot_rgb(page))) > MIN_AMBER,
+            30,
+            poll=0.5,
+        ), "the scene never appeared"
+        first = without_notice(page, screenshot_rgb(page))
+        page.wait_for_timeout(1500)
+        second = without_notice(page, screenshot_rgb(page))
+        changed = np.mean(np.any(np.abs(second.astype(int) - first) > 24, axis=2))
+        assert changed > 0.002, f"the animation did not move ({changed:.4f} of the view changed)"
+        assert refused == [] and sockets == [], (refused, sockets)
+        assert errors == []
+    finally:
+        context.close()
+
+
+# -- the CLI -----------------------------------------------------------------------------------
+def processes_with(token: str) -> dict[int, str]:
+    """pid -> command of every live process whose environment carries ``token``."""
+    found = {}
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/environ", "rb") as f:
+                if token.encode() not in f.read():
+                    continue
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                found[int(pid)] = f.read().replace(b"\0", b" ").decode(errors="replace")[:120]
+        except (FileNotFoundError, ProcessLookupError, PermissionError):
+            continue
+    return found
+
+
+class Watch:
+    """Polls, while a command runs, for the processes it started (found by an environment
+    token every child inherits): proof that a browser really ran."""
+
+    def __init__(self, token: str) -> None:
+        self.token = token
+        self.seen: dict[int, str] = {}
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            self.seen.update(processes_with(self.token))
+            self._stop.wait(0.2)
+
+    def chromium_seen(self) -> bool:
+        return any("chromium" in cmd or "chrome" in cmd for cmd in self.seen.values())
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join()
+
+
+def cli(*args: str, token: str) -> subprocess.Popen:
+    env = {**os.environ, "POINSOT_TEST_TOKEN": token}
+    return subprocess.Popen(
+        [sys.executable, "-m", "poinsot.app", *args],
+        cwd=ROOT,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def test_cli_screenshot_writes_the_png_and_leaves_no_process(tmp_path):
+    chromium_or_fail()
+    out = tmp_path / "shot.png"
+    token = f"poinsot-{uuid.uuid4()}"
+    watch = Watch(token)
+    start = time.monotonic()
+    proc = cli(
+        "screenshot",
+        "--preset",
+        "t_handle",
+        "--time",
+        "6",
+        "--size",
+        "800x450",
+        "--out",
+        str(out),
+        token=token,
+    )
+    try:
+        stdout, stderr = proc.communicate(timeout=240)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    elapsed = time.monotonic() - start
+    watch.stop()
+    assert proc.returncode == 0, stderr
+    assert re.search(r"wrote .*shot\.png \(800x450, scene t_handle, t = 6", stdout), stdout
+    assert watch.chromium_seen(), watch.seen
+    assert wait_until(lambda: not processes_with(token), 10), processes_with(token)
+    image = Image.open(out)
+    assert image.format == "PNG" and image.size == (800, 450) and image.mode == "RGB"
+    rgb = np.asarray(image)
+    # Opaque on the dark theme's background, the construction in the middle.
+    for corner in (rgb[0, 0], rgb[0, -1], rgb[-1, 0], rgb[-1, -1]):
+        assert tuple(corner) == THEME_BACKGROUND[True]
+    assert amber_fraction(rgb) > MIN_AMBER
+    drawn = np.any(rgb != THEME_BACKGROUND[True], axis=2)
+    assert 0.15 < drawn.mean() < 0.9, drawn.mean()  # framed: fills the picture, not the edges
+    print(f"CLI screenshot 800x450 in {elapsed:.1f} s")
+
+
+def test_cli_screenshot_killed_midway_leaves_no_process(tmp_path):
+    chromium_or_fail()
+    token = f"poinsot-{uuid.uuid4()}"
+    proc = cli(
+        "screenshot",
+        "--preset",
+        "major",
+        "--size",
+        "640x360",
+        "--out",
+        str(tmp_path / "never.png"),
+        token=token,
+    )
+    try:
+        started = wait_until(
+            lambda: any("chrom" in c for c in processes_with(token).values()), 60, poll=0.1
+        )
+        assert started, "chromium never started"
+        proc.send_signal(signal.SIGTERM)
+        proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode != 0
+    assert wait_until(lambda: not processes_with(token), 15), processes_with(token)
+    assert not (tmp_path / "never.png").exists()
+
+
+# -- the in-app controls -----------------------------------------------------------------------
+def download_png(page, button: str = "Screenshot (PNG)") -> tuple[str, Image.Image]:
+    with page.page.expect_download(timeout=120000) as info:
+        page.click_button(button)
+    download = info.value
+    data = open(download.path(), "rb").read()
+    return download.suggested_filename, Image.open(io.BytesIO(data))
+
+
+def started_session(app):
+    session = session_of(app)
+    assert wait_until(lambda: session.stats.frames >= 10, 20), "the scene is not animating"
+    return session
+
+
+def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_page):
+    page = open_page(poinsot_app.url, width=960, height=540)
+    session = started_session(poinsot_app)
+    lecture = lecture_of(session)
+    # Current view: the 3D view's size, opaque on the dark theme's background.
+    name, image = download_png(page)
+    width, height = session.client.camera.image_width, session.client.camera.image_height
+    assert (width, height) == (960, 540)
+    assert re.fullmatch(r"poinsot_major_t\d+\.\d\d\.png", name), name
+    t_name = float(name[len("poinsot_major_t") : -4])
+    assert 0.0 < t_name <= session.clock.now()
+    assert image.size == (width, height) and image.mode == "RGB"
+    rgb = np.asarray(image)
+    assert tuple(rgb[0, 0]) == THEME_BACKGROUND[True]
+    assert amber_fraction(rgb) > MIN_AMBER
+    assert name in lecture.message.content and page.errors == []
+    # 1920×1080, transparent: RGBA, clear where nothing is drawn.
+    page.choose("Picture size", "1920×1080")
+    page.set_checkbox("Transparent PNG", True)
+    assert wait_until(lambda: lecture.transparent.value and lecture.size.value == "1920×1080", 5)
+    name, image = download_png(page)
+    assert image.size == (1920, 1080) and image.mode == "RGBA"
+    rgba = np.asarray(image)
+    assert rgba[0, 0, 3] == 0 and rgba[-1, -1, 3] == 0
+    # Laid on the dark background afterwards, it is the same scene.
+    ground = Image.new("RGBA", image.size, (*THEME_BACKGROUND[True], 255))
+    assert amber_fraction(np.asarray(Image.alpha_composite(ground, image))) > MIN_AMBER
+    assert page.errors == []
+
+
+def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
+    page = open_page(poinsot_app.url, width=960, height=540)
+    session = started_session(poinsot_app)
+    lecture_of(session)
+    camera = session.client.camera
+    box = page.canvas_box()
+    # Focus the 3D view (not a widget): its bottom centre, between the floating panels.
+    page.page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] - 8)
+
+    def near(target, atol=1e-3):
+        return lambda: np.allclose(camera.position, target, atol=atol)
+
+    # Space: play/pause, through viser's command hotkeys.
+    page.page.keyboard.press("Space")
+    assert wait_until(lambda: session.clock.paused, 5), "space did not pause"
+    page.page.keyboard.press("Space")
+    assert wait_until(lambda: not session.clock.paused, 5), "space did not resume"
+    # 2: view along L. The browser reports its camera back to the server.
+    page.page.keyboard.press("2")
+    top = VIEWS["top"]
+    assert wait_until(near(top.position), 10), ("top view", camera.position)
+    assert np.allclose(camera.look_at, top.look_at, atol=1e-3)
+    # 4: ride along. Paused, the camera sits exactly where the body carries BODY_VIEW ...
+    page.page.keyboard.press("Space")
+    assert wait_until(lambda: session.clock.paused, 5), "space did not pause"
+    page.page.keyboard.press("4")
+    expected = ride_along(BODY_VIEW, session.frame.wxyz)
+    assert wait_until(near(expected.position), 10), ("ride along", camera.position, expected)
+    # ... and, running, it turns with the body.
+    page.page.keyboard.press("Space")
+    assert wait_until(lambda: not session.clock.paused, 5), "space did not resume"
+    assert wait_until(lambda: not near(expected.position, 0.05)(), 10), "the camera stood still"
+    assert np.linalg.norm(camera.position) == pytest.approx(
+        np.linalg.norm(BODY_VIEW.position), rel=1e-3
+    )
+    # 3: side view ends the ride.
+    page.page.keyboard.press("3")
+    assert wait_until(near(VIEWS["side"].position), 10), ("side view", camera.position)
+    # Theme: the page's background turns light.
+    page.page.keyboard.press("Space")
+    corner = (-3, int(box["x"] + box["width"] / 2))  # below the floating panels
+    dark = screenshot_rgb(page.page)[corner]
+    page.set_checkbox("Dark theme", False)
+    assert wait_until(lambda: screenshot_rgb(page.page)[corner].mean() > 200, 10), dark
+    assert dark.mean() < 40, dark
+    # Large text: the root font size (all panel text is in rem) grows.
+    root = "parseFloat(getComputedStyle(document.documentElement).fontSize)"
+    before = page.page.evaluate(root)
+    page.set_checkbox("Large text (projector)", True)
+    grown = before * LARGE_TEXT_PERCENT / 100
+    assert wait_until(lambda: page.page.evaluate(root) >= grown - 0.5, 10), before
+    label = (
+        "parseFloat(getComputedStyle([...document.querySelectorAll('label')].find("
+        "l => l.textContent === 'Dark theme')).fontSize)"
+    )
+    assert page.page.evaluate(label) >= 1.2 * 12
+    assert page.errors == []
+    assert session.stats.errors == 0, session.stats.last_error

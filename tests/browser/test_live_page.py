@@ -1,0 +1,162 @@
+"""The app in a real browser: Debian's Chromium, driven through playwright, rendering viser's
+WebGL client with SwiftShader. Each test drives the page like a user (keyboard on a slider
+thumb, clicks on the dropdown, the buttons and the checkboxes) and checks both what the server
+now holds and what the canvas shows."""
+
+from __future__ import annotations
+
+import colorsys
+
+import numpy as np
+import pytest
+from conftest import session_of, wait_until
+from poinsot.app.presets import DEFAULT_PRESET, Element, preset_by_key
+from poinsot.app.scene import palette
+
+pytestmark = pytest.mark.browser
+
+
+def amber_fraction(rgb: np.ndarray) -> float:
+    """Fraction of pixels with the ellipsoid's hue (amber, 22-45 degrees), saturated and not
+    dark (every other pixel sampled)."""
+    small = rgb[::2, ::2].reshape(-1, 3).astype(np.float64) / 255.0
+    hsv = np.array([colorsys.rgb_to_hsv(*px) for px in small[small.max(axis=1) > 0.15]])
+    if len(hsv) == 0:
+        return 0.0
+    hue = hsv[:, 0] * 360.0
+    amber = (hue > 22) & (hue < 45) & (hsv[:, 1] > 0.3) & (hsv[:, 2] > 0.18)
+    return float(np.sum(amber)) / len(small)
+
+
+def canvas_pixels(page) -> np.ndarray:
+    """The 3D view (left of the control panel) of a screenshot."""
+    rgb = page.screenshot_rgb()
+    return rgb[:, : int(rgb.shape[1] * 0.7)]
+
+
+def started(app, frames: int = 20):
+    session = session_of(app)
+    assert wait_until(lambda: session.stats.frames >= frames, 20), "the scene is not animating"
+    return session
+
+
+def pause(page, session) -> None:
+    page.click_button("Pause")
+    assert wait_until(lambda: session.clock.paused, 5)
+
+
+def test_page_loads_without_console_errors(poinsot_app, open_page):
+    page = open_page(poinsot_app.url)
+    session = started(poinsot_app, frames=60)
+    page.page.wait_for_timeout(1000)
+    assert page.errors == []
+    assert session.stats.errors == 0, session.stats.last_error
+    assert page.page.get_by_text("Stable about the major axis").count() >= 1
+
+
+def test_the_omega_plot_draws_its_three_components(poinsot_app, open_page):
+    """The live uPlot of omega_1, omega_2, omega_3 (numeric time axis) shows three curves."""
+    from PIL import Image
+
+    page = open_page(poinsot_app.url)
+    started(poinsot_app, frames=30)
+    plot = page.page.locator(".uplot-container").first
+    plot.wait_for(state="visible", timeout=20000)
+    page.page.wait_for_timeout(2500)  # a couple of seconds of samples
+    import io
+
+    rgb = np.asarray(Image.open(io.BytesIO(plot.screenshot())).convert("RGB")).astype(int)
+    for hex_color in palette.PLOT_SERIES:
+        color = np.array([int(hex_color[i : i + 2], 16) for i in (1, 3, 5)])
+        near = np.sum(np.abs(rgb - color).sum(axis=2) < 60)
+        assert near > 40, (hex_color, near)
+    assert page.errors == []
+
+
+def test_canvas_shows_the_ellipsoid(poinsot_app, open_page):
+    page = open_page(poinsot_app.url)
+    session = started(poinsot_app)
+    pause(page, session)
+    page.page.wait_for_timeout(500)
+    shown = canvas_pixels(page)
+    page.open_folder("Show")  # collapsed by default
+    page.set_checkbox("energy ellipsoid", False)
+    assert wait_until(lambda: not session.scene.is_visible(Element.ELLIPSOID), 5)
+    page.page.wait_for_timeout(500)
+    hidden = canvas_pixels(page)
+    # The semi-transparent amber ellipsoid covers a good part of the view; only it is amber.
+    assert amber_fraction(shown) > 0.02, amber_fraction(shown)
+    assert amber_fraction(hidden) < amber_fraction(shown) / 10, amber_fraction(hidden)
+    assert page.errors == []
+
+
+def test_moving_a_slider_changes_the_scene(poinsot_app, open_page):
+    page = open_page(poinsot_app.url)
+    session = started(poinsot_app)
+    pause(page, session)
+    page.page.wait_for_timeout(300)
+    before_pixels = canvas_pixels(page)
+    before_axes = session.scene.geometry.semi_axes.copy()
+    generation = session.generation
+    page.press_slider("I₁", "ArrowRight", times=15)  # I1: 1.00 -> 1.15, 15 steps of 0.01
+    assert wait_until(lambda: abs(session.params.inertia[0] - 1.15) < 1e-9, 10), session.params
+    assert session.generation > generation
+    assert page.slider_value("I₁") == pytest.approx(1.15)
+    assert session.preset.key == "custom"  # a hand edit leaves the preset
+    assert page.dropdown_value("Preset") == "Custom (edited)"
+    assert not np.allclose(session.scene.geometry.semi_axes, before_axes)
+    page.page.wait_for_timeout(500)
+    after_pixels = canvas_pixels(page)
+    changed = np.mean(np.any(np.abs(after_pixels.astype(int) - before_pixels) > 24, axis=2))
+    assert changed > 0.01, f"only {changed:.4f} of the view changed"
+    assert page.errors == []
+
+
+def test_choosing_a_preset_changes_the_scene(poinsot_app, open_page):
+    page = open_page(poinsot_app.url)
+    session = started(poinsot_app)
+    page.page.wait_for_timeout(300)
+    before = canvas_pixels(page)
+    sphere = preset_by_key("sphere")
+    page.choose("Preset", sphere.label)
+    assert wait_until(
+        lambda: (
+            session.preset.key == "sphere"
+            and session.body is not None
+            and session.params.inertia == sphere.inertia
+        ),
+        10,
+    )
+    # The sphere declares no traces and no energy control: they are gone from scene and panel.
+    assert session.scene.elements == sphere.elements
+    for gone in ("polhode (live)", "D = |L|²/2T", "Trail length"):
+        assert wait_until(lambda g=gone: page.control_count(g) == 0, 15), gone
+    assert page.control_count("|ω₀|") == 1  # declared by the sphere: still there
+    assert np.allclose(session.scene.geometry.semi_axes, 1.0)
+    page.page.wait_for_timeout(500)
+    after = canvas_pixels(page)
+    changed = np.mean(np.any(np.abs(after.astype(int) - before) > 24, axis=2))
+    assert changed > 0.01, f"only {changed:.4f} of the view changed"
+    assert page.errors == []
+
+
+def test_two_browsers_have_independent_sessions(poinsot_app, open_page):
+    first = open_page(poinsot_app.url)
+    a = started(poinsot_app)
+    second = open_page(poinsot_app.url)
+    assert wait_until(lambda: len(poinsot_app.sessions()) == 2, 10)
+    b = session_of(poinsot_app, 2)
+    assert a is not b
+    assert wait_until(lambda: b.stats.frames > 10, 10)
+    first.choose("Preset", preset_by_key("oblate").label)
+    assert wait_until(lambda: a.preset.key == "oblate", 10)
+    second.press_slider("|ω₀|", "ArrowRight", times=4)
+    assert wait_until(lambda: b.params.omega_norm == pytest.approx(1.4), 10)
+    # Each change stayed in its own session, scene and panel.
+    assert b.preset.key == "custom" and a.params.omega_norm == preset_by_key("oblate").omega_norm
+    assert a.params.inertia == preset_by_key("oblate").inertia
+    assert b.params.inertia == DEFAULT_PRESET.inertia
+    assert second.dropdown_value("Preset") == "Custom (edited)"
+    assert first.dropdown_value("Preset") == preset_by_key("oblate").label
+    assert a.scene.api is not b.scene.api
+    assert first.errors == [] and second.errors == []
