@@ -15,12 +15,15 @@ from poinsot.app.presets import PRESETS, preset_by_key
 
 def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--host", default="127.0.0.1",
+        "--host",
+        default="127.0.0.1",
         help="interface to listen on (0.0.0.0 lets students on the room's network connect)",
     )
     parser.add_argument("--port", type=int, default=8080, help="TCP port (0 = any free port)")
     parser.add_argument(
-        "--preset", default=PRESETS[0].key, choices=[p.key for p in PRESETS],
+        "--preset",
+        default=PRESETS[0].key,
+        choices=[p.key for p in PRESETS],
         help="scene each new browser starts with",
     )
 

@@ -11,7 +11,12 @@ import dataclasses
 import math
 
 from poinsot.app.presets import Preset
-from poinsot.physics import FreeRigidBody, attitude_with_L_along_z, check_real_body, omega_from_energy
+from poinsot.physics import (
+    FreeRigidBody,
+    attitude_with_L_along_z,
+    check_real_body,
+    omega_from_energy,
+)
 
 #: Slider ranges.
 INERTIA_RANGE = (0.1, 5.0)

@@ -1,4 +1,6 @@
-"""Speed of the closed form against bare ``scipy.special.ellipj``: ``python -m poinsot.physics.benchmark``.
+"""Speed of the closed form against bare ``scipy.special.ellipj``.
+
+Run it as ``python -m poinsot.physics.benchmark``.
 
 Prints, for 10⁶ times measured in this one run (so the ratios are meaningful on a noisy
 machine), the nanoseconds per point of ``omega(t)`` and ``attitude(t)`` next to bare
@@ -16,9 +18,8 @@ import argparse
 import time
 
 import numpy as np
-from scipy import special
-
 from poinsot.physics.rigid_body import FreeRigidBody
+from scipy import special
 
 # Cases timed: (label, inertia, omega0). Bare ellipj is run on the very same (u, m).
 CASES = (
@@ -98,7 +99,9 @@ def single_time(n: int = 1000) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m poinsot.physics.benchmark", description=__doc__)
+    parser = argparse.ArgumentParser(
+        prog="python -m poinsot.physics.benchmark", description=__doc__
+    )
     parser.add_argument("-n", type=int, default=1_000_000, help="times per evaluation")
     parser.add_argument("--repeat", type=int, default=5, help="best of this many runs")
     args = parser.parse_args(argv)

@@ -26,9 +26,8 @@ from dataclasses import dataclass
 from decimal import Decimal, localcontext
 
 import numpy as np
-from scipy import special
-
 from poinsot.physics import precise
+from scipy import special
 
 # The AGM stops when |a - b| <= _AGM_TOL * a. Convergence is quadratic, so the next step would
 # change a by (_AGM_TOL)^2 / 8 ~ 1e-17 relative: below double rounding (Numerical Recipes uses

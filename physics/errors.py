@@ -10,9 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial.transform import Rotation
-
 from poinsot.physics.rotations import geodesic_angle
+from scipy.spatial.transform import Rotation
 
 __all__ = [
     "angular_momentum_norm",

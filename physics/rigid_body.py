@@ -39,11 +39,10 @@ import math
 from decimal import Decimal, localcontext
 
 import numpy as np
-from scipy import special
-from scipy.spatial.transform import Rotation
-
 from poinsot.physics import elliptic, precise
 from poinsot.physics.regime import Regime
+from scipy import special
+from scipy.spatial.transform import Rotation
 
 __all__ = ["FreeRigidBody", "omega_from_energy", "attitude_with_L_along_z"]
 

@@ -9,7 +9,6 @@ axis i. These helpers let a scene say so and show a homogeneous box with the sam
 from __future__ import annotations
 
 import numpy as np
-
 from poinsot.physics.rigid_body import _check_inertia
 
 __all__ = ["check_real_body", "box_dimensions"]

@@ -29,15 +29,12 @@ import time
 import numpy as np
 import trimesh
 import trimesh.visual.material
-
-from poinsot.app.scene import palette
-
-from poinsot.app.scene import meshes
-from poinsot.app.scene.frames import wxyz
+from poinsot.app.exports.stage import Stage
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import Element, Preset, Solid, preset_by_key
+from poinsot.app.scene import meshes, palette
 from poinsot.app.scene.construction import HERPOLHODE_LIFT, PLANE_RADIUS, POLHODE_INFLATE, Geometry
-from poinsot.app.exports.stage import Stage
+from poinsot.app.scene.frames import wxyz
 from poinsot.app.scene.view import DEFAULT_VIEW, View
 from poinsot.physics import FreeRigidBody
 
@@ -222,8 +219,10 @@ def tube(
         normals[i] = n
     binormals = np.cross(tangents, normals)
     angles = np.linspace(0.0, 2.0 * np.pi, sides, endpoint=False)
-    ring = (np.cos(angles)[None, :, None] * normals[:, None]
-            + np.sin(angles)[None, :, None] * binormals[:, None])
+    ring = (
+        np.cos(angles)[None, :, None] * normals[:, None]
+        + np.sin(angles)[None, :, None] * binormals[:, None]
+    )
     vertices = (pts[:, None, :] + radius * ring).reshape(-1, 3)
     i = np.arange(len(pts) - 1)[:, None]
     j = np.arange(sides)[None, :]
@@ -268,9 +267,12 @@ def scene_glb(
     contact = np.asarray(body.contact_point(np.array([t])))[0] * s
     period = float(body.period)
     span = period if math.isfinite(period) and period > 0 else DEFAULT_SPAN
-    herpolhode = np.asarray(
-        body.contact_point(np.linspace(t - span, t, HERPOLHODE_POINTS)), dtype=np.float64
-    ) * s
+    herpolhode = (
+        np.asarray(
+            body.contact_point(np.linspace(t - span, t, HERPOLHODE_POINTS)), dtype=np.float64
+        )
+        * s
+    )
 
     scene = trimesh.Scene(base_frame="world")
     scene.graph.update(frame_from="world", frame_to="space", matrix=Z_UP_TO_Y_UP)
@@ -292,13 +294,19 @@ def scene_glb(
         add("solid", g.solid_mesh.copy(), "body")
 
     vertices, faces = meshes.disc_mesh(PLANE_RADIUS)
-    plane = trimesh.Trimesh(vertices=vertices + [0.0, 0.0, g.plane_height], faces=faces,
-                            process=False)
+    plane = trimesh.Trimesh(
+        vertices=vertices + [0.0, 0.0, g.plane_height], faces=faces, process=False
+    )
     add("plane", _painted(plane, palette.PLANE, 0.35), "space")
     lifted = herpolhode + [0.0, 0.0, HERPOLHODE_LIFT]
     add("herpolhode", _painted(tube(lifted), palette.HERPOLHODE), "space")
-    add("contact", _painted(trimesh.creation.icosphere(2, radius=0.035).apply_translation(contact),
-                            palette.CONTACT), "space")
+    add(
+        "contact",
+        _painted(
+            trimesh.creation.icosphere(2, radius=0.035).apply_translation(contact), palette.CONTACT
+        ),
+        "space",
+    )
     add("omega", _painted(_arrow(contact, 0.014, 0.04, 0.11), palette.OMEGA), "space")
     top = np.array([0.0, 0.0, g.plane_height + 0.65])
     add("L", _painted(_arrow(top, 0.016, 0.05, 0.14), palette.ANGULAR_MOMENTUM), "space")
@@ -379,7 +387,9 @@ def add_export_html_arguments(parser: argparse.ArgumentParser, presets: list[str
     parser.add_argument("--seconds", type=float, default=20.0, help="clip length (wall seconds)")
     parser.add_argument("--fps", type=float, default=HTML_FPS, help="recorded frames per second")
     parser.add_argument(
-        "--view", default="default", choices=("default", "top", "side"),
+        "--view",
+        default="default",
+        choices=("default", "top", "side"),
         help="initial camera (the viewer can still orbit)",
     )
     parser.add_argument("--light", action="store_true", help="light theme (default: dark)")

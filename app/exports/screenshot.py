@@ -31,12 +31,11 @@ import time
 from collections.abc import Iterator
 
 import numpy as np
-from scipy.spatial.transform import Rotation
-
+from poinsot.app.presets import PRESETS, Preset, preset_by_key
 from poinsot.app.scene.cameras import CAMERA_NAMES, space_view
 from poinsot.app.scene.frames import wxyz as to_wxyz
-from poinsot.app.presets import PRESETS, Preset, preset_by_key
 from poinsot.app.scene.view import View
+from scipy.spatial.transform import Rotation
 
 RGB = tuple[int, int, int]
 

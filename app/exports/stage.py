@@ -15,7 +15,6 @@ import warnings
 
 import numpy as np
 import viser
-
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import Element, Preset, Solid
 from poinsot.app.scene.construction import Frame, PoinsotScene

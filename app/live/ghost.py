@@ -51,10 +51,9 @@ from typing import Any, Protocol
 import numpy as np
 import viser
 import viser.uplot
-
 from poinsot.app.scene import meshes
-from poinsot.app.scene.frames import rotation_from_wxyz, wxyz_from_xyzw
 from poinsot.app.scene.construction import AXES_OVERSHOOT, Frame, Geometry, PoinsotScene
+from poinsot.app.scene.frames import rotation_from_wxyz, wxyz_from_xyzw
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.integrators import INTEGRATORS, Propagation, State
 

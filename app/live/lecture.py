@@ -24,13 +24,12 @@ import time
 from typing import Protocol
 
 import viser
-
 from poinsot.app.exports import export
-from poinsot.app.scene.cameras import BODY_VIEW, CAMERA_LABELS, ride_along, space_view
+from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
 from poinsot.app.live.clock import SimClock
 from poinsot.app.presets import Preset
+from poinsot.app.scene.cameras import BODY_VIEW, CAMERA_LABELS, ride_along, space_view
 from poinsot.app.scene.construction import Frame, PoinsotScene
-from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
 from poinsot.app.scene.view import View, configure_theme
 from poinsot.physics import FreeRigidBody
 
@@ -85,11 +84,14 @@ class LectureControls:
         labels = list(CAMERA_LABELS.values())
         with gui.add_folder("Lecture: views and export", order=order):
             self.views = gui.add_button_group(
-                "Camera", labels, hint="¾ view, along L (top), side, or riding on the body. "
-                "Keys 1-4."
+                "Camera",
+                labels,
+                hint="¾ view, along L (top), side, or riding on the body. Keys 1-4.",
             )
             self.size = gui.add_dropdown(
-                "Picture size", tuple(SIZE_CHOICES), initial_value=next(iter(SIZE_CHOICES)),
+                "Picture size",
+                tuple(SIZE_CHOICES),
+                initial_value=next(iter(SIZE_CHOICES)),
                 hint="Pixels of the PNG; 'current view' is the size of the 3D view.",
             )
             self.transparent = gui.add_checkbox(
@@ -97,11 +99,13 @@ class LectureControls:
             )
             self.screenshot = gui.add_button("Screenshot (PNG)", icon=viser.Icon.CAMERA)
             self.csv = gui.add_button(
-                "Data: t, ω, q (CSV)", icon=viser.Icon.TABLE_EXPORT,
+                "Data: t, ω, q (CSV)",
+                icon=viser.Icon.TABLE_EXPORT,
                 hint="The run so far (one period if it has just started), exact solution.",
             )
             self.glb = gui.add_button(
-                "Mesh: ellipsoid, plane, curves (GLB)", icon=viser.Icon.CUBE,
+                "Mesh: ellipsoid, plane, curves (GLB)",
+                icon=viser.Icon.CUBE,
                 hint="For Blender or any glTF viewer.",
             )
             self.dark = gui.add_checkbox("Dark theme", True)
@@ -119,8 +123,9 @@ class LectureControls:
         self.dark.on_update(lambda event: self.set_theme(dark=bool(event.target.value)))
         self.large.on_update(lambda event: self.set_theme(large=bool(event.target.value)))
 
-        self.commands = [gui.add_command("Play / pause", hotkey="space",
-                                         icon=viser.Icon.PLAYER_PLAY)]
+        self.commands = [
+            gui.add_command("Play / pause", hotkey="space", icon=viser.Icon.PLAYER_PLAY)
+        ]
         self.commands[0].on_trigger(lambda event: session.toggle_pause())
         for key, (name, label) in zip(CAMERA_HOTKEYS, CAMERA_LABELS.items(), strict=True):
             command = gui.add_command(f"Camera: {label}", hotkey=key, icon=viser.Icon.CAMERA)
@@ -212,7 +217,8 @@ class LectureControls:
         except TimeoutError:
             self.show(
                 f"Screenshot failed: the browser did not return the picture within "
-                f"{self.render_timeout:g} s. Try a smaller size.", error=True,
+                f"{self.render_timeout:g} s. Try a smaller size.",
+                error=True,
             )
         except Exception as exc:  # the GUI boundary: report, never raise into viser
             self.show(f"Screenshot failed: {type(exc).__name__}: {exc}", error=True)
@@ -222,14 +228,18 @@ class LectureControls:
         return None
 
     def download_csv(self) -> str | None:
-        return self._download("csv", lambda body, t, key: export.run_csv(
-            body, export.run_span(body, t), name=key, source=self.session.preset.source
-        ).encode("utf-8"))
+        return self._download(
+            "csv",
+            lambda body, t, key: export.run_csv(
+                body, export.run_span(body, t), name=key, source=self.session.preset.source
+            ).encode("utf-8"),
+        )
 
     def download_glb(self) -> str | None:
-        return self._download("glb", lambda body, t, key: export.scene_glb(
-            body, t, geometry=self.session.scene.geometry
-        ))
+        return self._download(
+            "glb",
+            lambda body, t, key: export.scene_glb(body, t, geometry=self.session.scene.geometry),
+        )
 
     def _download(self, suffix: str, make) -> str | None:
         try:

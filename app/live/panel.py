@@ -21,12 +21,16 @@ from typing import Any, Protocol
 import numpy as np
 import viser
 import viser.uplot
-
-from poinsot.app.scene import palette
-
 from poinsot.app.live import readouts
-from poinsot.app.parameters import INERTIA_RANGE, OMEGA_NORM_RANGE, SPEED_RANGE, TRAIL_RANGE, Parameters
+from poinsot.app.parameters import (
+    INERTIA_RANGE,
+    OMEGA_NORM_RANGE,
+    SPEED_RANGE,
+    TRAIL_RANGE,
+    Parameters,
+)
 from poinsot.app.presets import CUSTOM, PRESETS, Control, Element, Plot, Preset
+from poinsot.app.scene import palette
 
 ELEMENT_LABELS: dict[Element, str] = {
     Element.ELLIPSOID: "energy ellipsoid",

@@ -6,10 +6,9 @@ import threading
 import warnings
 
 import viser
-
 from poinsot.app.live.budget import FrameBudget
-from poinsot.app.presets import DEFAULT_PRESET, Preset
 from poinsot.app.live.session import MAX_FPS, Session
+from poinsot.app.presets import DEFAULT_PRESET, Preset
 
 
 class PoinsotApp:

@@ -18,7 +18,6 @@ import time
 from collections.abc import Callable
 
 import viser
-
 from poinsot.app.live import readouts
 from poinsot.app.live.budget import FrameBudget
 from poinsot.app.live.clock import SimClock

@@ -38,20 +38,31 @@ from typing import Any, TypeVar
 
 import numpy as np
 import scipy
-from scipy.spatial.transform import Rotation
-
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.integrators import INTEGRATORS, Integrator, integrate
+from scipy.spatial.transform import Rotation
 
 __all__ = ["CASES", "Case", "StudyConfig", "main", "run_report"]
 
 T = TypeVar("T")
 
 WORK_PRECISION_COLUMNS = (
-    "case", "method", "setting", "seconds", "omega_error", "attitude_error", "energy_drift",
+    "case",
+    "method",
+    "setting",
+    "seconds",
+    "omega_error",
+    "attitude_error",
+    "energy_drift",
 )
 ERROR_VS_TIME_COLUMNS = (
-    "case", "method", "setting", "t", "omega_error", "attitude_error", "energy_drift",
+    "case",
+    "method",
+    "setting",
+    "t",
+    "omega_error",
+    "attitude_error",
+    "energy_drift",
 )
 EXACT = "exact"
 #: Accuracy levels of the verdicts: max(omega error, attitude error) at or below each.
@@ -107,7 +118,9 @@ def _near_separatrix(mc: float) -> tuple[float, float, float]:
 
 
 GENERIC = Case(
-    "generic", (13.0, 10.0, 5.0), (0.3, 0.6, 0.9),
+    "generic",
+    (13.0, 10.0, 5.0),
+    (0.3, 0.6, 0.9),
     "uniform 1x2x3 box (I = M (b²+c², a²+c², a²+b²)/12, M = 12); omega0 chosen with m ~ 0.4",
     periods=10,
 )
@@ -116,56 +129,78 @@ CASES: tuple[Case, ...] = (
     GENERIC,
     *(
         Case(
-            f"near-separatrix 1-m={mc:.0e}", (1.0, 2.0, 3.0), _near_separatrix(mc),
+            f"near-separatrix 1-m={mc:.0e}",
+            (1.0, 2.0, 3.0),
+            _near_separatrix(mc),
             f"omega0 = (sqrt(3(1-mc)), 0, 1) on I = (1,2,3) puts 1-m at {mc:.0e} (Delta2/Delta1)",
-            periods=2, quick=mc in (1e-6, 1e-14),
+            periods=2,
+            quick=mc in (1e-6, 1e-14),
         )
         for mc in (1e-6, 1e-8, 1e-10, 1e-12, 1e-14)
     ),
     Case(
-        "separatrix", (2.0, 3.0, 6.0), (3.0, 0.25, 1.0),
+        "separatrix",
+        (2.0, 3.0, 6.0),
+        (3.0, 0.25, 1.0),
         "G² - 2T I2 == 0 exactly in floating point (72.5625 both): the limiting polhode; "
         "omega tends to the unstable rotation about I2 (rate ~1.4 per time unit)",
         horizon=20.0,
     ),
     Case(
-        "near-oblate 1e-6", (1.0, 1.0 + 1e-6, 2.0), (1.0, 0.5, 0.3),
+        "near-oblate 1e-6",
+        (1.0, 1.0 + 1e-6, 2.0),
+        (1.0, 0.5, 0.3),
         "a coin with a 1e-6 asymmetry: I1 ~ I2 < I3, elliptic parameter m ~ 1e-5",
         periods=10,
     ),
     Case(
-        "near-prolate 1e-10", (1.0, 2.0 - 2e-10, 2.0), (1.0, 0.5, 0.3),
+        "near-prolate 1e-10",
+        (1.0, 2.0 - 2e-10, 2.0),
+        (1.0, 0.5, 0.3),
         "a rod with a 1e-10 asymmetry: I1 < I2 ~ I3, elliptic parameter m ~ 1e-10",
         periods=10,
     ),
     Case(
-        "needle", (1e-4, 1.0, 1.0), (50.0, 1.0, 0.5),
+        "needle",
+        (1e-4, 1.0, 1.0),
+        (50.0, 1.0, 0.5),
         "a needle (I1 = 1e-4 I2) spinning fast about its axis: two time scales, 50 vs ~1",
         periods=10,
     ),
     Case(
-        "flat plate", (1.0, 2.0, 3.0), (1.0, 1.0, 1.0),
+        "flat plate",
+        (1.0, 2.0, 3.0),
+        (1.0, 1.0, 1.0),
         "the thin-plate limit I3 = I1 + I2 (the triangle inequality's edge)",
         periods=10,
     ),
     Case(
-        "non-physical 1:10:1000", (1.0, 10.0, 1000.0), (1.0, 1.0, 1.0),
+        "non-physical 1:10:1000",
+        (1.0, 10.0, 1000.0),
+        (1.0, 1.0, 1.0),
         "violates I3 <= I1 + I2 (no real body); Euler's rates reach ~1e3 |omega|: stiff",
         periods=10,
     ),
     Case(
-        "Toutatis", (1.0, 3.0836, 3.235), (1.714199, 0.0, 0.644256),
+        "Toutatis",
+        (1.0, 3.0836, 3.235),
+        (1.714199, 0.0, 0.644256),
         "asteroid 4179 Toutatis: moments from the radar shape model (Hudson & Ostro, Science "
         "270 (1995) 84; Scheeres et al., Icarus 132 (1998) 53); omega0 [rad/day] fitted to its "
         "long-axis mode, periods 5.41 d and 7.35 d",
         periods=10,
     ),
     Case(
-        "long horizon", GENERIC.inertia, GENERIC.omega0,
+        "long horizon",
+        GENERIC.inertia,
+        GENERIC.omega0,
         "the generic box followed for 1e4 periods (1e3 with --quick); loose settings are "
         "pointless there (errors O(1)), so the full run tries fewer, tighter ones, and longer",
-        periods=1e4, quick_periods=1e3,
-        tolerances=(1e-8, 1e-13), steps_per_scale=(16, 128), run_budget=90.0,
+        periods=1e4,
+        quick_periods=1e3,
+        tolerances=(1e-8, 1e-13),
+        steps_per_scale=(16, 128),
+        run_budget=90.0,
     ),
 )
 
@@ -531,9 +566,7 @@ def _study_case(
     failed: list[str] = []
     for name, integrator in INTEGRATORS.items():
         settings = (
-            [tau / n for n in steps_per_scale]
-            if integrator.kind == "fixed"
-            else list(tolerances)
+            [tau / n for n in steps_per_scale] if integrator.kind == "fixed" else list(tolerances)
         )
         previous: tuple[float, float] | None = None  # (setting, seconds)
         for k, value in enumerate(settings):
@@ -670,14 +703,27 @@ def _write_csvs(out: Path, results: list[CaseResult]) -> None:
             ex = r.exact
             w, a = ex.worst_inside
             writer.writerow(
-                [r.case.name, EXACT, "closed form", f"{ex.seconds:.6g}", _csv_float(w),
-                 _csv_float(a), _csv_float(ex.invariant_energy)]
+                [
+                    r.case.name,
+                    EXACT,
+                    "closed form",
+                    f"{ex.seconds:.6g}",
+                    _csv_float(w),
+                    _csv_float(a),
+                    _csv_float(ex.invariant_energy),
+                ]
             )
             for run in r.runs:
                 writer.writerow(
-                    [run.case, run.method, run.setting, f"{run.seconds:.6g}",
-                     _csv_float(run.omega_error), _csv_float(run.attitude_error),
-                     _csv_float(run.energy_drift)]
+                    [
+                        run.case,
+                        run.method,
+                        run.setting,
+                        f"{run.seconds:.6g}",
+                        _csv_float(run.omega_error),
+                        _csv_float(run.attitude_error),
+                        _csv_float(run.energy_drift),
+                    ]
                 )
     with open(out / "error_vs_time.csv", "w", newline="") as f:
         writer = csv.writer(f)
@@ -685,16 +731,28 @@ def _write_csvs(out: Path, results: list[CaseResult]) -> None:
         for r in results:
             for t, w, a in r.exact.checks + ([r.exact.far_check] if r.exact.far_check else []):
                 writer.writerow(
-                    [r.case.name, EXACT, "closed form", _csv_float(t), _csv_float(w),
-                     _csv_float(a), ""]
+                    [
+                        r.case.name,
+                        EXACT,
+                        "closed form",
+                        _csv_float(t),
+                        _csv_float(w),
+                        _csv_float(a),
+                        "",
+                    ]
                 )
             for run in r.runs:
                 for i, t in enumerate(run.times):
                     writer.writerow(
-                        [run.case, run.method, run.setting, _csv_float(float(t)),
-                         _csv_float(float(run.errors.omega[i])),
-                         _csv_float(float(run.errors.attitude[i])),
-                         _csv_float(float(run.errors.energy[i]))]
+                        [
+                            run.case,
+                            run.method,
+                            run.setting,
+                            _csv_float(float(t)),
+                            _csv_float(float(run.errors.omega[i])),
+                            _csv_float(float(run.errors.attitude[i])),
+                            _csv_float(float(run.errors.energy[i])),
+                        ]
                     )
 
 
@@ -722,7 +780,8 @@ def _verdict(r: CaseResult) -> tuple[str, list[tuple[float, str]]]:
     parts = []
     if math.isfinite(ex_acc):
         beaten = [
-            (lvl, run) for lvl, run in best_integrator.items()
+            (lvl, run)
+            for lvl, run in best_integrator.items()
             if run is not None and run.seconds < r.exact.seconds and lvl >= ex_acc
         ]
         if beaten:
@@ -747,7 +806,8 @@ def _verdict(r: CaseResult) -> tuple[str, list[tuple[float, str]]]:
             f"({most_accurate.method} {most_accurate.setting})"
         )
     hopeless = [
-        m for m in INTEGRATORS
+        m
+        for m in INTEGRATORS
         if (mine := [run for run in r.runs if run.method == m])
         and min(run.accuracy for run in mine) > 0.1
     ]
@@ -962,13 +1022,18 @@ def _write_markdown(
         ex_acc = max(ex_w, ex_a)
         for level, text in per_level:
             exact_text = (
-                f"{_g(r.exact.seconds * 1e3)} ms" if math.isfinite(ex_acc) and ex_acc <= level
-                else "not verified" if not math.isfinite(ex_acc) else "not reached"
+                f"{_g(r.exact.seconds * 1e3)} ms"
+                if math.isfinite(ex_acc) and ex_acc <= level
+                else "not verified"
+                if not math.isfinite(ex_acc)
+                else "not reached"
             )
             add(f"| {level:.0e} | {text} | {exact_text} |")
         add("")
-        add("| method | setting | seconds | repeats | cost | omega error | attitude error | "
-            "energy drift |")
+        add(
+            "| method | setting | seconds | repeats | cost | omega error | attitude error | "
+            "energy drift |"
+        )
         add("|---|---|---|---|---|---|---|---|")
         w, a = r.exact.worst_inside
         add(
@@ -1013,8 +1078,13 @@ def _cpu_count() -> int:
 # Figures (matplotlib is optional: the `report` extra)
 # ---------------------------------------------------------------------------------------------
 
-_COLOURS = {"RK45": "tab:blue", "DOP853": "tab:orange", "splitting": "tab:green",
-            "midpoint": "tab:purple", EXACT: "black"}
+_COLOURS = {
+    "RK45": "tab:blue",
+    "DOP853": "tab:orange",
+    "splitting": "tab:green",
+    "midpoint": "tab:purple",
+    EXACT: "black",
+}
 
 
 def _arrange(fig: Any) -> None:
@@ -1043,14 +1113,25 @@ def _write_figures(out: Path, results: list[CaseResult]) -> tuple[list[str], str
             for method in INTEGRATORS:
                 runs = [run for run in r.runs if run.method == method]
                 if runs:
-                    ax.loglog([run.seconds for run in runs],
-                              [max(pick(run), 1e-17) for run in runs],
-                              "o-", color=_COLOURS[method], label=method, ms=4)
+                    ax.loglog(
+                        [run.seconds for run in runs],
+                        [max(pick(run), 1e-17) for run in runs],
+                        "o-",
+                        color=_COLOURS[method],
+                        label=method,
+                        ms=4,
+                    )
             w, a = r.exact.worst_inside
             y = w if "omega" in ylabel else a
             if math.isfinite(y):
-                ax.loglog([r.exact.seconds], [max(y, 1e-17)], "*", color="black", ms=12,
-                          label="exact (vs mpmath)")
+                ax.loglog(
+                    [r.exact.seconds],
+                    [max(y, 1e-17)],
+                    "*",
+                    color="black",
+                    ms=12,
+                    label="exact (vs mpmath)",
+                )
             ax.set_title(r.case.name, fontsize=9)
             ax.set_xlabel("run time [s]", fontsize=8)
             ax.set_ylabel(ylabel, fontsize=8)
@@ -1073,13 +1154,24 @@ def _write_figures(out: Path, results: list[CaseResult]) -> tuple[list[str], str
                 continue
             best = min(runs, key=lambda run: run.accuracy)
             t = best.times[1:]
-            ax.loglog(t, np.maximum(best.errors.omega[1:], 1e-17), color=_COLOURS[method],
-                      label=f"{method} {best.setting}", lw=1)
+            ax.loglog(
+                t,
+                np.maximum(best.errors.omega[1:], 1e-17),
+                color=_COLOURS[method],
+                label=f"{method} {best.setting}",
+                lw=1,
+            )
         pts = r.exact.checks + ([r.exact.far_check] if r.exact.far_check else [])
         inside = [p for p in pts if p[0] <= r.t_end * (1 + 1e-12)]
         if inside:
-            ax.loglog([p[0] for p in inside], [max(p[1], 1e-17) for p in inside], "*",
-                      color="black", ms=10, label="exact vs mpmath")
+            ax.loglog(
+                [p[0] for p in inside],
+                [max(p[1], 1e-17) for p in inside],
+                "*",
+                color="black",
+                ms=10,
+                label="exact vs mpmath",
+            )
         ax.set_title(r.case.name, fontsize=9)
         ax.set_xlabel("simulated time", fontsize=8)
         ax.set_ylabel("omega error (relative)", fontsize=8)
@@ -1136,8 +1228,9 @@ def run_report(out: Path | str, quick: bool = False, progress: bool = True) -> R
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The ``report`` subcommand's options."""
-    parser.add_argument("--quick", action="store_true",
-                        help="a reduced matrix and fewer settings (< 60 s)")
+    parser.add_argument(
+        "--quick", action="store_true", help="a reduced matrix and fewer settings (< 60 s)"
+    )
     parser.add_argument("--out", default="out/report", help="output directory (created)")
 
 

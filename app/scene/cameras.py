@@ -11,7 +11,6 @@ through :func:`app.frames.rotation_from_wxyz`, the one place that knows the comp
 from __future__ import annotations
 
 import numpy as np
-
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.view import DEFAULT_VIEW, VIEWS, View
 

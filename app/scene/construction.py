@@ -36,13 +36,10 @@ from contextlib import AbstractContextManager
 import numpy as np
 import trimesh
 import viser
-
-from poinsot.app.scene import palette
-
-from poinsot.app.scene import meshes
+from poinsot.app.presets import Element, Solid
+from poinsot.app.scene import meshes, palette
 from poinsot.app.scene.frames import wxyz_from_xyzw
 from poinsot.app.scene.sampling import FIRST_BATCH, MotionSampler, Samples, trace_speed
-from poinsot.app.presets import Element, Solid
 from poinsot.app.scene.trail import Trail
 from poinsot.physics import FreeRigidBody, Regime
 

@@ -8,7 +8,6 @@ import functools
 
 import numpy as np
 import trimesh
-
 from poinsot.app.presets import Solid
 
 #: Icosphere subdivisions of the ellipsoid mesh: 2562 vertices, chord error ~ 2e-3.

@@ -5,7 +5,6 @@ from __future__ import annotations
 import dataclasses
 
 import viser
-
 from poinsot.app.scene import palette
 
 

@@ -113,9 +113,7 @@ def world_vertices(scene: trimesh.Scene, node: str) -> np.ndarray:
 
 def space_vertices(scene: trimesh.Scene, node: str) -> np.ndarray:
     """A node's vertices in the app's z-up space frame (undoing the glTF y-up root)."""
-    return trimesh.transform_points(
-        world_vertices(scene, node), np.linalg.inv(export.Z_UP_TO_Y_UP)
-    )
+    return trimesh.transform_points(world_vertices(scene, node), np.linalg.inv(export.Z_UP_TO_Y_UP))
 
 
 @pytest.mark.parametrize("key,t", [("major", 3.7), ("t_handle", 11.0), ("oblate", 2.0)])
@@ -196,8 +194,11 @@ def test_html_is_self_contained_and_records_every_frame():
     messages = recording["messages"]
     names = {m.get("name") for _, m in messages}
     assert {"/space/body/ellipsoid", "/space/plane/disc", "/space/L"} <= names
-    times = [t for t, m in messages if m.get("type") == "SetOrientationMessage"
-             and m.get("name") == "/space/body"]
+    times = [
+        t
+        for t, m in messages
+        if m.get("type") == "SetOrientationMessage" and m.get("name") == "/space/body"
+    ]
     assert len(times) == 30 + 1  # the snapshot at t = 0 and one pose per frame
     assert np.allclose(np.diff(times), 1 / 15)
     assert any(m.get("type") == "SetCameraFovMessage" for _, m in messages)
@@ -293,15 +294,23 @@ def test_every_preset_stages_and_seeks():
 
 def run_cli(*args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-m", "poinsot.app", *args], cwd=ROOT, env={**os.environ, **(env or {})},
-        capture_output=True, text=True, timeout=120,
+        [sys.executable, "-m", "poinsot.app", *args],
+        cwd=ROOT,
+        env={**os.environ, **(env or {})},
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
 
 
 def test_cli_screenshot_without_chromium_says_how_to_install_it(tmp_path):
     out = tmp_path / "x.png"
-    done = run_cli("screenshot", "--out", str(out),
-                   env={screenshot.CHROMIUM_ENV: str(tmp_path / "no-chromium")})
+    done = run_cli(
+        "screenshot",
+        "--out",
+        str(out),
+        env={screenshot.CHROMIUM_ENV: str(tmp_path / "no-chromium")},
+    )
     assert done.returncode == screenshot.EXIT_NO_BROWSER != 0
     assert "sudo apt-get install chromium" in done.stderr
     assert not out.exists()
@@ -320,7 +329,8 @@ def test_cli_export_html_writes_the_page(tmp_path):
     out = tmp_path / "clip.html"
     done = run_cli("export-html", "--preset", "oblate", "--seconds", "1.5", "--out", str(out))
     assert done.returncode == 0, done.stderr
-    assert re.search(r"wrote .*clip\.html \(0\.\d\d MB, 1\.5 s at 30 fps, preset oblate\)",
-                     done.stdout), done.stdout
+    assert re.search(
+        r"wrote .*clip\.html \(0\.\d\d MB, 1\.5 s at 30 fps, preset oblate\)", done.stdout
+    ), done.stdout
     recording = embedded_recording(out.read_text(encoding="utf-8"))
     assert recording["durationSeconds"] == pytest.approx(1.5)

@@ -117,7 +117,10 @@ def relative_energy_error(inertia: np.ndarray, omega0: np.ndarray, omega: np.nda
 def test_registry_lists_the_required_methods():
     assert set(INTEGRATORS) == {"RK45", "DOP853", "splitting", "midpoint"}
     assert {n: INTEGRATORS[n].order for n in INTEGRATORS} == {
-        "RK45": 5, "DOP853": 8, "splitting": 2, "midpoint": 2,
+        "RK45": 5,
+        "DOP853": 8,
+        "splitting": 2,
+        "midpoint": 2,
     }
     assert set(FIXED) == {"splitting", "midpoint"} == set(GEOMETRIC)
 
@@ -171,8 +174,12 @@ def test_fixed_step_grid_cuts_each_interval_into_equal_steps():
 )
 def test_bad_input_raises_readable_value_error(kwargs, message):
     args = {
-        "method": "splitting", "inertia": (1.0, 2.0, 3.0), "omega0": (1.0, 0.5, 0.2),
-        "attitude0": None, "t_eval": [0.0, 1.0], "setting": 0.1,
+        "method": "splitting",
+        "inertia": (1.0, 2.0, 3.0),
+        "omega0": (1.0, 0.5, 0.2),
+        "attitude0": None,
+        "t_eval": [0.0, 1.0],
+        "setting": 0.1,
     }
     args.update(kwargs)
     with pytest.raises(ValueError, match=message):

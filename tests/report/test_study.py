@@ -52,7 +52,13 @@ def test_work_precision_csv_columns_and_coverage(quick_report):
     columns, rows = read_rows(quick_report / "work_precision.csv")
     assert tuple(columns) == WORK_PRECISION_COLUMNS
     assert tuple(columns) == (
-        "case", "method", "setting", "seconds", "omega_error", "attitude_error", "energy_drift",
+        "case",
+        "method",
+        "setting",
+        "seconds",
+        "omega_error",
+        "attitude_error",
+        "energy_drift",
     )
     seen = {(r["case"], r["method"]) for r in rows}
     for case in QUICK_CASES:
@@ -159,7 +165,8 @@ def test_cases_are_data_with_sources_and_horizons():
     # The near-separatrix ladder reaches 1 - m = 1e-14 (to the rounding of the float omega0).
     mcs = sorted(
         FreeRigidBody(c.inertia, c.omega0).complementary_parameter
-        for c in CASES if c.name.startswith("near-separatrix")
+        for c in CASES
+        if c.name.startswith("near-separatrix")
     )
     assert mcs[0] == pytest.approx(1e-14, rel=0.05) and mcs[-1] == pytest.approx(1e-6, rel=1e-6)
     assert by_name["flat plate"].inertia[2] == sum(by_name["flat plate"].inertia[:2])
