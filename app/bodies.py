@@ -79,7 +79,9 @@ def _single_mesh(loaded: object, name: str) -> trimesh.Trimesh:
         meshes = [g for g in loaded.dump() if isinstance(g, trimesh.Trimesh)]
         if not meshes:
             raise MeshError(f"{name!r} holds no triangle mesh")
-        return trimesh.util.concatenate(meshes)
+        merged = trimesh.util.concatenate(meshes)
+        assert isinstance(merged, trimesh.Trimesh)
+        return merged
     if isinstance(loaded, trimesh.Trimesh):
         return loaded
     raise MeshError(f"{name!r} holds no triangle mesh (found {type(loaded).__name__})")
