@@ -46,9 +46,11 @@ def serve(args: argparse.Namespace) -> int:
 
 def report(args: argparse.Namespace) -> int:
     """Write the work-precision report into ``args.out`` (see :mod:`app.report`)."""
-    from poinsot.app.report.study import main as report_main
+    from pathlib import Path
 
-    return report_main(args)
+    from poinsot.app.report import run_report
+
+    return run_report(Path(args.out), quick=args.quick)
 
 
 def screenshot(args: argparse.Namespace) -> int:

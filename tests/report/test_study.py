@@ -16,17 +16,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from PIL import Image
+
 from poinsot.app.cli import main as cli_main
+from poinsot.app.report.cases import CASES, StudyConfig
+from poinsot.app.report.progress import Progress
 from poinsot.app.report.reference import TaylorReference
-from poinsot.app.report.study import (
-    CASES,
-    ERROR_VS_TIME_COLUMNS,
-    EXACT,
-    WORK_PRECISION_COLUMNS,
-    Progress,
-    StudyConfig,
-    _time_scale,
-)
+from poinsot.app.report.runs import time_scale
+from poinsot.app.report.tables import ERROR_VS_TIME_COLUMNS, EXACT, WORK_PRECISION_COLUMNS
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.integrators import INTEGRATORS
 
@@ -177,9 +173,9 @@ def test_cases_are_data_with_sources_and_horizons():
 
 
 def test_time_scale_follows_the_fastest_rate():
-    assert _time_scale((1.0, 1.0, 1.0), (0.0, 0.0, 2.0)) == pytest.approx(math.pi)
+    assert time_scale((1.0, 1.0, 1.0), (0.0, 0.0, 2.0)) == pytest.approx(math.pi)
     # Euler's rate |I2 - I3| / I1 |omega| = 990 |omega| dominates on (1, 10, 1000).
-    assert _time_scale((1.0, 10.0, 1000.0), (1.0, 0.0, 0.0)) == pytest.approx(2 * math.pi / 990)
+    assert time_scale((1.0, 10.0, 1000.0), (1.0, 0.0, 0.0)) == pytest.approx(2 * math.pi / 990)
 
 
 def test_taylor_reference_is_self_consistent_at_30_digits():
