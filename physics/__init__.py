@@ -3,14 +3,24 @@
 The closed-form elliptic-function solution of Euler's equations and the attitude, for every
 regime, plus the geometry of Poinsot's construction (polhode, herpolhode, invariable plane).
 
-    >>> from physics import FreeRigidBody
+    >>> from poinsot.physics import FreeRigidBody
     >>> body = FreeRigidBody(inertia=(1.0, 2.0, 3.0), omega0=(1.0, 0.1, 0.5))
     >>> body.omega([0.0, 1.0]).shape
     (2, 3)
+    >>> FreeRigidBody.from_energy((1.0, 2.0, 2.6), 2.0).regime.label
+    'separatrix'
+
+Rooms: :mod:`~poinsot.physics.free_body` (the public object), :mod:`~.classification` and
+:mod:`~.closed_forms` (regimes and their solutions), :mod:`~.elliptic` (Jacobi functions and
+integrals), :mod:`~.exact` and :mod:`~.precise` (exact and extra-precise arithmetic),
+:mod:`~.rotations` and :mod:`~.errors` (the quaternion algebra and the error measures),
+:mod:`~.integrators` (numerical methods to compare against), :mod:`~.initial_state`,
+:mod:`~.validation`, :mod:`~.relabelling`, :mod:`~.solids`.
 """
 
+from poinsot.physics.free_body import FreeRigidBody
+from poinsot.physics.initial_state import attitude_with_L_along_z, omega_from_energy
 from poinsot.physics.regime import Regime
-from poinsot.physics.rigid_body import FreeRigidBody, attitude_with_L_along_z, omega_from_energy
 from poinsot.physics.solids import box_dimensions, check_real_body
 
 __all__ = [

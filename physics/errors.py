@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from poinsot.physics.rotations import geodesic_angle
 from scipy.spatial.transform import Rotation
+
+from poinsot.physics.rotations import geodesic_angle
 
 __all__ = [
     "angular_momentum_norm",

@@ -9,7 +9,8 @@ axis i. These helpers let a scene say so and show a homogeneous box with the sam
 from __future__ import annotations
 
 import numpy as np
-from poinsot.physics.rigid_body import _check_inertia
+
+from poinsot.physics.validation import check_inertia
 
 __all__ = ["check_real_body", "box_dimensions"]
 
@@ -28,7 +29,7 @@ def check_real_body(inertia) -> None:
         ValueError: bad moments (as :class:`FreeRigidBody`), or a moment larger than the sum of
             the other two, with a message naming the offending axis.
     """
-    moments = _check_inertia(inertia)
+    moments = check_inertia(inertia)
     total = float(moments.sum())
     for i in range(3):
         others = total - moments[i]

@@ -18,7 +18,6 @@ import functools
 
 import numpy as np
 import pytest
-from poinsot.physics import FreeRigidBody
 from reference import (
     ATTITUDE_ATOL_GENERIC,
     ATTITUDE_ATOL_SEPARATRIX,
@@ -35,6 +34,8 @@ from reference import (
     omega0_with_complementary_parameter,
 )
 from scipy.spatial.transform import Rotation
+
+from poinsot.physics import FreeRigidBody
 
 CONSTANT_RTOL = 1e-13
 """``m``, ``1 - m``, ``lambda``, ``4K/lambda``, ``D``, ``T``: each is a handful of roundings of

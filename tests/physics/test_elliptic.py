@@ -15,7 +15,6 @@ import math
 import mpmath as mp
 import numpy as np
 import pytest
-from poinsot.physics.elliptic import ellipk, sncndn
 from reference import (
     EPS,
     MP_DPS,
@@ -24,6 +23,8 @@ from reference import (
     mp_parameter,
     mp_sncndn,
 )
+
+from poinsot.physics.elliptic import ellipk, sncndn
 
 ELLIPK_RTOL = 1e-14
 """K(m) relative error: Carlson's ``R_F(0, mc, 1)`` is accurate to a few ulps for every ``mc`` in

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from poinsot.physics import FreeRigidBody, Regime, attitude_with_L_along_z, omega_from_energy
 from reference import (
     ATTITUDE_ATOL_GENERIC,
     EPS,
@@ -22,6 +21,8 @@ from reference import (
     geodesic_angle,
 )
 from scipy.spatial.transform import Rotation
+
+from poinsot.physics import FreeRigidBody, Regime, attitude_with_L_along_z, omega_from_energy
 
 ROT0 = Rotation.from_rotvec([-0.7, 0.4, 1.2])
 

@@ -12,13 +12,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import poinsot.physics.integrators as integrators_module
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+import poinsot.physics.integrators.attitudes as attitudes_module
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.integrators import INTEGRATORS, Trajectory, integrate
-from scipy.spatial.transform import Rotation
 
 EPS = float(np.finfo(float).eps)
 
@@ -197,7 +198,7 @@ def test_chunked_attitude_assembly_matches_a_single_chunk(monkeypatch):
     t = np.linspace(0.0, 30.0, 7)
     for method in FIXED:
         whole = integrate(method, inertia, omega0, attitude0, t, 0.01)
-        monkeypatch.setattr(integrators_module, "_CHUNK", 37)
+        monkeypatch.setattr(attitudes_module, "_CHUNK", 37)
         chunked = integrate(method, inertia, omega0, attitude0, t, 0.01)
         monkeypatch.undo()
         np.testing.assert_array_equal(whole.omega, chunked.omega)
@@ -207,7 +208,7 @@ def test_chunked_attitude_assembly_matches_a_single_chunk(monkeypatch):
 def test_prefix_products_match_sequential_products():
     q = Rotation.random(1000, random_state=3).as_quat().T
     counts = np.array([0, 1, 2, 3, 511, 512, 513, 999, 1000, 1000])
-    tree = integrators_module._prefix_products(q, counts)
+    tree = attitudes_module.prefix_products(q, counts)
     acc = Rotation.identity()
     expected = {0: acc}
     for k in range(1000):

@@ -18,7 +18,6 @@ import math
 
 import numpy as np
 import pytest
-from poinsot.physics import FreeRigidBody, Regime
 from reference import (
     ATTITUDE_ATOL_GENERIC,
     OMEGA_RTOL_GENERIC,
@@ -30,6 +29,8 @@ from reference import (
     integrate_dop853,
 )
 from scipy.spatial.transform import Rotation
+
+from poinsot.physics import FreeRigidBody, Regime
 
 CROSSING_PERIOD_RTOL = 1e-10
 """Period measured as the spacing of DOP853 zero crossings (event roots on the dense output):

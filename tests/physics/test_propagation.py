@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from poinsot.physics.integrators import INTEGRATORS, Propagation, integrate
 from scipy.spatial.transform import Rotation
+
+from poinsot.physics.integrators import INTEGRATORS, Propagation, integrate
 
 INERTIA = np.array([1.0, 2.0, 2.6])
 OMEGA0 = np.array([0.35, 0.4, 1.1])

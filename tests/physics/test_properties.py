@@ -18,7 +18,6 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
-from poinsot.physics import FreeRigidBody, Regime
 from reference import (
     ATTITUDE_ATOL_GENERIC,
     EPS,
@@ -30,6 +29,8 @@ from reference import (
     hat,
 )
 from scipy.spatial.transform import Rotation
+
+from poinsot.physics import FreeRigidBody, Regime
 
 FD_STEP = 0.05
 """Finite-difference step for ``dR/dt``, in units of the fastest time scale ``1/rate``."""

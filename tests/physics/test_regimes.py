@@ -12,7 +12,6 @@ import itertools
 
 import numpy as np
 import pytest
-from poinsot.physics import FreeRigidBody, Regime
 from reference import (
     ATTITUDE_ATOL_GENERIC,
     ATTITUDE_ATOL_SEPARATRIX,
@@ -25,6 +24,8 @@ from reference import (
     geodesic_angle,
 )
 from scipy.spatial.transform import Rotation
+
+from poinsot.physics import FreeRigidBody, Regime
 
 ROT0 = Rotation.from_rotvec([0.4, -0.9, 1.7])
 

@@ -20,9 +20,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from poinsot.physics import FreeRigidBody, Regime, elliptic, precise
-from poinsot.physics.rigid_body import _sqrt_ratio
 from scipy.spatial.transform import Rotation
+
+from poinsot.physics import FreeRigidBody, Regime, elliptic, precise
+from poinsot.physics.exact import sqrt_ratio
 
 SCALAR_RTOL = 4e-16
 """Scalar against array path, relative to |ω| (ω, contact point) or to 1 (quaternions):
@@ -169,7 +170,7 @@ def test_sqrt_ratio_is_correctly_rounded() -> None:
         with localcontext() as ctx:
             ctx.prec = 120
             exact = (Decimal(num) / Decimal(den)).sqrt()
-        assert _sqrt_ratio(num, den) == float(exact), (num, den)
+        assert sqrt_ratio(num, den) == float(exact), (num, den)
 
 
 @pytest.mark.parametrize("mc", ["0.62", "0.5", "1e-10", "1e-16", "1e-300", "0.999999", "1"])

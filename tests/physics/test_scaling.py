@@ -15,9 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from poinsot.physics import FreeRigidBody
 from reference import as_matrices, geodesic_angle
 from scipy.spatial.transform import Rotation
+
+from poinsot.physics import FreeRigidBody
 
 SCALE_RTOL = 1e-12
 """omega and attitude under a change of units, over 3 periods: the rounded scaled inputs

@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from poinsot.physics import FreeRigidBody, attitude_with_L_along_z, omega_from_energy
 from scipy.spatial.transform import Rotation
+
+from poinsot.physics import FreeRigidBody, attitude_with_L_along_z, omega_from_energy
 
 GOOD_I = (1.0, 2.0, 3.0)
 GOOD_W = (0.3, 0.2, 1.0)
