@@ -1,0 +1,324 @@
+"""Fit the exact torque-free solution to a recorded ω(t): :func:`fit_angular_velocity`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from poinsot.physics.fit import model
+from poinsot.physics.fit.model import Layout
+from poinsot.physics.fit.result import (
+    AngularVelocityFit,
+    covariance,
+    flip_period,
+    propagate,
+    quality_message,
+    sensor_reading,
+)
+from poinsot.physics.fit.samples import (
+    MIN_SAMPLES,
+    SIGN_THRESHOLD,
+    Smoothed,
+    check_samples,
+    half_width_for,
+    sign_change_counts,
+    sign_changes,
+    smooth,
+)
+from poinsot.physics.fit.start import Start, euler_estimate, family_starts
+
+#: ω must vary by at least this fraction of |ω| during the segment: a steady spin about one
+#: principal axis reveals nothing of the moments.
+MIN_VARIATION = 0.01
+# The model's sign changes are counted at these multiples of the data's threshold: a component
+# that just grazes the threshold may or may not count in noisy data.
+_GRAZE = (0.7, 1.3)
+# Growing windows: the first covers this many radians of rotation; each start runs
+# _SCREEN_NFEV iterations on each window; after each window the starts whose cost exceeds
+# _PROMISING times the best's are dropped; the rest are polished (up to _POLISH_NFEV).
+_FIRST_WINDOW = 3.0
+_SCREEN_NFEV = 5
+_PROMISING = 4.0
+_POLISH_NFEV = 200
+# A candidate whose sign changes agree with the data's beats a smaller residual that does not
+# agree only if its cost is within this factor.
+_COMPARABLE = 1.5
+# Forward-difference step of the Jacobian, relative (the closed form is exact to rounding).
+_STEP = 1.5e-8
+
+
+class _Problem:
+    """The data of one fit, and the model's residuals and Jacobian on them.
+
+    Only the five parameters of the body (moments, ω0) need new closed-form solutions to be
+    differentiated; the rotation and the bias act on the body's ω afterwards, so their Jacobian
+    columns reuse the last ω computed (cached by parameter vector).
+    """
+
+    def __init__(self, t, omega, smoothed: Smoothed, layout: Layout, threshold: float, counts):
+        self.t, self.omega, self.smoothed, self.layout = t, omega, smoothed, layout
+        self.threshold = threshold  # of the sign changes [rad/s]
+        self.counts = counts  # (3,) sign changes of the smoothed data
+        self.tau = t - t[0]
+        self._penalty = 10.0 * float(np.max(np.abs(omega)))
+        self._cache: tuple[bytes, NDArray[np.float64] | None] = (b"", None)
+
+    def window(self, n: int) -> _Problem:
+        """The same problem on the first ``n`` samples only."""
+        return _Problem(
+            self.t[:n], self.omega[:n], self.smoothed, self.layout, self.threshold, self.counts
+        )
+
+    def _evaluate(self, core: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """(N, 3) ω of the body with parameters ``core`` (5,), or None if refused."""
+        try:
+            return model.body_omega(core, self.tau)
+        except ValueError:  # parameters the closed form refuses
+            return None
+
+    def _body_omega(self, core: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """:meth:`_evaluate`, remembered for the last parameters (least_squares asks for the
+        residuals, then the Jacobian, at the same point)."""
+        key = core.tobytes()
+        if key != self._cache[0]:
+            self._cache = (key, self._evaluate(core))
+        return self._cache[1]
+
+    def _sensor(self, x: NDArray[np.float64], w: NDArray[np.float64]) -> NDArray[np.float64]:
+        matrix = model.rotation_matrix(x, self.layout)
+        return w if matrix is None else w @ matrix  # row form of Rᵀ ω
+
+    def residuals(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        w = self._body_omega(x[:5])
+        if w is None:  # a large, finite penalty
+            return np.full(self.omega.size, self._penalty)
+        pred = self._sensor(x, w)
+        if self.layout.bias:
+            pred = pred + x[self.layout.bias_slice]
+        return (pred - self.omega).ravel()
+
+    def jacobian(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """(3N, p): forward differences for the body's parameters, the rest from the cached ω."""
+        w = self._body_omega(x[:5])
+        if w is None:
+            return np.zeros((self.omega.size, x.size))
+        cols = []
+        for i in range(x.size):
+            h = _STEP * max(1.0, abs(float(x[i])))
+            e = np.zeros_like(x)
+            e[i] = h
+            if i < 5:
+                wi = self._evaluate(x[:5] + e[:5])
+                d = np.zeros_like(w) if wi is None else self._sensor(x, wi - w) / h
+            elif self.layout.rotation and i < 8:
+                d = (self._sensor(x + e, w) - self._sensor(x, w)) / h
+            else:  # the bias
+                d = np.zeros_like(w)
+                d[:, i - x.size + 3] = 1.0
+            cols.append(d.ravel())
+        return np.stack(cols, axis=1)
+
+    def consistent(self, x: NDArray[np.float64]) -> bool:
+        """Do the model's components change sign as the data's do (within the grazing range)?"""
+        w = self.residuals(x).reshape(-1, 3) + self.omega
+        a, b = (sign_change_counts(self.t, w, g * self.threshold) for g in _GRAZE)
+        return bool(np.all((np.minimum(a, b) <= self.counts) & (self.counts <= np.maximum(a, b))))
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    x: NDArray[np.float64]
+    cost: float
+    consistent: bool
+
+
+def fit_angular_velocity(
+    t: ArrayLike, omega: ArrayLike, *, fit_rotation: bool = False, fit_bias: bool = False
+) -> AngularVelocityFit:
+    """Fit the exact free-body solution [LL76 §37] to a recorded angular velocity.
+
+    Args:
+        t: (N,) strictly increasing sample times [s], N >= 20 (one flight: no hand, no table).
+        omega: (N, 3) angular velocity [rad/s] in the sensor's axes.
+        fit_rotation: also fit a (small) rotation between the sensor's and the principal axes.
+        fit_bias: also fit a constant gyroscope bias.
+
+    Returns:
+        An :class:`AngularVelocityFit`. A motion no torque-free body explains (a torque acted)
+        is still returned, with ``explained=False`` and a ``message`` giving the residual
+        relative to |ω|.
+
+    Raises:
+        ValueError: wrong shapes, too few samples, NaN or infinite values, times that do not
+            increase, a body that hardly turns, or a ω that stays constant (a steady spin about
+            a principal axis, which does not reveal the moments).
+
+    Method: Euler's equations, linear in the moments once ω and dω/dt are smoothed out of the
+    data, give a first estimate (:mod:`poinsot.physics.fit.start`); nonlinear least squares
+    (``scipy.optimize.least_squares``) of the exact solution then start from it and from every
+    other assignment of the moments to the axes in both families. The candidates whose
+    components change sign where the data's do are preferred, the smallest residual wins.
+    """
+    problem = _problem(t, omega, fit_rotation, fit_bias)
+    inertia0, matrix0 = euler_estimate(
+        problem.smoothed.value, problem.smoothed.derivative, fit_rotation
+    )
+    rotvec0 = Rotation.from_matrix(matrix0).as_rotvec() if fit_rotation else None
+    omega0 = matrix0 @ problem.smoothed.value[0]
+    starts = family_starts(inertia0, omega0)
+    x0s = [problem.layout.pack(s.inertia, omega0, rotvec0) for s in _plausible(starts, problem)]
+    best = _search(problem, x0s)
+    return _result(problem, best)
+
+
+def _problem(t, omega, fit_rotation: bool, fit_bias: bool) -> _Problem:
+    t_arr, w_arr = check_samples(t, omega)
+    smoothed = smooth(t_arr, w_arr, half_width_for(t_arr, w_arr))
+    speed = np.linalg.norm(smoothed.value, axis=1)
+    variation = float(np.max(np.ptp(smoothed.value, axis=0)))
+    if variation < max(MIN_VARIATION * float(np.mean(speed)), 5.0 * smoothed.noise):
+        raise ValueError(
+            f"ω stays constant during this segment (it varies by {variation:.2g} rad/s at "
+            f"|ω| ≈ {np.mean(speed):.3g} rad/s): a steady spin about one principal axis does "
+            "not reveal the moments of inertia; throw the body with a visible wobble"
+        )
+    threshold = SIGN_THRESHOLD * float(np.max(speed))
+    counts = sign_change_counts(t_arr, smoothed.value, threshold)
+    return _Problem(t_arr, w_arr, smoothed, Layout(fit_rotation, fit_bias), threshold, counts)
+
+
+def _plausible(starts: list[Start], problem: _Problem) -> list[Start]:
+    """The starts whose family lets the data's sign changes happen.
+
+    In each family one component never changes sign (``dn``, [LL76 §37, Eq. 37.10]): a start
+    that gives that role to a component the data see changing sign cannot be right. Of the 12
+    starts this keeps 4 once the data show two components changing sign (both families, either
+    of the two as the intermediate axis); all of them if the data show none.
+    """
+    kept = [s for s in starts if problem.counts[s.steady] == 0]
+    return kept or starts
+
+
+def _search(problem: _Problem, x0s: list[NDArray[np.float64]]) -> _Candidate:
+    """Fit from every start on growing windows of the data, keep the promising, choose.
+
+    Near the separatrix a small error in the parameters shifts the flips by a time that grows
+    like ``exp(σ t)``, ``σ <= |ω|`` [LL76 §37, Problem 1]: fitting the first ``3/|ω|`` seconds
+    first, then windows twice as long, brings each start close enough at every step for the
+    longer record to be fitted without crawling along a narrow valley. After each window the
+    candidates whose cost exceeds :data:`_PROMISING` times the best's are dropped; the rest
+    are polished on the whole record. The smallest residual wins, unless its components
+    change sign where the data's do not (or the reverse) and a candidate that agrees with
+    the data has a comparable residual.
+    """
+    xs = x0s
+    for count in _window_counts(problem):
+        window = problem.window(count)
+        fits = sorted((_solve(window, x, _SCREEN_NFEV) for x in xs), key=lambda f: f[1])
+        xs = [x for x, cost in fits if cost <= _PROMISING * fits[0][1]]
+    polished = []
+    for x in xs:
+        x, cost = _solve(problem, x, _POLISH_NFEV)
+        polished.append(_Candidate(x, cost, problem.consistent(x)))
+    polished.sort(key=lambda c: c.cost)
+    best = polished[0]
+    if not best.consistent:
+        agreeing = [c for c in polished if c.consistent and c.cost <= _COMPARABLE * best.cost]
+        best = agreeing[0] if agreeing else best
+    return best
+
+
+def _window_counts(problem: _Problem) -> list[int]:
+    """Sample counts of the growing windows: durations ``3 · 2^k / max|ω|``, then all."""
+    n = problem.t.size
+    duration = _FIRST_WINDOW / float(np.max(np.linalg.norm(problem.smoothed.value, axis=1)))
+    counts = []
+    while True:
+        count = int(np.searchsorted(problem.tau, duration)) + 1
+        if count >= n:
+            break
+        counts.append(max(count, min(MIN_SAMPLES, n)))
+        duration *= 2.0
+    return counts + [n]
+
+
+def _solve(
+    problem: _Problem, x0: NDArray[np.float64], max_nfev: int
+) -> tuple[NDArray[np.float64], float]:
+    """Levenberg–Marquardt from ``x0``: the parameters reached and their cost ``½ Σ r²``."""
+    result = least_squares(
+        problem.residuals,
+        x0,
+        jac=problem.jacobian,
+        method="lm",
+        x_scale="jac",
+        max_nfev=max_nfev,
+        ftol=1e-12,
+        xtol=1e-12,
+        gtol=1e-12,
+    )
+    return result.x, float(result.cost)
+
+
+def _result(problem: _Problem, best: _Candidate) -> AngularVelocityFit:
+    """The result at the chosen parameters, its axes labelled after the sensor's."""
+    layout = problem.layout
+    x = model.relabelled(best.x, layout)
+    cov = covariance(problem.jacobian(x), problem.residuals(x))
+    sigma = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    fitted = model.body(x)
+    matrix = model.rotation_matrix(x, layout)
+    bias = x[layout.bias_slice].copy() if layout.bias else None
+    residual = sensor_reading(fitted, matrix, bias, problem.tau) - problem.omega
+    rms = float(np.sqrt(np.mean(residual**2)))
+    scale = float(np.sqrt(np.mean(np.sum(problem.omega**2, axis=1))))
+    explained, message = quality_message(rms, scale, problem.smoothed.noise, best.consistent)
+    inertia = model.moments(x)
+    intermediate = int(np.argsort(inertia)[1])
+    flip = flip_period(fitted)
+    return AngularVelocityFit(
+        inertia=inertia,
+        inertia_sigma=propagate(model.moments, x, cov),
+        omega0=x[2:5].copy(),
+        omega0_sigma=sigma[2:5],
+        rotation=None if matrix is None else Rotation.from_matrix(matrix),
+        rotation_sigma=sigma[layout.rotation_slice] if layout.rotation else None,
+        bias=bias,
+        bias_sigma=sigma[layout.bias_slice] if layout.bias else None,
+        body=fitted,
+        t0=float(problem.t[0]),
+        rms=rms,
+        relative_rms=rms / scale,
+        noise=problem.smoothed.noise,
+        regime=fitted.regime,
+        intermediate_axis=intermediate,
+        period=float(fitted.period),
+        flip_period=flip,
+        flip_period_sigma=float(propagate(lambda y: flip_period(model.body(y)), x, cov)[0]),
+        measured_flip_period=_measured_flip(problem, x, intermediate),
+        separatrix_distance=model.separatrix_distance(x),
+        separatrix_sigma=float(propagate(model.separatrix_distance, x, cov)[0]),
+        family_confirmed=best.consistent,
+        explained=explained,
+        message=message,
+        n_samples=int(problem.t.size),
+    )
+
+
+def _measured_flip(problem: _Problem, x: NDArray[np.float64], axis: int) -> float | None:
+    """Mean spacing [s] of the sign changes of the data's intermediate component (principal
+    axes, bias removed), or ``None`` if it changes sign fewer than twice."""
+    w = problem.smoothed.value
+    if problem.layout.bias:
+        w = w - x[problem.layout.bias_slice]
+    matrix = model.rotation_matrix(x, problem.layout)
+    if matrix is not None:
+        w = w @ matrix.T
+    times = sign_changes(problem.t, w[:, axis], problem.threshold)
+    if times.size < 2:
+        return None
+    return float((times[-1] - times[0]) / (times.size - 1))
