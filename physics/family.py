@@ -52,6 +52,7 @@ __all__ = [
     "momentum_view",
     "polhode_curves",
     "polhode_family",
+    "polhode_points",
     "polhode_progress",
 ]
 
@@ -205,44 +206,85 @@ def _pure_spins(J: NDArray[np.float64], D: float, two_T: float) -> _Parts:
     return parts
 
 
-def _separatrix_arcs(J: NDArray[np.float64], two_T: float, n: int) -> _Parts:
-    """``D = I2``: ``(s1 A1 cos φ, A2 sin φ, s3 A3 cos φ)``, φ from -π/2 to π/2 [Pars65 §13.12,
-    Eqs. 13.12.19-20]: four arcs from ``-e2`` to ``+e2``; ``(s1, s3)`` and ``(-s1, -s3)`` make up
-    one of the two ellipses (planes through e2)."""
-    I1, I2, I3 = J
-    phi = np.linspace(-0.5 * math.pi, 0.5 * math.pi, n)
+def _branch(
+    J: NDArray[np.float64], D: float, two_T: float, phi: NDArray, signs: tuple[int, int, int]
+) -> NDArray[np.float64]:
+    """The points ω (N, 3) at the amplitudes ``phi`` (N,) on one branch of the polhodes of D:
+    ``(A1 cos φ, A2 sin φ, s3 A3 dn)`` if ``D > I2``, ``(s1 A1 dn, A2 sin φ, A3 cos φ)`` if
+    ``D < I2``, ``(s1 A1 cos φ, A2 sin φ, s3 A3 cos φ)`` if ``D = I2`` [LL76 §37, Eq. 37.10;
+    Pars65 §13.12, Eqs. 13.12.19-20]; amplitudes as in the module docstring. ``D = I1`` or
+    ``I3`` gives the pole itself for every φ."""
+    I1, I2, I3 = (float(x) for x in J)
+    s1, _, s3 = signs
     cos, sin = np.cos(phi), np.sin(phi)
-    A1 = math.sqrt(two_T * (I3 - I2) / (I1 * (I3 - I1)))
-    A2 = math.sqrt(two_T / I2)
-    A3 = math.sqrt(two_T * (I2 - I1) / (I3 * (I3 - I1)))
-    return [
-        (np.stack([s1 * A1 * cos, A2 * sin, s3 * A3 * cos], axis=-1), (s1, 1, s3))
-        for s1, s3 in ((1, 1), (1, -1), (-1, 1), (-1, -1))
-    ]
-
-
-def _closed_polhodes(J: NDArray[np.float64], D: float, two_T: float, n: int) -> _Parts:
-    """``D ≠ I2``: the two closed curves around ``±e3`` (``D > I2``) or ``±e1`` (``D < I2``),
-    uniform in the amplitude φ [LL76 §37, Eq. 37.10]; amplitudes as in the module docstring."""
-    I1, I2, I3 = J
-    phi = np.linspace(0.0, 2.0 * math.pi, n, endpoint=False)
-    cos, sin = np.cos(phi), np.sin(phi)
+    if D == I2:
+        A1 = math.sqrt(two_T * (I3 - I2) / (I1 * (I3 - I1)))
+        A3 = math.sqrt(two_T * (I2 - I1) / (I3 * (I3 - I1)))
+        return np.stack([s1 * A1 * cos, math.sqrt(two_T / I2) * sin, s3 * A3 * cos], axis=-1)
     A1 = math.sqrt(two_T * (I3 - D) / (I1 * (I3 - I1)))
     A3 = math.sqrt(two_T * (D - I1) / (I3 * (I3 - I1)))
     if D > I2:
         A2 = math.sqrt(two_T * (I3 - D) / (I2 * (I3 - I2)))
         mc = (I3 - I1) * (D - I2) / ((I3 - I2) * (D - I1))
         dn = np.sqrt(cos * cos + mc * sin * sin)
-        return [
-            (np.stack([A1 * cos, A2 * sin, pole * A3 * dn], axis=-1), (1, 1, pole))
-            for pole in (1, -1)
-        ]
+        return np.stack([A1 * cos, A2 * sin, s3 * A3 * dn], axis=-1)
     A2 = math.sqrt(two_T * (D - I1) / (I2 * (I2 - I1)))
     mc = (I3 - I1) * (I2 - D) / ((I2 - I1) * (I3 - D))
     dn = np.sqrt(cos * cos + mc * sin * sin)
-    return [
-        (np.stack([pole * A1 * dn, A2 * sin, A3 * cos], axis=-1), (pole, 1, 1)) for pole in (1, -1)
-    ]
+    return np.stack([s1 * A1 * dn, A2 * sin, A3 * cos], axis=-1)
+
+
+def _separatrix_arcs(J: NDArray[np.float64], two_T: float, n: int) -> _Parts:
+    """``D = I2``: four arcs from ``-e2`` to ``+e2`` (φ from -π/2 to π/2); ``(s1, s3)`` and
+    ``(-s1, -s3)`` make up one of the two ellipses (planes through e2)."""
+    phi = np.linspace(-0.5 * math.pi, 0.5 * math.pi, n)
+    out: _Parts = []
+    for s1, s3 in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+        signs = (s1, 1, s3)
+        out.append((_branch(J, float(J[1]), two_T, phi, signs), signs))
+    return out
+
+
+def _closed_polhodes(J: NDArray[np.float64], D: float, two_T: float, n: int) -> _Parts:
+    """``D ≠ I2``: the two closed curves around ``±e3`` (``D > I2``) or ``±e1`` (``D < I2``),
+    uniform in the amplitude φ."""
+    phi = np.linspace(0.0, 2.0 * math.pi, n, endpoint=False)
+    out: _Parts = []
+    for pole in (1, -1):
+        signs = (1, 1, pole) if D > J[1] else (pole, 1, 1)
+        out.append((_branch(J, D, two_T, phi, signs), signs))
+    return out
+
+
+def polhode_points(
+    inertia: ArrayLike,
+    D: float,
+    phi: ArrayLike,
+    signs: tuple[int, int, int] = (1, 1, 1),
+    *,
+    energy: float | None = None,
+    momentum: float | None = None,
+) -> NDArray[np.float64]:
+    """Points ω (N, 3) [rad/time] at the amplitudes ``phi`` (N,) [rad] on one branch of the
+    polhodes of D, the branch named by the :attr:`PolhodeCurve.signs` of its curve.
+
+    Args:
+        inertia: (3,) ``I1 < I2 < I3``. D: ``G²/2T`` in ``[I1, I3]``. phi: (N,) amplitudes
+            (on the separatrix, ``-π/2 … π/2`` runs from ``-e2`` to ``+e2``).
+        signs: ``(s1, 1, s3)``: the pole sign on the pole axis (``s1`` below the separatrix,
+            ``s3`` above it), both arc signs on it. energy, momentum: as in
+            :func:`polhode_curves`.
+    """
+    I1, I2, I3 = sorted_moments(inertia)
+    D = _check_D(D, I1, I3)
+    s1, s2, s3 = (int(x) for x in signs)
+    if s2 != 1 or s1 not in (1, -1) or s3 not in (1, -1):
+        raise ValueError(f"signs must be (±1, 1, ±1), got {signs!r}")
+    angles = np.atleast_1d(np.asarray(phi, dtype=float))
+    if angles.ndim != 1 or not np.all(np.isfinite(angles)):
+        raise ValueError("phi must be a finite number or a 1-D array of finite numbers")
+    two_T, _ = _two_T_and_G(D, energy, momentum)
+    return _branch(np.array([I1, I2, I3]), D, two_T, angles, (s1, 1, s3))
 
 
 def polhode_family(

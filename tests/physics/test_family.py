@@ -20,6 +20,7 @@ from poinsot.physics.family import (
     momentum_view,
     polhode_curves,
     polhode_family,
+    polhode_points,
     polhode_progress,
 )
 
@@ -217,3 +218,26 @@ def test_arc_rejects_non_bodies_and_bad_times():
     arc = PolhodeArc(FreeRigidBody((1.0, 2.0, 3.0), (1.0, 0.3, 0.2)))
     with pytest.raises(ValueError, match="finite"):
         arc.fraction([0.0, math.inf])
+
+
+def test_polhode_points_are_the_curves_at_any_amplitude():
+    inertia = (1.0, 2.0, 3.0)
+    rng = np.random.default_rng(7)
+    phi = rng.uniform(-4.0, 4.0, 200)
+    for D in (1.0, 1.4, 2.0, 2.6, 3.0):
+        for curve in polhode_curves(inertia, D, energy=0.8, n=16):
+            w = polhode_points(inertia, D, phi, curve.signs, energy=0.8)
+            J = np.asarray(inertia)
+            assert np.abs((w * w) @ J / curve.two_T - 1.0).max() <= SURFACE_RTOL
+            assert np.abs(np.linalg.norm(w * J, axis=1) / curve.G - 1.0).max() <= SURFACE_RTOL
+            if curve.omega.shape[0] > 1:
+                grid = (
+                    np.linspace(-0.5 * math.pi, 0.5 * math.pi, 16)
+                    if curve.regime is Regime.SEPARATRIX
+                    else np.linspace(0.0, 2.0 * math.pi, 16, endpoint=False)
+                )
+                np.testing.assert_allclose(
+                    polhode_points(inertia, D, grid, curve.signs, energy=0.8), curve.omega
+                )
+    with pytest.raises(ValueError, match="signs"):
+        polhode_points(inertia, 1.5, [0.0], (1, -1, 1))
