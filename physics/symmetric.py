@@ -234,3 +234,32 @@ def measure_spin_rate(body: FreeRigidBody, t_end: float) -> float:
     if float(np.hypot(w[:, i], w[:, j]).min()) == 0.0:
         raise ValueError("ω lies along the symmetry axis: there is no spin of ω to measure")
     return -_slope(t, np.arctan2(w[:, j], w[:, i]))
+
+
+def _demo() -> None:  # pragma: no cover - a printout for the report
+    print("free symmetric top: theory against the rates measured on the exact motion (t = 60)")
+    print(
+        f"{'I':>5} {'J':>5} {'shape':>8} {'p = G/I':>12} {'measured':>12} {'rel.err':>8}"
+        f" {'s':>12} {'measured':>12} {'rel.err':>8} {'α_b°':>7} {'α_s°':>7} {'θ°':>7}"
+    )
+    for It, J, w0 in [
+        (2.0, 3.0, (0.5, 0.2, 1.0)),
+        (3.0, 1.0, (0.5, 0.2, 1.0)),
+        (1.0, 10.0, (1.0, 0.0, 0.05)),
+        (10.0, 0.5, (0.05, 0.0, 3.0)),
+    ]:
+        top = symmetric_top(It, J, w0)
+        body = top.body()
+        p, s = measure_precession_rate(body, 60.0), measure_spin_rate(body, 60.0)
+        angles = np.degrees(
+            [top.body_cone_half_angle, top.space_cone_half_angle, top.nutation_angle]
+        )
+        print(
+            f"{It:5g} {J:5g} {top.shape:>8} {top.precession_rate:12.9f} {p:12.9f} "
+            f"{p / top.precession_rate - 1:8.0e} {top.spin_rate:12.9f} {s:12.9f} "
+            f"{s / top.spin_rate - 1:8.0e} {angles[0]:7.2f} {angles[1]:7.2f} {angles[2]:7.2f}"
+        )
+
+
+if __name__ == "__main__":  # pragma: no cover
+    _demo()
