@@ -3,7 +3,7 @@ the contact point along its polhode.
 
 For sorted moments ``I1 < I2 < I3`` and a fixed energy ``2T``, the polhodes are the curves cut on
 the energy ellipsoid ``Σ Iᵢ xᵢ² = 2T`` (body frame, ω-space) by the cones
-``Σ Iᵢ (Iᵢ - D) xᵢ² = 0``, one for each ``D = G²/2T`` in ``[I1, I3]`` [FM06 §7.9, Eq. 7.57;
+``Σ Iᵢ (Iᵢ - D) xᵢ² = 0``, one for each ``D = G²/2T`` in ``[I1, I3]`` [FM06 §7.8, Eq. 7.57;
 Pars65 §13.12]. They fall into three kinds [LL76 §37, Fig. 51; FM06 Fig. 7.7]:
 
 * ``D < I2``: two closed curves around the minor axis ``±e1`` (:attr:`Regime.MINOR_AXIS`);

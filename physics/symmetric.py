@@ -1,5 +1,5 @@
 """The free symmetric top: precession, spin, and the body cone rolling on the space cone
-[GPS02 §5.6; FM06 §7.11; LL76 §33].
+[GPS02 §5.6; FM06 §7.11].
 
 Body axes: ``e3`` is the symmetry axis, ``I1 = I2 = I`` (transverse), ``I3 = J`` (axial); the
 body is *oblate* if ``J > I`` (a disc, a coin), *prolate* if ``J < I`` (a rod, a cigar). ω3 is
