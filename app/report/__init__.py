@@ -15,10 +15,13 @@ Outputs in the output directory:
   (one row per run; errors are maxima over the output grid; the ``exact`` rows carry the
   closed form's errors against the mpmath reference, at its check points);
 * ``error_vs_time.csv``: the same errors against simulated time, for every run;
-* ``report.md``: tables, a verdict per case, the exact solution's stability findings, and its
-  speed-up over DOP853 at equal accuracy at t = 1e4;
+* ``report.md``: tables, a verdict per case, the observed orders, each case's conditioning
+  (:mod:`~poinsot.app.report.conditioning`), the saturated errors near the separatrix read as
+  flips (:mod:`~poinsot.app.report.findings`), the exact solution's stability findings, its
+  speed-up over DOP853 at equal accuracy at t = 1e4, and the figures with their captions;
 * ``work_precision.png``, ``work_precision_attitude.png``, ``error_vs_time.png`` (matplotlib,
-  Agg backend, imported lazily; skipped with a note if it is not installed).
+  Agg backend, imported lazily; skipped with a note in report.md and on stderr if it is not
+  installed).
 
 The package composes :mod:`poinsot.physics` and does no physics of its own; it never imports
 viser or the live server. The command line (``poinsot report``, or

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from poinsot.app.report.conditioning import FlipCounter
 from poinsot.app.report.runs import ExactGrid
 from poinsot.app.report.timing import timed
 from poinsot.physics import FreeRigidBody, errors
@@ -114,7 +115,8 @@ def measure_exact(
             np.max(np.linalg.norm(momentum - body.angular_momentum, axis=1)) / g0
         ),
     )
-    grid = ExactGrid(case, inertia, omega0, t_eval, omega, attitude, energy0)
+    flips = FlipCounter.for_motion(inertia, omega)
+    grid = ExactGrid(case, inertia, omega0, t_eval, omega, attitude, energy0, flips)
     return findings, grid
 
 

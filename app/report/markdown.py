@@ -17,11 +17,17 @@ import scipy
 
 from poinsot.app.report.cases import StudyConfig
 from poinsot.app.report.exact import FAR_PERIODS
+from poinsot.app.report.figures import caption, takeaway
+from poinsot.app.report.findings import (
+    conditioning_section,
+    orders_section,
+    saturation_section,
+)
 from poinsot.app.report.formatting import exp, sig, vector
 from poinsot.app.report.speedup import SPEEDUP_REPEATS, Speedup
 from poinsot.app.report.study import CaseResult
 from poinsot.app.report.timing import repeats_text
-from poinsot.app.report.verdicts import observed_order, verdict
+from poinsot.app.report.verdicts import verdict
 from poinsot.physics.integrators import INTEGRATORS
 
 __all__ = ["ReportInputs", "write_markdown"]
@@ -51,10 +57,12 @@ def write_markdown(out: Path, inputs: ReportInputs) -> None:
         *_cases_table(inputs.results),
         *_speedup(inputs.speedup),
         *_verdicts(inputs.results),
-        *_observed_orders(inputs.results),
+        *orders_section(inputs.results),
+        *conditioning_section(inputs.results),
+        *saturation_section(inputs.results),
         *_stability(inputs.results),
         *_per_case(inputs.results),
-        *_figures(inputs.figures, inputs.figure_note),
+        *_figures(inputs.figures, inputs.figure_note, inputs.results),
     ]
     (out / "report.md").write_text("\n".join(lines))
 
@@ -118,15 +126,15 @@ def _cases_table(results: list[CaseResult]) -> list[str]:
     lines = [
         "## Cases",
         "",
-        "| case | I | omega0 | regime | m | 1-m | period | horizon | source |",
+        "| case | I | omega0 [rad per time unit] | regime | m | 1-m | period | horizon | source |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in results:
         c = r.case
         lines.append(
             f"| {c.name} | {vector(c.inertia)} | {vector(c.omega0)} | {r.regime} | "
-            f"{sig(r.parameter)} | {sig(r.complementary)} | {sig(r.period, 6)} | "
-            f"{sig(r.t_end, 6)} | {c.source} |"
+            f"{sig(r.parameter)} | {sig(r.complementary)} | {sig(r.period, 6)} {c.time_unit} | "
+            f"{sig(r.t_end, 6)} {c.time_unit} | {c.source} |"
         )
     return [*lines, ""]
 
@@ -178,27 +186,6 @@ def _verdicts(results: list[CaseResult]) -> list[str]:
         *(f"- **{r.case.name}**: {v.text}" for r, v in zip(results, verdicts, strict=True)),
         "",
     ]
-
-
-def _observed_orders(results: list[CaseResult]) -> list[str]:
-    lines = [
-        "## Observed orders",
-        "",
-        "p in omega error ~ cost^-p (cost: steps, or RHS evaluations), fitted over each "
-        "method's runs with 1e-13 < error < 1e-2; expected: the order "
-        + ", ".join(f"{i.name} {i.order}" for i in INTEGRATORS.values())
-        + ". Blank: fewer than two runs in that range (the case is too hard or too easy).",
-        "",
-        "| case | " + " | ".join(INTEGRATORS) + " |",
-        "|---|" + "---|" * len(INTEGRATORS),
-    ]
-    for r in results:
-        cells = []
-        for name in INTEGRATORS:
-            p = observed_order([run for run in r.runs if run.method == name])
-            cells.append(f"{p:.2f}" if math.isfinite(p) else "")
-        lines.append(f"| {r.case.name} | " + " | ".join(cells) + " |")
-    return [*lines, ""]
 
 
 def _stability(results: list[CaseResult]) -> list[str]:
@@ -283,8 +270,16 @@ def _case_runs(r: CaseResult) -> list[str]:
     return lines
 
 
-def _figures(figures: list[str], note: str) -> list[str]:
+def _figures(figures: list[str], note: str, results: list[CaseResult]) -> list[str]:
+    """Each figure with its caption and a one-line takeaway."""
     lines = ["## Figures", ""]
-    for name in figures:
-        lines += [f"![{name}]({name})", ""]
+    for number, name in enumerate(figures, start=1):
+        lines += [
+            f"![{name}]({name})",
+            "",
+            f"*Figure {number} ({name}).* {caption(name)}",
+            "",
+            f"**Takeaway:** {takeaway(name, results)}",
+            "",
+        ]
     return [*lines, note, ""]

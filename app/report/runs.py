@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from poinsot.app.report.cases import CaseSettings
+from poinsot.app.report.conditioning import FlipCounter, separatrix_distance
 from poinsot.app.report.progress import Progress
 from poinsot.app.report.timing import timed
 from poinsot.physics import errors
@@ -81,6 +82,8 @@ class ExactGrid:
     omega: NDArray[np.float64]
     attitude: Rotation
     energy0: float
+    flips: FlipCounter
+    """Counts the half-turns of a motion on this grid (see :mod:`conditioning`)."""
 
 
 def measure_errors(exact: ExactGrid, omega: NDArray[np.float64], attitude: Rotation) -> RunErrors:
@@ -108,6 +111,10 @@ class IntegratorRun:
     energy_drift: float
     times: NDArray[np.float64]
     errors: RunErrors
+    flips: int
+    """Half-turns of the run's motion counted on the output grid."""
+    separatrix_range: tuple[float, float]
+    """(min, max) over the grid of the run's d = 1 - I2 / D: its side of the separatrix."""
 
     @property
     def accuracy(self) -> float:
@@ -186,6 +193,19 @@ def _run_one(exact: ExactGrid, name: str, label: str, value: float, quick: bool)
     seconds, trajectory, repeats = timed(call, quick)
     errs = measure_errors(exact, trajectory.omega, trajectory.attitude)
     w, a, e = errs.worst
+    d = separatrix_distance(exact.inertia, trajectory.omega)
     return IntegratorRun(
-        exact.case, name, label, seconds, repeats, trajectory.cost, w, a, e, exact.t_eval, errs
+        exact.case,
+        name,
+        label,
+        seconds,
+        repeats,
+        trajectory.cost,
+        w,
+        a,
+        e,
+        exact.t_eval,
+        errs,
+        exact.flips.count(trajectory.omega),
+        (float(d.min()), float(d.max())),
     )

@@ -5,12 +5,14 @@ integrator at its ladder of settings, measured against it.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from poinsot.app.report.cases import Case, StudyConfig
+from poinsot.app.report.conditioning import Conditioning, condition_number
 from poinsot.app.report.exact import (
     CHECK_FRACTIONS,
     ExactFindings,
@@ -25,7 +27,11 @@ from poinsot.physics.integrators import INTEGRATORS
 if TYPE_CHECKING:
     from poinsot.app.report.reference import TaylorReference
 
-__all__ = ["CaseResult", "progress_units", "study_case"]
+__all__ = ["FLIP_SAMPLES", "CaseResult", "progress_units", "study_case"]
+
+#: Output samples per period of omega needed to count flips: a period has two of them, and the
+#: hysteresis count needs a sample in each stay near the intermediate axis.
+FLIP_SAMPLES = 8
 
 
 @dataclass
@@ -44,6 +50,19 @@ class CaseResult:
     skipped: list[str]
     failed: list[str]
     run_budget: float
+    conditioning: Conditioning
+    exact_flips: int
+    """Half-turns of the exact motion counted on the output grid."""
+    samples: int
+    """Intervals of the output grid."""
+
+    @property
+    def flips_resolved(self) -> bool:
+        """Whether the output grid is fine enough to count flips: at least FLIP_SAMPLES samples
+        per period of omega (a motion with no period is taken as resolved)."""
+        return not math.isfinite(self.period) or self.samples * self.period >= (
+            FLIP_SAMPLES * self.t_end
+        )
 
 
 def progress_units(config: StudyConfig) -> int:
@@ -81,6 +100,7 @@ def study_case(
     progress.advance(f"{case.name}: mpmath reference")
 
     outcome = run_integrators(grid, tau, settings, config.quick, progress)
+    conditioning = condition_number(inertia, omega0, t_eval, grid.omega)
     return CaseResult(
         case=case,
         regime=body.regime.name,
@@ -94,4 +114,7 @@ def study_case(
         skipped=outcome.skipped,
         failed=outcome.failed,
         run_budget=settings.run_budget,
+        conditioning=conditioning,
+        exact_flips=grid.flips.count(grid.omega),
+        samples=config.samples,
     )

@@ -74,7 +74,10 @@ def verdict(r: CaseResult) -> Verdict:
         and min(run.accuracy for run in mine) > 0.1
     ]
     if hopeless:
-        parts.append(f"no setting brings {' or '.join(hopeless)} below an error of 0.1")
+        why = ""
+        if r.conditioning.floor >= 0.01:
+            why = f" (κ u = {r.conditioning.floor:.2g}: the problem's conditioning)"
+        parts.append(f"no setting brings {' or '.join(hopeless)} below an error of 0.1{why}")
     return Verdict("; ".join(parts) + ".", per_level, exact_wins)
 
 
@@ -106,14 +109,25 @@ def _exact_against_integrators(
     )
 
 
-def observed_order(runs: list[IntegratorRun]) -> float:
-    """p in omega error ~ cost^-p (cost = steps or RHS evaluations), fitted over the runs in the
-    asymptotic range ORDER_FIT_RANGE (NaN with fewer than two)."""
+def order_fit_runs(runs: list[IntegratorRun]) -> list[IntegratorRun]:
+    """The runs an order is fitted over: omega error inside ORDER_FIT_RANGE, by cost."""
     low, high = ORDER_FIT_RANGE
-    pts = [(r.cost, r.omega_error) for r in runs if low < r.omega_error < high and r.cost > 0]
-    if len(pts) < 2 or len({c for c, _ in pts}) < 2:
+    inside = [r for r in runs if low < r.omega_error < high and r.cost > 0]
+    return sorted(inside, key=lambda r: r.cost)
+
+
+def observed_order(runs: list[IntegratorRun]) -> float:
+    """p in omega error ~ cost^-p (cost = steps or RHS evaluations), fitted over
+    :func:`order_fit_runs`. NaN with fewer than two, or when the error does not decrease as
+    the cost grows: then there is no order to observe (the error sits at a floor, e.g. the
+    conditioning floor of :mod:`conditioning`, and a fit would give orders near 0 or < 0)."""
+    pts = order_fit_runs(runs)
+    if len(pts) < 2 or len({r.cost for r in pts}) < 2:
         return math.nan
-    x, y = np.log([c for c, _ in pts]), np.log([e for _, e in pts])
+    if any(b.omega_error >= a.omega_error for a, b in zip(pts, pts[1:], strict=False)):
+        return math.nan
+    x = np.log([r.cost for r in pts])
+    y = np.log([r.omega_error for r in pts])
     return float(-np.polyfit(x, y, 1)[0])
 
 

@@ -1,8 +1,9 @@
 """``poinsot report --quick``: the files it writes and what they must contain.
 
-One quick run through the real command line (module fixture, ~40 s on the 2-core CI machine),
-then checks on its outputs: the CSV columns exactly, every case x method present, finite
-non-negative errors and positive timings, a verdict per case in report.md, valid PNG images.
+One quick run through the real command line (``quick_report`` in conftest.py, ~40 s on the
+2-core CI machine), then checks on its outputs: the CSV columns exactly, every case x method
+present, finite non-negative errors and positive timings, a verdict per case in report.md,
+valid PNG images.
 The study's building blocks are tested on their own below (cheap).
 """
 
@@ -17,7 +18,6 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from poinsot.app.cli import main as cli_main
 from poinsot.app.report.cases import CASES, StudyConfig
 from poinsot.app.report.progress import Progress
 from poinsot.app.report.reference import TaylorReference
@@ -28,13 +28,6 @@ from poinsot.physics.integrators import INTEGRATORS
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 QUICK_CASES = [c.name for c in StudyConfig.for_mode(quick=True).cases]
-
-
-@pytest.fixture(scope="module")
-def quick_report(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("report")
-    assert cli_main(["report", "--quick", "--out", str(out)]) == 0
-    return out
 
 
 def read_rows(path: Path) -> tuple[list[str], list[dict[str, str]]]:
