@@ -58,10 +58,14 @@ __all__ = [
 
 #: Fourier samples of |dω/dt| per circuit: start, and the most before giving up.
 _ARC_SAMPLES_MIN = 64
+_EPS = float(np.finfo(float).eps)
 _ARC_SAMPLES_MAX = 1 << 21
 #: The series of |dω/dt| is converged when its coefficients in the upper quarter of the
-#: spectrum fall below this fraction of the mean (then the rest is rounding noise).
+#: spectrum fall below this fraction of the mean, or below the rounding noise of the samples,
+#: _ARC_NOISE_EPS · eps · max|dω/dt| (a bursty speed, next to the separatrix, has a mean far
+#: below its peak; a noise-level term adds < 1e-13 of a circuit to the arc).
 _ARC_TAIL = 1e-15
+_ARC_NOISE_EPS = 16.0
 
 
 def sorted_moments(inertia: ArrayLike) -> tuple[float, float, float]:
@@ -405,7 +409,8 @@ class PolhodeArc:
             F = np.fft.rfft(f) / M
             mean = float(F[0].real)
             tail = np.abs(F[3 * (M // 8) : M // 2])
-            if mean == 0.0 or float(tail.max()) <= _ARC_TAIL * mean:
+            floor = max(_ARC_TAIL * mean, _ARC_NOISE_EPS * _EPS * float(f.max()))
+            if mean == 0.0 or float(tail.max()) <= floor:
                 break
             if M >= _ARC_SAMPLES_MAX:
                 raise ValueError(
@@ -416,7 +421,7 @@ class PolhodeArc:
             M *= 2
         self._mean = mean
         coef = 2.0 * F[1 : M // 2]
-        keep = np.flatnonzero(np.abs(coef) > 0.1 * _ARC_TAIL * max(mean, 1e-300))
+        keep = np.flatnonzero(np.abs(coef) > 0.1 * floor)
         self._coef = coef[: int(keep[-1]) + 1] if keep.size else coef[:0]
         self._w = 2.0 * math.pi / P
 

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy import special
 
 from poinsot.physics import FreeRigidBody, Regime
 from poinsot.physics.family import (
@@ -241,3 +242,18 @@ def test_polhode_points_are_the_curves_at_any_amplitude():
                 )
     with pytest.raises(ValueError, match="signs"):
         polhode_points(inertia, 1.5, [0.0], (1, -1, 1))
+
+
+@pytest.mark.parametrize("tilt", [1e-12, 1e-150, 1e-300])
+def test_arc_next_to_the_separatrix_tends_to_two_separatrix_arcs(tilt):
+    # 1 - m ~ tilt²: the closed polhode hugs the two separatrix arcs on the e1 side, and the
+    # speed along it is a burst twice per circuit (a mean far below its peak). For I = (1, 2, 3)
+    # and 2T = 2 each arc runs from -e2 to +e2 on (A1 cos φ, A2 sin φ, A3 cos φ) with A1² = 1,
+    # A2² = 1, A3² = 1/3: its length is 2 A2 E(1 - (A1² + A3²)/A2²) = 2 E(-1/3).
+    body = FreeRigidBody((1.0, 2.0, 3.0), (tilt, 1.0, 0.0))
+    arc = PolhodeArc(body)
+    expected = 2.0 * 2.0 * special.ellipe(1.0 - (1.0 + 1.0 / 3.0))
+    assert arc.circuit_length == pytest.approx(expected, rel=1e-12)
+    # by symmetry the quarter periods are the quarter arcs
+    frac = arc.fraction(np.array([0.25, 0.5, 0.75]) * arc.circuit_time)
+    np.testing.assert_allclose(frac, [0.25, 0.5, 0.75], atol=1e-12)
