@@ -12,6 +12,8 @@ from __future__ import annotations
 import csv
 import math
 import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -233,3 +235,15 @@ def test_progress_bar_writes_to_stderr(capsys):
     bar.close()
     err = capsys.readouterr().err
     assert "[" in err and "100%" in err and err.endswith("\n")
+
+
+def test_python_dash_m_runs_the_report_command():
+    done = subprocess.run(
+        [sys.executable, "-m", "poinsot.app.report", "--help"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "--quick" in done.stdout and "--out" in done.stdout
