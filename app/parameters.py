@@ -1,8 +1,8 @@
-"""The parameters a user edits, and how they become a :class:`physics.FreeRigidBody`.
+"""The parameters a user edits, and how they become a :class:`poinsot.physics.FreeRigidBody`.
 
-The app never integrates or solves anything: the initial omega comes from
-:func:`physics.omega_from_energy` and the attitude that puts L along +z from
-:func:`physics.attitude_with_L_along_z`.
+The app never integrates or solves anything: the body comes from one call into physics
+(:func:`_body`: :meth:`FreeRigidBody.from_energy` builds the initial ω from D, |ω₀| and the
+pole, and the attitude that puts L along +z).
 """
 
 from __future__ import annotations
@@ -11,12 +11,7 @@ import dataclasses
 import math
 
 from poinsot.app.presets import Preset
-from poinsot.physics import (
-    FreeRigidBody,
-    attitude_with_L_along_z,
-    check_real_body,
-    omega_from_energy,
-)
+from poinsot.physics import FreeRigidBody, attitude_with_L_along_z, check_real_body
 
 #: Slider ranges.
 INERTIA_RANGE = (0.1, 5.0)
@@ -24,29 +19,36 @@ OMEGA_NORM_RANGE = (0.2, 4.0)
 SPEED_RANGE = (0.05, 4.0)
 TRAIL_RANGE = (100, 6000)
 
+Vector = tuple[float, float, float]
+
+
+def _vector(values: tuple[float, ...] | list[float]) -> Vector:
+    x, y, z = (float(v) for v in values)
+    return x, y, z
+
 
 @dataclasses.dataclass(frozen=True)
 class Parameters:
     """Moments (caller order), D = |L|²/2T, which polhode, and |omega0|.
 
-    ``omega0``: an exact initial omega given by a preset (data), used instead of
-    :func:`physics.omega_from_energy`; any edit drops it (the sliders then speak).
+    ``omega0``: an exact initial omega given by a preset (data), used instead of the one built
+    from D, |ω₀| and the pole; any edit drops it (the sliders then speak).
     """
 
-    inertia: tuple[float, float, float]
+    inertia: Vector
     D: float
     pole_sign: int = 1
     omega_norm: float = 1.0
-    omega0: tuple[float, float, float] | None = None
+    omega0: Vector | None = None
 
     @classmethod
     def from_preset(cls, preset: Preset) -> Parameters:
         return cls(
-            tuple(float(i) for i in preset.inertia),  # type: ignore[arg-type]
+            _vector(preset.inertia),
             float(preset.D),
             int(preset.pole_sign),
             float(preset.omega_norm),
-            None if preset.omega0 is None else tuple(float(w) for w in preset.omega0),  # type: ignore[arg-type]
+            None if preset.omega0 is None else _vector(preset.omega0),
         )
 
     @property
@@ -57,17 +59,28 @@ class Parameters:
     def intermediate(self) -> float:
         return sorted(self.inertia)[1]
 
+    # -- edits (each drops a preset's exact omega0) ----------------------------------------
     def with_inertia(self, index: int, value: float) -> Parameters:
         """Change one moment; D is clamped into the new [min I, max I]."""
-        inertia = list(self.inertia)
-        inertia[index] = float(value)
-        lo, hi = min(inertia), max(inertia)
-        return dataclasses.replace(
-            self,
-            inertia=tuple(inertia),
-            D=min(max(self.D, lo), hi),  # type: ignore[arg-type]
-            omega0=None,
-        )
+        moments = list(self.inertia)
+        moments[index] = float(value)
+        inertia = _vector(moments)
+        D = min(max(self.D, min(inertia)), max(inertia))
+        return dataclasses.replace(self, inertia=inertia, D=D, omega0=None)
+
+    def with_D(self, D: float) -> Parameters:
+        """D, clamped into [min I, max I]."""
+        lo, hi = self.D_range
+        return dataclasses.replace(self, D=min(max(float(D), lo), hi), omega0=None)
+
+    def with_pole(self, sign: int) -> Parameters:
+        return dataclasses.replace(self, pole_sign=1 if sign >= 0 else -1, omega0=None)
+
+    def with_omega_norm(self, value: float) -> Parameters:
+        """|ω₀|; a value that is not a positive number changes nothing."""
+        if not (math.isfinite(value) and value > 0):
+            return self
+        return dataclasses.replace(self, omega_norm=float(value), omega0=None)
 
     def mirrored(self, side: str) -> Parameters:
         """Move D to the ``side`` ("minor" or "major") of the separatrix D = I2, keeping its
@@ -85,9 +98,10 @@ class Parameters:
     def side(self) -> str:
         return "major" if self.D >= self.intermediate else "minor"
 
+    # -- the body --------------------------------------------------------------------------
     def check(self) -> None:
         """Raise ValueError, with a message for the GUI, if no real body has these values
-        (:func:`physics.check_real_body`: the triangle inequality I_i <= I_j + I_k)."""
+        (:func:`poinsot.physics.check_real_body`: the triangle inequality I_i <= I_j + I_k)."""
         check_real_body(self.inertia)
         if not (math.isfinite(self.omega_norm) and self.omega_norm > 0):
             raise ValueError("|ω₀| must be positive")
@@ -95,12 +109,7 @@ class Parameters:
     def build(self) -> FreeRigidBody:
         """The body, with L along +z at t = 0. Raises ValueError with a readable message."""
         self.check()
-        if self.omega0 is not None:
-            omega0 = self.omega0
-        else:
-            omega0 = omega_from_energy(self.inertia, self.D, self.omega_norm, self.pole_sign)
-        attitude0 = attitude_with_L_along_z(self.inertia, omega0)
-        return FreeRigidBody(self.inertia, omega0, attitude0)
+        return _body(self)
 
     def matches(self, preset: Preset, rel: float = 1e-9) -> bool:
         """True while these are still the preset's values (within slider rounding)."""
@@ -115,3 +124,14 @@ class Parameters:
             and math.isclose(self.omega_norm, other.omega_norm, rel_tol=rel)
             and self.omega0 == other.omega0
         )
+
+
+def _body(p: Parameters) -> FreeRigidBody:
+    """The one place the app asks physics for a body, L along +z: from D, |ω₀| and the pole
+    (:meth:`FreeRigidBody.from_energy`, which checks its input once), or from a preset's exact
+    ω₀."""
+    if p.omega0 is None:
+        return FreeRigidBody.from_energy(
+            p.inertia, p.D, omega_norm=p.omega_norm, pole_sign=p.pole_sign
+        )
+    return FreeRigidBody(p.inertia, p.omega0, attitude_with_L_along_z(p.inertia, p.omega0))

@@ -5,75 +5,24 @@ which scene elements, controls and plots it uses; the session creates exactly th
 else. The moments of inertia are *data* here, each with its source; for the solid shapes
 (box, disc, rod, T-handle) the numbers are the principal moments of the homogeneous solid of
 the stated dimensions, normalised so that the smallest moment is 1, and
-``tests/test_app_presets.py`` checks them against trimesh's mass properties of the very mesh
-the app draws.
+``tests/app/test_parts.py`` checks them against trimesh's mass properties of the very mesh
+the app draws. The vocabulary (elements, controls, plots, solids) is :mod:`poinsot.app.elements`.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from enum import StrEnum
-from typing import Literal
 
-
-class Element(StrEnum):
-    """A scene element that a preset may declare (each is a node, or a group of nodes)."""
-
-    ELLIPSOID = "ellipsoid"
-    AXES = "axes"
-    PLANE = "plane"
-    CONTACT = "contact"
-    OMEGA = "omega"
-    L = "L"
-    POLHODE = "polhode"
-    POLHODE_FULL = "polhode_full"
-    HERPOLHODE = "herpolhode"
-    SOLID = "solid"
-
-
-class Control(StrEnum):
-    """A group of GUI controls that a preset may declare."""
-
-    INERTIA = "inertia"  # sliders I1, I2, I3
-    ENERGY = "energy"  # D = |L|^2 / 2T in [min I, max I]
-    SIDE = "side"  # which side of the separatrix, and which of the two polhodes
-    OMEGA_NORM = "omega_norm"  # |omega0|
-    SPEED = "speed"  # simulation seconds per wall-clock second
-    PLAYBACK = "playback"  # play/pause, step, reset
-    TRAIL = "trail"  # trail length
-    VISIBILITY = "visibility"  # show/hide of each declared element
-
-
-class Plot(StrEnum):
-    OMEGA = "omega"  # live uPlot of omega_1, omega_2, omega_3 against time
-
-
-ALL_ELEMENTS: frozenset[Element] = frozenset(Element)
-ALL_CONTROLS: frozenset[Control] = frozenset(Control)
-ALL_PLOTS: frozenset[Plot] = frozenset(Plot)
-
-#: Elements that need a non-trivial polhode/herpolhode (left out where omega is constant).
-TRACE_ELEMENTS: frozenset[Element] = frozenset(
-    {Element.POLHODE, Element.POLHODE_FULL, Element.HERPOLHODE}
+from poinsot.app.elements import (
+    ALL_CONTROLS,
+    ALL_ELEMENTS,
+    ALL_PLOTS,
+    TRACE_ELEMENTS,
+    Control,
+    Element,
+    Plot,
+    Solid,
 )
-
-
-@dataclasses.dataclass(frozen=True)
-class Solid:
-    """A homogeneous solid drawn inside the ellipsoid, in the body's principal axes.
-
-    ``kind`` and ``dims`` (scene units, before the display scaling):
-    - ``"box"``: full side lengths along body axes 1, 2, 3;
-    - ``"cylinder"``: (radius, length), symmetry axis = body axis ``axis``;
-    - ``"t_handle"``: (bar length, bar radius, stem length, stem radius); the bar lies along
-      body axis 1, the stem along -axis 2, the mesh is shifted by ``offset`` so that the
-      centre of mass is at the origin.
-    """
-
-    kind: Literal["box", "cylinder", "t_handle"]
-    dims: tuple[float, ...]
-    axis: int = 2
-    offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -190,7 +139,7 @@ PRESETS: tuple[Preset, ...] = (
     Preset(
         key="oblate",
         label="Oblate symmetric (a disc)",
-        source="Fasano-Marmi Sec. 7.11 and seed 003: I1 = I2 < I3, the axis precesses "
+        source="Fasano-Marmi Sec. 7.11; Goldstein Sec. 5.6: I1 = I2 < I3, the axis precesses "
         "uniformly about L; polhode and herpolhode are circles. Disc r 1, thickness 0.25",
         inertia=_DISC_INERTIA,
         D=1.45,
@@ -200,7 +149,7 @@ PRESETS: tuple[Preset, ...] = (
     Preset(
         key="prolate",
         label="Prolate symmetric (a rod)",
-        source="Fasano-Marmi Sec. 7.11 and seed 003: I1 = I2 > I3, body cone rolling "
+        source="Fasano-Marmi Sec. 7.11; Goldstein Sec. 5.6: I1 = I2 > I3, body cone rolling "
         "outside the space cone. Rod r 0.35, length 2",
         inertia=_ROD_INERTIA,
         D=0.5,

@@ -1,17 +1,20 @@
 """Camera presets for lectures: the three-quarter default, the view along L, the side view, and
 the ride-along view fixed in the body frame.
 
-The space-frame views are :data:`app.view.VIEWS`. The ride-along view is a :class:`View` in
-*body* coordinates: every frame the attitude R(t) carries its position, look-at point and up
-vector into space, so the body stands still on screen while the invariable plane, L and the
-herpolhode turn around it. The attitude arrives as the scene's ``wxyz`` and becomes a rotation
-through :func:`app.frames.rotation_from_wxyz`, the one place that knows the component order.
+The space-frame views are :data:`poinsot.app.scene.view.VIEWS`. The ride-along view is a
+:class:`View` in *body* coordinates: every frame the attitude R(t) carries its position, look-at
+point and up vector into space, so the body stands still on screen while the invariable plane, L and
+the herpolhode turn around it. The attitude arrives as the scene's ``wxyz`` and becomes a rotation
+through :func:`poinsot.app.scene.frames.rotation_from_wxyz`, the one place that knows the component
+order.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
 from poinsot.app.scene.frames import rotation_from_wxyz
+from poinsot.app.scene.geometry import triple
 from poinsot.app.scene.view import DEFAULT_VIEW, VIEWS, View
 
 #: Ride-along camera in body coordinates (display units; the largest semi-axis is 1): a
@@ -49,8 +52,8 @@ def ride_along(body_view: View, attitude_wxyz: np.ndarray) -> View:
         np.array([body_view.position, body_view.look_at, body_view.up], dtype=np.float64)
     )
     return View(
-        position=tuple(float(x) for x in position),  # type: ignore[arg-type]
-        look_at=tuple(float(x) for x in look_at),  # type: ignore[arg-type]
-        up=tuple(float(x) for x in up),  # type: ignore[arg-type]
+        position=triple(position),
+        look_at=triple(look_at),
+        up=triple(up),
         fov_degrees=body_view.fov_degrees,
     )

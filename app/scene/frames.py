@@ -1,14 +1,19 @@
-"""The one place where an attitude becomes a viser orientation.
+"""The one place where an attitude becomes a viser orientation, and back.
 
-scipy's ``Rotation.as_quat()`` is scalar-last (x, y, z, w); viser's ``wxyz`` is scalar-first.
-Every pose the app sends goes through :func:`wxyz`; nothing else in ``app/`` touches a
-quaternion's component order.
+scipy's ``Rotation.as_quat()`` and :mod:`poinsot.physics.rotations` are scalar-last
+(x, y, z, w); viser's ``wxyz`` is scalar-first. Every pose the app sends goes through
+:func:`wxyz`; every pose read back from the scene goes through :func:`rotation_from_wxyz` or
+:func:`xyzw_from_wxyz`; nothing else in the app touches a quaternion's component order.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+#: Index order taking (x, y, z, w) to (w, x, y, z), and back.
+_WXYZ_FROM_XYZW = [3, 0, 1, 2]
+_XYZW_FROM_WXYZ = [1, 2, 3, 0]
 
 
 def wxyz(rotation: Rotation) -> np.ndarray:
@@ -26,11 +31,11 @@ def wxyz_from_xyzw(xyzw: np.ndarray) -> np.ndarray:
     return np.where(q[:, :1] < 0.0, -q, q)
 
 
-#: Index order taking (x, y, z, w) to (w, x, y, z).
-_WXYZ_FROM_XYZW = [3, 0, 1, 2]
+def xyzw_from_wxyz(q: np.ndarray) -> np.ndarray:
+    """A viser orientation (w, x, y, z) as a scalar-last quaternion, (4,) or (N, 4)."""
+    return np.asarray(q, dtype=np.float64)[..., _XYZW_FROM_WXYZ]
 
 
 def rotation_from_wxyz(q: np.ndarray) -> Rotation:
-    """Inverse of :func:`wxyz` (used by tests and the export of issue 5)."""
-    w, x, y, z = np.asarray(q, dtype=np.float64)
-    return Rotation.from_quat([x, y, z, w])
+    """Inverse of :func:`wxyz` for one orientation (the ghost's start, the ride-along camera)."""
+    return Rotation.from_quat(xyzw_from_wxyz(q))

@@ -1,6 +1,6 @@
 """Meshes the scene draws: the unit icosphere behind the ellipsoid, the plane disc, and the
 solid bodies of the presets. Geometry only (trimesh); the physical sizes come from
-:mod:`physics` and the presets."""
+:mod:`poinsot.physics` and the presets."""
 
 from __future__ import annotations
 
@@ -8,7 +8,8 @@ import functools
 
 import numpy as np
 import trimesh
-from poinsot.app.presets import Solid
+
+from poinsot.app.elements import Solid
 
 #: Icosphere subdivisions of the ellipsoid mesh: 2562 vertices, chord error ~ 2e-3.
 ELLIPSOID_SUBDIVISIONS = 4

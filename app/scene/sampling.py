@@ -17,6 +17,7 @@ import dataclasses
 import math
 
 import numpy as np
+
 from poinsot.physics import FreeRigidBody
 
 #: Grid times evaluated per physics call (about 128 frames' worth: a 512-time call costs

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 
 import viser
+
 from poinsot.app.scene import palette
 
 
