@@ -3,10 +3,12 @@
 Parameter vector ``x`` (see :class:`Layout`):
 
 - ``x[0:2]``: the moments, through the body's second moments of mass ``s = (sx, sy, sz)``
-  (``sx = ∫ x² dm``, ...), ``log s = (q0, q1, -q0 - q1)``. The principal moments are then
+  (``sx = ∫ x² dm``, ...) as a direction on the unit sphere, ``(θ, φ) = x[0:2]``:
+  ``s ∝ ((sin θ cos φ)², (sin θ sin φ)², cos² θ)``. The principal moments are then
   ``I = (sy + sz, sx + sz, sx + sy)``: positive and obeying the triangle inequality
-  ``Ii + Ij >= Ik`` for every value of ``x``, as every real body's do; the common scale, which
-  ω(t) cannot reveal, is fixed by the sum of the logs.
+  ``Ii + Ij >= Ik`` for every value of ``x``, as every real body's do, the flat and slender
+  limits included at finite angles (a logarithm of ``s`` would put them at infinity, where the
+  fit would stall); the common scale, which ω(t) cannot reveal, is fixed by ``|s| = 1``.
 - ``x[2:5]``: ω0 [rad/s], the body's angular velocity at the first sample, principal axes.
 - then, if fitted, the rotation vector [rad] of the rotation sensor -> principal axes,
 - then, if fitted, the gyroscope's constant bias [rad/s] in the sensor's axes.
@@ -25,12 +27,6 @@ from scipy.spatial.transform import Rotation
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.fit.omega import free_omega
 
-#: |log| of a second moment relative to their geometric mean is kept below this: a flat or
-#: slender body (one second moment e^-25 ~ 1e-11 of the others) is still described.
-LOG_LIMIT = 25.0
-#: Second moments below this fraction of the largest are raised to it when converting moments
-#: that break the triangle inequality (a noisy first estimate) into parameters.
-SECOND_MOMENT_FLOOR = 1e-3
 #: The six orders of three axes (as index tuples).
 ASSIGNMENTS = ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0))
 
@@ -58,7 +54,7 @@ class Layout:
     def pack(self, inertia, omega0, rotvec=None, bias=None) -> NDArray[np.float64]:
         """The parameter vector of moments (3,), ω0 (3,) and, as the layout has them, a rotation
         vector (3,) and a bias (3,) (``None``: zero)."""
-        parts = [log_ratios(np.asarray(inertia, dtype=float)), np.asarray(omega0, dtype=float)]
+        parts = [angles(np.asarray(inertia, dtype=float)), np.asarray(omega0, dtype=float)]
         if self.rotation:
             parts.append(np.zeros(3) if rotvec is None else np.asarray(rotvec, dtype=float))
         if self.bias:
@@ -68,23 +64,22 @@ class Layout:
 
 def moments(x: NDArray[np.float64]) -> NDArray[np.float64]:
     """(3,) principal moments of the parameters ``x``, normalised so that the largest is 1."""
-    q = np.clip([x[0], x[1], -x[0] - x[1]], -LOG_LIMIT, LOG_LIMIT)
-    s = np.exp(q - np.max(q))
-    inertia = np.array([s[1] + s[2], s[0] + s[2], s[0] + s[1]])
+    theta, phi = float(x[0]), float(x[1])
+    sin_t = np.sin(theta)
+    s = np.array([(sin_t * np.cos(phi)) ** 2, (sin_t * np.sin(phi)) ** 2, np.cos(theta) ** 2])
+    inertia = np.sum(s) - s  # (sy + sz, sx + sz, sx + sy)
     return inertia / np.max(inertia)
 
 
-def log_ratios(inertia: NDArray[np.float64]) -> NDArray[np.float64]:
+def angles(inertia: NDArray[np.float64]) -> NDArray[np.float64]:
     """(2,) the parameters ``x[0:2]`` of positive moments (3,), any scale.
 
-    Moments that break the triangle inequality (possible for a noisy estimate) are moved onto
-    the nearest admissible ones by raising the negative second moments to a small floor.
+    Moments that break the triangle inequality (a noisy first estimate can) are moved onto the
+    nearest admissible ones by raising the negative second moments to zero.
     """
-    s = 0.5 * np.sum(inertia) - inertia  # sx = (Iy + Iz - Ix) / 2, ...
-    s = np.maximum(s, SECOND_MOMENT_FLOOR * np.max(s))
-    q = np.log(s)
-    q -= np.mean(q)
-    return q[:2]
+    s = np.maximum(0.5 * np.sum(inertia) - inertia, 0.0)  # sx = (Iy + Iz - Ix) / 2, ...
+    r = np.sqrt(s / np.sum(s))
+    return np.array([np.arccos(np.clip(r[2], 0.0, 1.0)), np.arctan2(r[1], r[0])])
 
 
 def rotation_matrix(x: NDArray[np.float64], layout: Layout) -> NDArray[np.float64] | None:
@@ -121,10 +116,8 @@ def relabelled(x: NDArray[np.float64], layout: Layout) -> NDArray[np.float64]:
         return x
     nearest, _ = nearest_axes(matrix, np.zeros(3))
     signed = nearest @ matrix.T  # a signed permutation: new principal = signed @ old
-    order = np.abs(signed) @ np.arange(3.0)
-    q = np.array([x[0], x[1], -x[0] - x[1]])[order.round().astype(int)]
     out = x.copy()
-    out[:2] = q[:2]
+    out[:2] = angles(np.abs(signed) @ moments(x))
     out[2:5] = signed @ x[2:5]
     out[layout.rotation_slice] = Rotation.from_matrix(nearest).as_rotvec()
     return out
@@ -152,20 +145,17 @@ def predict(x: NDArray[np.float64], layout: Layout, tau: NDArray[np.float64]) ->
     return w
 
 
-def separatrix_distance(x: NDArray[np.float64]) -> float:
-    """``(D - I2) / (I3 - I1)`` for the parameters, ``D = |L|²/2T`` (Pars' D, [Pars65 §13.12]).
+def separatrix_distance(inertia: NDArray[np.float64], omega0: NDArray[np.float64]) -> float:
+    """``(D - I2) / (I3 - I1)`` of the body (moments (3,), ω0 (3,)), ``D = |L|²/2T`` (Pars' D,
+    [Pars65 §13.12]) and ``I1 <= I2 <= I3`` the sorted moments.
 
     Positive in the major-axis family, negative in the minor-axis family, zero on the
-    separatrix [LL76 §37]; the sorted moments ``I1 <= I2 <= I3`` are meant.
+    separatrix [LL76 §37]; 0 for a body at rest or with three equal moments.
     """
-    inertia = moments(x)
-    w = x[2:5]
-    m = inertia * w
-    two_t = float(w @ m)
-    if two_t <= 0.0:
-        return 0.0
+    m = inertia * omega0
+    two_t = float(omega0 @ m)
     order = np.sort(inertia)
     span = float(order[2] - order[0])
-    if span <= 0.0:
+    if two_t <= 0.0 or span <= 0.0:
         return 0.0
     return float((m @ m / two_t - order[1]) / span)

@@ -12,9 +12,13 @@ from scipy.spatial.transform import Rotation
 
 from poinsot.physics import FreeRigidBody, Regime
 
-#: A fit is "explained" when its rms residual is at most this fraction of the rms of |ω| (or
-#: within 3 noise levels): a free flight recorded by a phone fits to a few tenths of a percent.
-EXPLAINED_FRACTION = 0.05
+#: A fit is "explained" when its rms residual is within 3 noise levels, or at most this
+#: fraction of the rms of |ω|: a free flight recorded by a phone fits to a few tenths of a
+#: percent, while a torque that changes |L| by a few percent over the segment does not fit.
+EXPLAINED_FRACTION = 0.02
+#: The family is named only when the fitted motion lies at least this many sigmas from the
+#: separatrix; closer, the data cannot tell the two families apart and ``family`` says so.
+FAMILY_SIGMAS = 3.0
 
 
 @dataclass(frozen=True)
@@ -87,7 +91,14 @@ class AngularVelocityFit:
 
     @property
     def family(self) -> str:
-        """The family's name: ``"major-axis family"``, ``"minor-axis family"``, ..."""
+        """``"major-axis family"`` or ``"minor-axis family"`` when the data set it (the fitted
+        motion lies at least :data:`FAMILY_SIGMAS` sigmas from the separatrix), else
+        ``"separatrix"`` (within the uncertainty); the label of :attr:`regime` for the other
+        regimes (``"symmetric"``, ...)."""
+        if self.regime not in (Regime.MAJOR_AXIS, Regime.MINOR_AXIS):
+            return self.regime.label
+        if abs(self.separatrix_distance) < FAMILY_SIGMAS * self.separatrix_sigma:
+            return Regime.SEPARATRIX.label
         return self.regime.label
 
     def predict(self, t: ArrayLike) -> NDArray[np.float64]:
@@ -140,7 +151,8 @@ def propagate(
         h = 1e-6 * max(1.0, abs(float(x[i])))
         e = np.zeros_like(x)
         e[i] = h
-        cols.append((np.atleast_1d(f(x + e)) - np.atleast_1d(f(x - e))) / (2.0 * h))
+        with np.errstate(invalid="ignore"):  # inf - inf: not finite, handled below
+            cols.append((np.atleast_1d(f(x + e)) - np.atleast_1d(f(x - e))) / (2.0 * h))
     grad = np.stack(cols, axis=1)
     finite = np.isfinite(grad).all(axis=1)
     safe = np.where(finite[:, None], grad, 0.0)
@@ -160,18 +172,19 @@ def quality_message(rms: float, scale: float, noise: float, confirmed: bool) -> 
     """``(explained, message)`` for a fit of rms residual ``rms`` to data of rms |ω| ``scale``
     with sensor noise ``noise`` [rad/s]; ``confirmed``: the family agrees with the data."""
     percent = 100.0 * rms / scale
+    noise = max(noise, 1e-15 * scale)  # noise-free synthetic data
     explained = rms <= max(EXPLAINED_FRACTION * scale, 3.0 * noise)
     if explained:
         text = (
-            f"a torque-free motion fits: rms residual {rms:.3g} rad/s, {percent:.2g}% of |ω| "
-            f"(sensor noise ≈ {noise:.2g} rad/s)"
+            f"a torque-free motion fits: rms residual {rms:.3g} rad/s, {percent:.2g}% of |ω|, "
+            f"{rms / noise:.2g}× the sensor noise (≈ {noise:.2g} rad/s)"
         )
     else:
         text = (
             "no torque-free motion explains this segment: the best fit leaves an rms residual "
-            f"of {rms:.3g} rad/s, {percent:.2g}% of |ω|, where a free flight fits to the sensor "
-            f"noise (≈ {noise:.2g} rad/s here): a torque acted (the hand at the throw or the "
-            "catch, air, a string), or the segment is not a single flight"
+            f"of {rms:.3g} rad/s, {percent:.2g}% of |ω| and {rms / noise:.2g}× the sensor noise "
+            f"(≈ {noise:.2g} rad/s), where a free flight fits to the noise: a torque acted (the "
+            "hand at the throw or the catch, air, a string), or the segment is not one flight"
         )
     if not confirmed:
         text += (

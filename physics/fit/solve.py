@@ -9,6 +9,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
+from poinsot.physics import FreeRigidBody
 from poinsot.physics.fit import model
 from poinsot.physics.fit.model import Layout
 from poinsot.physics.fit.result import (
@@ -39,11 +40,13 @@ MIN_VARIATION = 0.01
 _GRAZE = (0.7, 1.3)
 # Growing windows: the first covers this many radians of rotation; each start runs
 # _SCREEN_NFEV iterations on each window; after each window the starts whose cost exceeds
-# _PROMISING times the best's are dropped; the rest are polished (up to _POLISH_NFEV).
+# _PROMISING times the best's are dropped; the best _POLISHED of the rest are polished (up to
+# _POLISH_NFEV iterations each).
 _FIRST_WINDOW = 3.0
 _SCREEN_NFEV = 5
 _PROMISING = 4.0
-_POLISH_NFEV = 200
+_POLISHED = 3
+_POLISH_NFEV = 100
 # A candidate whose sign changes agree with the data's beats a smaller residual that does not
 # agree only if its cost is within this factor.
 _COMPARABLE = 1.5
@@ -100,6 +103,28 @@ class _Problem:
         if self.layout.bias:
             pred = pred + x[self.layout.bias_slice]
         return (pred - self.omega).ravel()
+
+    def moment_jacobian(self, x: NDArray[np.float64], axes: list[int]) -> NDArray[np.float64]:
+        """(3N, p): the Jacobian with respect to the moments of ``axes`` (two of them, the
+        largest staying 1) in place of the angles ``x[0:2]``: the uncertainties are reported
+        for the moments, and a flat body's moments stay measurable at the edge of the angles'
+        range, where d(moments)/d(angles) vanishes."""
+        jac = self.jacobian(x)
+        inertia, omega0 = model.moments(x), x[2:5]
+        w = self._body_omega(x[:5])
+        for col, k in enumerate(axes):
+            h = _STEP * max(1.0, float(inertia[k]))
+            shifted = inertia.copy()
+            shifted[k] += h
+            try:
+                wk = model.free_omega(shifted, omega0, self.tau)
+            except ValueError:
+                wk = None
+            if w is None or wk is None:
+                jac[:, col] = 0.0
+            else:
+                jac[:, col] = (self._sensor(x, wk - w) / h).ravel()
+        return jac
 
     def jacobian(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """(3N, p): forward differences for the body's parameters, the rest from the cached ω."""
@@ -209,7 +234,9 @@ def _search(problem: _Problem, x0s: list[NDArray[np.float64]]) -> _Candidate:
     Near the separatrix a small error in the parameters shifts the flips by a time that grows
     like ``exp(σ t)``, ``σ <= |ω|`` [LL76 §37, Problem 1]: fitting the first ``3/|ω|`` seconds
     first, then windows twice as long, brings each start close enough at every step for the
-    longer record to be fitted without crawling along a narrow valley. After each window the
+    longer record to be fitted without crawling along a narrow valley. The rotation and the
+    bias are held at their starts on the shorter windows (on a short stretch they trade off
+    against the moments and ω0) and fitted on the whole record. After each window the
     candidates whose cost exceeds :data:`_PROMISING` times the best's are dropped; the rest
     are polished on the whole record. The smallest residual wins, unless its components
     change sign where the data's do not (or the reverse) and a candidate that agrees with
@@ -218,10 +245,11 @@ def _search(problem: _Problem, x0s: list[NDArray[np.float64]]) -> _Candidate:
     xs = x0s
     for count in _window_counts(problem):
         window = problem.window(count)
-        fits = sorted((_solve(window, x, _SCREEN_NFEV) for x in xs), key=lambda f: f[1])
-        xs = [x for x, cost in fits if cost <= _PROMISING * fits[0][1]]
+        core = 5 if count < problem.t.size else None
+        fits = sorted((_solve(window, x, _SCREEN_NFEV, core) for x in xs), key=lambda f: f[1])
+        xs = _distinct([x for x, cost in fits if cost <= _PROMISING * fits[0][1]])
     polished = []
-    for x in xs:
+    for x in xs[:_POLISHED]:
         x, cost = _solve(problem, x, _POLISH_NFEV)
         polished.append(_Candidate(x, cost, problem.consistent(x)))
     polished.sort(key=lambda c: c.cost)
@@ -230,6 +258,20 @@ def _search(problem: _Problem, x0s: list[NDArray[np.float64]]) -> _Candidate:
         agreeing = [c for c in polished if c.consistent and c.cost <= _COMPARABLE * best.cost]
         best = agreeing[0] if agreeing else best
     return best
+
+
+def _distinct(xs: list[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
+    """``xs`` without the candidates that converged onto one met before (same moments, ω0)."""
+    kept: list[NDArray[np.float64]] = []
+    for x in xs:
+        inertia = model.moments(x)
+        if not any(
+            np.allclose(inertia, model.moments(k), rtol=0, atol=1e-6)
+            and np.allclose(x[2:5], k[2:5], rtol=1e-6, atol=1e-9)
+            for k in kept
+        ):
+            kept.append(x)
+    return kept
 
 
 def _window_counts(problem: _Problem) -> list[int]:
@@ -247,13 +289,29 @@ def _window_counts(problem: _Problem) -> list[int]:
 
 
 def _solve(
-    problem: _Problem, x0: NDArray[np.float64], max_nfev: int
+    problem: _Problem, x0: NDArray[np.float64], max_nfev: int, first: int | None = None
 ) -> tuple[NDArray[np.float64], float]:
-    """Levenberg–Marquardt from ``x0``: the parameters reached and their cost ``½ Σ r²``."""
+    """Levenberg–Marquardt from ``x0``: the parameters reached and their cost ``½ Σ r²``.
+
+    With ``first``, only ``x[:first]`` moves; the other parameters keep their values.
+    """
+    if first is not None and first < x0.size:
+        rest = x0[first:]
+        z, cost = _solve_all(
+            lambda z: problem.residuals(np.concatenate([z, rest])),
+            lambda z: problem.jacobian(np.concatenate([z, rest]))[:, :first],
+            x0[:first],
+            max_nfev,
+        )
+        return np.concatenate([z, rest]), cost
+    return _solve_all(problem.residuals, problem.jacobian, x0, max_nfev)
+
+
+def _solve_all(fun, jac, x0: NDArray[np.float64], max_nfev: int) -> tuple[NDArray, float]:
     result = least_squares(
-        problem.residuals,
+        fun,
         x0,
-        jac=problem.jacobian,
+        jac=jac,
         method="lm",
         x_scale="jac",
         max_nfev=max_nfev,
@@ -265,11 +323,26 @@ def _solve(
 
 
 def _result(problem: _Problem, best: _Candidate) -> AngularVelocityFit:
-    """The result at the chosen parameters, its axes labelled after the sensor's."""
+    """The result at the chosen parameters, its axes labelled after the sensor's.
+
+    The covariance is computed for ``y = (the two smaller moments, ω0, rotation, bias)``;
+    the flip period and the distance to the separatrix are propagated from it.
+    """
     layout = problem.layout
     x = model.relabelled(best.x, layout)
-    cov = covariance(problem.jacobian(x), problem.residuals(x))
+    inertia = model.moments(x)
+    free = [k for k in range(3) if k != int(np.argmax(inertia))]
+    cov = covariance(problem.moment_jacobian(x, free), problem.residuals(x))
     sigma = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    inertia_sigma = np.zeros(3)
+    inertia_sigma[free] = sigma[:2]
+    y = np.concatenate([inertia[free], x[2:]])
+
+    def moments_of(y: NDArray[np.float64]) -> NDArray[np.float64]:
+        out = inertia.copy()
+        out[free] = y[:2]
+        return out
+
     fitted = model.body(x)
     matrix = model.rotation_matrix(x, layout)
     bias = x[layout.bias_slice].copy() if layout.bias else None
@@ -277,12 +350,10 @@ def _result(problem: _Problem, best: _Candidate) -> AngularVelocityFit:
     rms = float(np.sqrt(np.mean(residual**2)))
     scale = float(np.sqrt(np.mean(np.sum(problem.omega**2, axis=1))))
     explained, message = quality_message(rms, scale, problem.smoothed.noise, best.consistent)
-    inertia = model.moments(x)
     intermediate = int(np.argsort(inertia)[1])
-    flip = flip_period(fitted)
     return AngularVelocityFit(
         inertia=inertia,
-        inertia_sigma=propagate(model.moments, x, cov),
+        inertia_sigma=inertia_sigma,
         omega0=x[2:5].copy(),
         omega0_sigma=sigma[2:5],
         rotation=None if matrix is None else Rotation.from_matrix(matrix),
@@ -297,11 +368,15 @@ def _result(problem: _Problem, best: _Candidate) -> AngularVelocityFit:
         regime=fitted.regime,
         intermediate_axis=intermediate,
         period=float(fitted.period),
-        flip_period=flip,
-        flip_period_sigma=float(propagate(lambda y: flip_period(model.body(y)), x, cov)[0]),
+        flip_period=flip_period(fitted),
+        flip_period_sigma=float(
+            propagate(lambda y: flip_period(FreeRigidBody(moments_of(y), y[2:5])), y, cov)[0]
+        ),
         measured_flip_period=_measured_flip(problem, x, intermediate),
-        separatrix_distance=model.separatrix_distance(x),
-        separatrix_sigma=float(propagate(model.separatrix_distance, x, cov)[0]),
+        separatrix_distance=model.separatrix_distance(inertia, x[2:5]),
+        separatrix_sigma=float(
+            propagate(lambda y: model.separatrix_distance(moments_of(y), y[2:5]), y, cov)[0]
+        ),
         family_confirmed=best.consistent,
         explained=explained,
         message=message,
