@@ -21,15 +21,19 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Protocol
+from collections.abc import Callable
+from typing import Literal, Protocol
 
 import viser
-from poinsot.app.exports import export
+
+from poinsot.app.exports.glb import scene_glb
+from poinsot.app.exports.run_csv import run_csv, run_span
 from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
 from poinsot.app.live.clock import SimClock
 from poinsot.app.presets import Preset
+from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.cameras import BODY_VIEW, CAMERA_LABELS, ride_along, space_view
-from poinsot.app.scene.construction import Frame, PoinsotScene
+from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.view import View, configure_theme
 from poinsot.physics import FreeRigidBody
 
@@ -41,7 +45,7 @@ LARGE_TEXT_PERCENT = 130
 #: Order of the lecture folder in the panel (after the session's own groups).
 FOLDER_ORDER = 70.0
 #: Hotkeys of the camera views, in CAMERA_LABELS order.
-CAMERA_HOTKEYS = ("1", "2", "3", "4")
+CAMERA_HOTKEYS: tuple[Literal["1", "2", "3", "4"], ...] = ("1", "2", "3", "4")
 
 
 class LectureSession(Protocol):
@@ -80,64 +84,74 @@ class LectureControls:
         self.camera = "default"
         self._render_lock = threading.Lock()
         self.last_download: str = ""  # name of the last file handed to the browser
-        gui = self.client.gui
-        labels = list(CAMERA_LABELS.values())
-        with gui.add_folder("Lecture: views and export", order=order):
-            self.views = gui.add_button_group(
-                "Camera",
-                labels,
-                hint="¾ view, along L (top), side, or riding on the body. Keys 1-4.",
-            )
-            self.size = gui.add_dropdown(
-                "Picture size",
-                tuple(SIZE_CHOICES),
-                initial_value=next(iter(SIZE_CHOICES)),
-                hint="Pixels of the PNG; 'current view' is the size of the 3D view.",
-            )
-            self.transparent = gui.add_checkbox(
-                "Transparent PNG", False, hint="Leave the background transparent (for slides)."
-            )
-            self.screenshot = gui.add_button("Screenshot (PNG)", icon=viser.Icon.CAMERA)
-            self.csv = gui.add_button(
-                "Data: t, ω, q (CSV)",
-                icon=viser.Icon.TABLE_EXPORT,
-                hint="The run so far (one period if it has just started), exact solution.",
-            )
-            self.glb = gui.add_button(
-                "Mesh: ellipsoid, plane, curves (GLB)",
-                icon=viser.Icon.CUBE,
-                hint="For Blender or any glTF viewer.",
-            )
-            self.dark = gui.add_checkbox("Dark theme", True)
-            self.large = gui.add_checkbox(
-                "Large text (projector)", False, hint="Scales every text of the panel."
-            )
-            self.message = gui.add_markdown("")
-            gui.add_markdown("<small>Keys: **space** play/pause · **1-4** camera views</small>")
-            self.style = gui.add_html("")
-
-        self.views.on_click(lambda event: self._on_view(event))
-        self.screenshot.on_click(lambda event: self.take_screenshot())
-        self.csv.on_click(lambda event: self.download_csv())
-        self.glb.on_click(lambda event: self.download_glb())
+        with self.client.gui.add_folder("Lecture: views and export", order=order):
+            self._add_widgets(self.client.gui)
+        self.views.on_click(self._on_view)
+        self.screenshot.on_click(lambda _: self._discard(self.take_screenshot()))
+        self.csv.on_click(lambda _: self._discard(self.download_csv()))
+        self.glb.on_click(lambda _: self._discard(self.download_glb()))
         self.dark.on_update(lambda event: self.set_theme(dark=bool(event.target.value)))
         self.large.on_update(lambda event: self.set_theme(large=bool(event.target.value)))
+        self.commands = self._add_hotkeys(self.client.gui)
 
-        self.commands = [
-            gui.add_command("Play / pause", hotkey="space", icon=viser.Icon.PLAYER_PLAY)
-        ]
-        self.commands[0].on_trigger(lambda event: session.toggle_pause())
+    def _add_widgets(self, gui: viser.GuiApi) -> None:
+        self.views = gui.add_button_group(
+            "Camera",
+            list(CAMERA_LABELS.values()),
+            hint="¾ view, along L (top), side, or riding on the body. Keys 1-4.",
+        )
+        self.size = gui.add_dropdown(
+            "Picture size",
+            tuple(SIZE_CHOICES),
+            initial_value=next(iter(SIZE_CHOICES)),
+            hint="Pixels of the PNG; 'current view' is the size of the 3D view.",
+        )
+        self.transparent = gui.add_checkbox(
+            "Transparent PNG", False, hint="Leave the background transparent (for slides)."
+        )
+        self.screenshot = gui.add_button("Screenshot (PNG)", icon=viser.Icon.CAMERA)
+        self.csv = gui.add_button(
+            "Data: t, ω, q (CSV)",
+            icon=viser.Icon.TABLE_EXPORT,
+            hint="The run so far (one period if it has just started), exact solution.",
+        )
+        self.glb = gui.add_button(
+            "Mesh: ellipsoid, plane, curves (GLB)",
+            icon=viser.Icon.CUBE,
+            hint="For Blender or any glTF viewer.",
+        )
+        self.dark = gui.add_checkbox("Dark theme", True)
+        self.large = gui.add_checkbox(
+            "Large text (projector)", False, hint="Scales every text of the panel."
+        )
+        self.message = gui.add_markdown("")
+        gui.add_markdown("<small>Keys: **space** play/pause · **1-4** camera views</small>")
+        self.style = gui.add_html("")
+
+    def _add_hotkeys(self, gui: viser.GuiApi) -> list[viser.CommandHandle]:
+        """Space plays/pauses; 1-4 choose the camera views (also in the command palette)."""
+        play = gui.add_command("Play / pause", hotkey="space", icon=viser.Icon.PLAYER_PLAY)
+        play.on_trigger(lambda _: self.session.toggle_pause())
+        commands = [play]
         for key, (name, label) in zip(CAMERA_HOTKEYS, CAMERA_LABELS.items(), strict=True):
             command = gui.add_command(f"Camera: {label}", hotkey=key, icon=viser.Icon.CAMERA)
-            command.on_trigger(lambda event, name=name: self.set_camera(name))
-            self.commands.append(command)
+            command.on_trigger(self._camera_callback(name))
+            commands.append(command)
+        return commands
+
+    def _camera_callback(self, name: str) -> Callable[[object], None]:
+        return lambda _: self.set_camera(name)
+
+    @staticmethod
+    def _discard(_: object) -> None:
+        """A button callback returns nothing (the actions' results are for tests)."""
 
     # -- messages ------------------------------------------------------------------------
     def show(self, text: str, error: bool = False) -> None:
         self.message.content = f"**⚠ {text}**" if error else text
 
     # -- camera --------------------------------------------------------------------------
-    def _on_view(self, event: viser.GuiEvent) -> None:
+    def _on_view(self, event: viser.GuiEvent[viser.GuiButtonGroupHandle]) -> None:
         for name, label in CAMERA_LABELS.items():
             if label == event.target.value:
                 self.set_camera(name)
@@ -230,18 +244,20 @@ class LectureControls:
     def download_csv(self) -> str | None:
         return self._download(
             "csv",
-            lambda body, t, key: export.run_csv(
-                body, export.run_span(body, t), name=key, source=self.session.preset.source
+            lambda body, t, key: run_csv(
+                body, run_span(body, t), name=key, source=self.session.preset.source
             ).encode("utf-8"),
         )
 
     def download_glb(self) -> str | None:
         return self._download(
             "glb",
-            lambda body, t, key: export.scene_glb(body, t, geometry=self.session.scene.geometry),
+            lambda body, t, key: scene_glb(body, t, geometry=self.session.scene.geometry),
         )
 
-    def _download(self, suffix: str, make) -> str | None:
+    def _download(
+        self, suffix: str, make: Callable[[FreeRigidBody, float, str], bytes]
+    ) -> str | None:
         try:
             body, t, key = self._now()
             data = make(body, t, key)
@@ -255,7 +271,7 @@ class LectureControls:
             return None
 
 
-def add_lecture_controls(session: LectureSession, **kwargs) -> LectureControls:
+def add_lecture_controls(session: LectureSession, **kwargs: float) -> LectureControls:
     """Mount the lecture folder and hotkeys on ``session``'s panel; keep the returned object
     and call its ``on_frame(frame)`` after each frame."""
     return LectureControls(session, **kwargs)

@@ -1,27 +1,26 @@
-"""The control panel of one session: preset, sliders, playback, show/hide, readouts, plot.
+"""The control panel of one session: preset, sliders, playback, show/hide.
 
 Only the controls the current preset declares exist (:meth:`ControlPanel.declare` creates and
 removes whole groups; ``order`` keeps the layout stable whatever the creation order). A removed
-group is hidden at once and deleted RETIRE_SECONDS later (:meth:`ControlPanel.collect`): the
-browser applies the GUI updates of one rendered frame after that frame's removals, so an
-update sent just before a removal would otherwise reach an element that no longer exists and
-log a console error. Callbacks
-never touch the scene or block: they hand a small action to the session's frame thread via
-``Actions``. Programmatic value changes (``event.client is None``) are ignored, so the
-session can mirror its state into the widgets without feedback loops.
+group is retired (:mod:`poinsot.app.live.widgets`: hidden at once, deleted a moment later).
+Callbacks never touch the scene or block: they hand a small action to the session's frame
+thread via :class:`Actions`. Programmatic value changes (``event.client is None``) are
+ignored, so the session can mirror its state into the widgets without feedback loops. The
+time, readouts and the plot of ω are in the floating "Motion" window
+(:mod:`poinsot.app.live.motion_window`).
 """
 
 from __future__ import annotations
 
-import math
-import time
+import dataclasses
 from collections.abc import Callable
-from typing import Any, Protocol
+from typing import Any, Protocol, TypeVar
 
-import numpy as np
 import viser
-import viser.uplot
-from poinsot.app.live import readouts
+
+from poinsot.app.elements import Control, Element, Plot
+from poinsot.app.live.motion_window import MotionWindow
+from poinsot.app.live.widgets import Removable, Retirement, set_marks, set_value
 from poinsot.app.parameters import (
     INERTIA_RANGE,
     OMEGA_NORM_RANGE,
@@ -29,8 +28,7 @@ from poinsot.app.parameters import (
     TRAIL_RANGE,
     Parameters,
 )
-from poinsot.app.presets import CUSTOM, PRESETS, Control, Element, Plot, Preset
-from poinsot.app.scene import palette
+from poinsot.app.presets import CUSTOM, PRESETS, Preset
 
 ELEMENT_LABELS: dict[Element, str] = {
     Element.ELLIPSOID: "energy ellipsoid",
@@ -48,15 +46,10 @@ ELEMENT_LABELS: dict[Element, str] = {
 SIDE_OPTIONS = ("minor axis", "major axis")
 POLE_OPTIONS = ("+ pole", "− pole")
 
-#: Number of plot samples kept (one per plot refresh, 10 per second: the last 30 s).
-PLOT_SAMPLES = 300
-#: Delay between hiding a removed widget and deleting it [s].
-RETIRE_SECONDS = 1.5
-#: Width of the floating readout window [CSS px].
-DATA_WINDOW_WIDTH = 360
+Group = Control | Plot
 
-# Layout: top-level order of the folders and the plot.
-_ORDER = {
+# Layout: top-level order of the folders and the "Motion" window.
+_ORDER: dict[str | Group, float] = {
     "scene": 0.0,
     Control.INERTIA: 10.0,
     "motion": 20.0,
@@ -65,6 +58,11 @@ _ORDER = {
     "readouts": 50.0,
     Plot.OMEGA: 60.0,
 }
+
+#: A widget whose changes the panel listens to.
+H = TypeVar(
+    "H", bound=viser.GuiInputHandle[Any] | viser.GuiButtonHandle | viser.GuiButtonGroupHandle
+)
 
 
 class Actions(Protocol):
@@ -81,53 +79,81 @@ class Actions(Protocol):
     def report(self, error: BaseException) -> None: ...
 
 
+@dataclasses.dataclass
+class Widgets:
+    """The declared widgets the session's state is mirrored into (empty: not declared)."""
+
+    inertia: tuple[viser.GuiSliderHandle[float], ...] = ()
+    energy: viser.GuiSliderHandle[float] | None = None
+    omega_norm: viser.GuiSliderHandle[float] | None = None
+    speed: viser.GuiSliderHandle[float] | None = None
+    trail: viser.GuiSliderHandle[int] | None = None
+    pause: viser.GuiButtonHandle | None = None
+
+    def forget(self, group: Group) -> None:
+        """The widgets of ``group`` are gone."""
+        for field in dataclasses.fields(self):
+            if field.name == _MIRRORED.get(group):
+                setattr(self, field.name, field.default)  # () or None
+
+
+#: The :class:`Widgets` field each group fills.
+_MIRRORED: dict[Group, str] = {
+    Control.INERTIA: "inertia",
+    Control.ENERGY: "energy",
+    Control.OMEGA_NORM: "omega_norm",
+    Control.SPEED: "speed",
+    Control.TRAIL: "trail",
+    Control.PLAYBACK: "pause",
+}
+
+
 class ControlPanel:
-    def _user_only(self, callback: Callable[[Any], None]) -> Callable[[viser.GuiEvent], None]:
-        """Run ``callback(handle)`` for changes made in the browser only (a value set by the
-        server fires the same callbacks, with no client); never let it raise into viser."""
-
-        def wrapped(event: viser.GuiEvent) -> None:
-            if event.client is None:
-                return
-            try:
-                callback(event.target)
-            except Exception as exc:
-                self.actions.report(exc)
-
-        return wrapped
-
-    def __init__(self, gui: viser.GuiApi, actions: Actions, preset: Preset) -> None:
+    def __init__(
+        self, gui: viser.GuiApi, actions: Actions, preset: Preset, retirement: Retirement
+    ) -> None:
         self.gui = gui
         self.actions = actions
-        self._groups: dict[Any, list[Any]] = {}
-        self._group_names: dict[Any, list[str]] = {}
-        self._folders: dict[str, viser.GuiFolderHandle] = {}
-        self.handles: dict[str, Any] = {}
+        self.retirement = retirement
+        self.widgets = Widgets()
+        self._groups: dict[Group, list[Removable]] = {}
+        self._folders: dict[str | Group, viser.GuiFolderHandle] = {}
         self._elements: frozenset[Element] = frozenset()
-        self._plot_t: list[float] = []
-        self._plot_w: list[np.ndarray] = []
-        self._retired: list[tuple[float, Any]] = []
-        self._data_window: Any = None
-        self._data_tab: Any = None
-
         with gui.add_folder("Scene", order=_ORDER["scene"]) as folder:
             self._folders["scene"] = folder
-            labels = [p.label for p in PRESETS] + [CUSTOM.label]
-            self.handles["preset"] = preset_dd = gui.add_dropdown(
+            self.preset = gui.add_dropdown(
                 "Preset",
-                labels,
+                [p.label for p in (*PRESETS, CUSTOM)],
                 initial_value=preset.label,
                 hint="Start from a classical case; editing a slider turns it into 'Custom'.",
             )
-            self.handles["source"] = gui.add_markdown(self._source_text(preset))
-            self.handles["status"] = gui.add_markdown("")
+            self.source = gui.add_markdown(self._source_text(preset))
+            self.status = gui.add_markdown("")
+        self.motion = MotionWindow(gui, order=_ORDER["readouts"])
+        self._on_user(self.preset, self._choose_preset)
 
-        @preset_dd.on_update
-        @self._user_only
-        def _(handle) -> None:
-            for p in (*PRESETS, CUSTOM):
-                if p.label == handle.value:
-                    actions.choose_preset(p)
+    def _on_user(self, handle: H, callback: Callable[[H], None]) -> H:
+        """Run ``callback(handle)`` for changes made in the browser only (a value set by the
+        server fires the same callbacks, with no client); never let it raise into viser."""
+
+        def wrapped(event: viser.GuiEvent[Any]) -> None:
+            if event.client is None:
+                return
+            try:
+                callback(handle)
+            except Exception as exc:
+                self.actions.report(exc)
+
+        if isinstance(handle, viser.GuiButtonHandle | viser.GuiButtonGroupHandle):
+            handle.on_click(wrapped)
+        else:
+            handle.on_update(wrapped)
+        return handle
+
+    def _choose_preset(self, handle: viser.GuiDropdownHandle[str]) -> None:
+        for p in (*PRESETS, CUSTOM):
+            if p.label == handle.value:
+                self.actions.choose_preset(p)
 
     # -- declaration ---------------------------------------------------------------------
     def declare(
@@ -141,73 +167,40 @@ class ControlPanel:
         visible: Callable[[Element], bool],
     ) -> None:
         """Create exactly the declared groups (keeping existing ones), remove the others."""
-        wanted: set[Any] = set(controls) | set(plots)
+        wanted: set[Group] = set(controls) | set(plots)
         if Control.VISIBILITY in controls and elements != self._elements:
             self._remove_group(Control.VISIBILITY)  # rebuilt below for the new elements
         self._elements = elements
         for key in list(self._groups):
             if key not in wanted:
                 self._remove_group(key)
-        builders: dict[Any, Callable[[], list[Any]]] = {
+        builders: dict[Group, Callable[[], list[Removable]]] = {
             Control.INERTIA: lambda: self._build_inertia(params),
             Control.ENERGY: lambda: self._build_energy(params),
-            Control.SIDE: lambda: self._build_side(params),
+            Control.SIDE: self._build_side,
             Control.OMEGA_NORM: lambda: self._build_omega_norm(params),
             Control.SPEED: lambda: self._build_speed(speed),
             Control.PLAYBACK: self._build_playback,
             Control.TRAIL: lambda: self._build_trail(trail),
             Control.VISIBILITY: lambda: self._build_visibility(elements, visible),
-            Plot.OMEGA: self._build_plot,
+            Plot.OMEGA: lambda: [self.motion.add_plot()],
         }
-        if self._data_tab is None:
-            self._build_data_window()
         for key in sorted(wanted, key=lambda k: _ORDER.get(k, 25.0)):
             if key not in self._groups:
                 self._groups[key] = builders[key]()
         self._prune_folders()
 
-    def _build_data_window(self) -> None:
-        """Readouts and the plot float at the bottom left of the 3D view, so that a lecture
-        sees them beside the scene without scrolling the control panel."""
-        window = self.gui.add_panel(order=_ORDER["readouts"])
-        self._data_window = window
-        self._data_tab = window.add_tab("Motion", viser.Icon.CHART_LINE)
-        with self._data_tab:
-            self.handles["time"] = self.gui.add_markdown(
-                readouts.time_markdown(0.0, False), order=0.0
-            )
-            self.handles["readouts"] = self.gui.add_markdown("", order=1.0)
-        window.float(x=16, y=-16, width=DATA_WINDOW_WIDTH)
-
     @property
-    def groups(self) -> frozenset[Any]:
+    def groups(self) -> frozenset[Group]:
         return frozenset(self._groups)
 
-    def _remove_group(self, key: Any) -> None:
-        for name in self._group_names.pop(key, []):
-            self.handles.pop(name, None)
-        self._retire(self._groups.pop(key, []))
+    def _remove_group(self, key: Group) -> None:
+        self.widgets.forget(key)
+        if key is Plot.OMEGA:
+            self.motion.forget_plot()
+        self.retirement.retire(self._groups.pop(key, []))
 
-    def _retire(self, handles: list[Any]) -> None:
-        """Hide now, delete after RETIRE_SECONDS (see the module docstring)."""
-        due = time.monotonic() + RETIRE_SECONDS
-        for handle in handles:
-            handle.visible = False
-            self._retired.append((due, handle))
-
-    def collect(self, now: float | None = None) -> int:
-        """Delete the retired widgets that are due; returns how many are still waiting."""
-        now = time.monotonic() if now is None else now
-        keep = []
-        for due, handle in self._retired:
-            if due <= now:
-                handle.remove()
-            else:
-                keep.append((due, handle))
-        self._retired = keep
-        return len(keep)
-
-    def _folder(self, name: str, label: str, expand: bool = True) -> viser.GuiFolderHandle:
+    def _folder(self, name: str | Group, label: str, expand: bool = True) -> viser.GuiFolderHandle:
         if name not in self._folders:
             self._folders[name] = self.gui.add_folder(
                 label, order=_ORDER[name], expand_by_default=expand
@@ -215,7 +208,7 @@ class ControlPanel:
         return self._folders[name]
 
     def _prune_folders(self) -> None:
-        used = {"scene"}
+        used: set[str | Group] = {"scene"}
         if self._groups.keys() & {Control.ENERGY, Control.SIDE, Control.OMEGA_NORM}:
             used.add("motion")
         if self._groups.keys() & {Control.SPEED, Control.PLAYBACK, Control.TRAIL}:
@@ -224,18 +217,12 @@ class ControlPanel:
             if key in self._groups:
                 used.add(key)
         for name in [n for n in self._folders if n not in used]:
-            self._retire([self._folders.pop(name)])
-
-    def _tag(self, key: Any, **handles: Any) -> list[Any]:
-        self._group_names[key] = list(handles)
-        self.handles.update(handles)
-        return list(handles.values())
+            self.retirement.retire([self._folders.pop(name)])
 
     # -- groups --------------------------------------------------------------------------
-    def _build_inertia(self, params: Parameters) -> list[Any]:
-        folder = self._folder(Control.INERTIA, "Body: principal moments")
-        sliders = {}
-        with folder:
+    def _build_inertia(self, params: Parameters) -> list[Removable]:
+        sliders = []
+        with self._folder(Control.INERTIA, "Body: principal moments"):
             for i in range(3):
                 slider = self.gui.add_slider(
                     f"I{'₁₂₃'[i]}",
@@ -246,18 +233,18 @@ class ControlPanel:
                     order=float(i),
                     hint="A principal moment of inertia (mass × length²).",
                 )
-                slider.on_update(self._user_only(self._inertia_cb(i)))
-                sliders[f"I{i + 1}"] = slider
-        return self._tag(Control.INERTIA, **sliders)
+                sliders.append(self._on_user(slider, self._inertia_callback(i)))
+        self.widgets.inertia = tuple(sliders)
+        return list(sliders)
 
-    def _inertia_cb(self, index: int) -> Callable[[Any], None]:
-        def cb(handle) -> None:
+    def _inertia_callback(self, index: int) -> Callable[[viser.GuiSliderHandle[float]], None]:
+        def callback(handle: viser.GuiSliderHandle[float]) -> None:
             value = float(handle.value)
             self.actions.edit(lambda p: p.with_inertia(index, value))
 
-        return cb
+        return callback
 
-    def _build_energy(self, params: Parameters) -> list[Any]:
+    def _build_energy(self, params: Parameters) -> list[Removable]:
         lo, hi = params.D_range
         with self._folder("motion", "Motion"):
             slider = self.gui.add_slider(
@@ -271,13 +258,12 @@ class ControlPanel:
                 hint="Energy parameter in [I_min, I_max]; D = I₂ is the separatrix.",
             )
 
-        @slider.on_update
-        @self._user_only
-        def _(handle) -> None:
+        def move(handle: viser.GuiSliderHandle[float]) -> None:
             value = float(handle.value)
-            self.actions.edit(lambda p: _with_D(p, value))
+            self.actions.edit(lambda p: p.with_D(value))
 
-        return self._tag(Control.ENERGY, energy=slider)
+        self.widgets.energy = self._on_user(slider, move)
+        return [slider]
 
     @staticmethod
     def _energy_marks(params: Parameters) -> tuple[tuple[float, str], ...]:
@@ -288,25 +274,22 @@ class ControlPanel:
             marks.insert(1, (mid, "I₂"))
         return tuple(marks)
 
-    def _build_side(self, params: Parameters) -> list[Any]:
+    def _build_side(self) -> list[Removable]:
         with self._folder("motion", "Motion"):
             side = self.gui.add_button_group("Side of separatrix", SIDE_OPTIONS, order=1.0)
             pole = self.gui.add_button_group("Polhode", POLE_OPTIONS, order=2.0)
 
-        def choose_side(handle) -> None:
+        def choose_side(handle: viser.GuiButtonGroupHandle) -> None:
             choice = "major" if handle.value == SIDE_OPTIONS[1] else "minor"
             self.actions.edit(lambda p: p.mirrored(choice))
 
-        def choose_pole(handle) -> None:
+        def choose_pole(handle: viser.GuiButtonGroupHandle) -> None:
             sign = 1 if handle.value == POLE_OPTIONS[0] else -1
-            self.actions.edit(lambda p: _with_pole(p, sign))
+            self.actions.edit(lambda p: p.with_pole(sign))
 
-        side.on_click(self._user_only(choose_side))
-        pole.on_click(self._user_only(choose_pole))
+        return [self._on_user(side, choose_side), self._on_user(pole, choose_pole)]
 
-        return self._tag(Control.SIDE, side=side, pole=pole)
-
-    def _build_omega_norm(self, params: Parameters) -> list[Any]:
+    def _build_omega_norm(self, params: Parameters) -> list[Removable]:
         with self._folder("motion", "Motion"):
             slider = self.gui.add_slider(
                 "|ω₀|",
@@ -318,15 +301,14 @@ class ControlPanel:
                 hint="Initial angular speed (rad per time unit).",
             )
 
-        @slider.on_update
-        @self._user_only
-        def _(handle) -> None:
+        def move(handle: viser.GuiSliderHandle[float]) -> None:
             value = float(handle.value)
-            self.actions.edit(lambda p: _with_omega_norm(p, value))
+            self.actions.edit(lambda p: p.with_omega_norm(value))
 
-        return self._tag(Control.OMEGA_NORM, omega_norm=slider)
+        self.widgets.omega_norm = self._on_user(slider, move)
+        return [slider]
 
-    def _build_speed(self, speed: float) -> list[Any]:
+    def _build_speed(self, speed: float) -> list[Removable]:
         with self._folder("playback", "Playback"):
             slider = self.gui.add_slider(
                 "Speed",
@@ -337,20 +319,20 @@ class ControlPanel:
                 order=0.0,
                 hint="Simulation time units per second.",
             )
-        slider.on_update(self._user_only(lambda h: self.actions.set_speed(float(h.value))))
-        return self._tag(Control.SPEED, speed=slider)
+        self.widgets.speed = self._on_user(slider, lambda h: self.actions.set_speed(float(h.value)))
+        return [slider]
 
-    def _build_playback(self) -> list[Any]:
+    def _build_playback(self) -> list[Removable]:
         with self._folder("playback", "Playback"):
             pause = self.gui.add_button("Pause", icon=viser.Icon.PLAYER_PAUSE, order=1.0)
             step = self.gui.add_button("Step", icon=viser.Icon.PLAYER_TRACK_NEXT, order=2.0)
             reset = self.gui.add_button("Reset", icon=viser.Icon.REFRESH, order=3.0)
-        pause.on_click(self._user_only(lambda _: self.actions.toggle_pause()))
-        step.on_click(self._user_only(lambda _: self.actions.step()))
-        reset.on_click(self._user_only(lambda _: self.actions.reset()))
-        return self._tag(Control.PLAYBACK, pause=pause, step=step, reset=reset)
+        self.widgets.pause = self._on_user(pause, lambda _: self.actions.toggle_pause())
+        self._on_user(step, lambda _: self.actions.step())
+        self._on_user(reset, lambda _: self.actions.reset())
+        return [pause, step, reset]
 
-    def _build_trail(self, trail: int) -> list[Any]:
+    def _build_trail(self, trail: int) -> list[Removable]:
         with self._folder("playback", "Playback"):
             slider = self.gui.add_slider(
                 "Trail length",
@@ -361,139 +343,56 @@ class ControlPanel:
                 order=4.0,
                 hint="Points kept in the polhode and herpolhode traces.",
             )
-        slider.on_update(self._user_only(lambda h: self.actions.set_trail(int(h.value))))
-        return self._tag(Control.TRAIL, trail=slider)
+        self.widgets.trail = self._on_user(slider, lambda h: self.actions.set_trail(int(h.value)))
+        return [slider]
 
     def _build_visibility(
         self, elements: frozenset[Element], visible: Callable[[Element], bool]
-    ) -> list[Any]:
-        boxes = {}
+    ) -> list[Removable]:
+        boxes: list[Removable] = []
         with self._folder(Control.VISIBILITY, "Show", expand=False):
             for n, element in enumerate(e for e in Element if e in elements):
                 box = self.gui.add_checkbox(
                     ELEMENT_LABELS[element], visible(element), order=float(n)
                 )
-                box.on_update(self._user_only(self._visible_cb(element)))
-                boxes[f"show_{element.value}"] = box
-        return self._tag(Control.VISIBILITY, **boxes)
+                boxes.append(self._on_user(box, self._visibility_callback(element)))
+        return boxes
 
-    def _visible_cb(self, element: Element) -> Callable[[Any], None]:
+    def _visibility_callback(self, element: Element) -> Callable[[viser.GuiCheckboxHandle], None]:
         return lambda handle: self.actions.set_visible(element, bool(handle.value))
-
-    def _build_plot(self) -> list[Any]:
-        series = [viser.uplot.Series(label="t")]
-        for i, color in enumerate(palette.PLOT_SERIES):
-            series.append(viser.uplot.Series(label=f"ω{'₁₂₃'[i]}", stroke=color, width=2))
-        axis = {
-            "stroke": "#c8d0da",
-            "grid": {"stroke": "#3a4048", "width": 1},
-            "ticks": {"stroke": "#3a4048"},
-        }
-        # Created with two samples, not empty: viser's uPlot keeps the x range relative to the
-        # data's extent, and an empty first data set (extent -inf..inf) leaves it NaN forever.
-        with self._data_tab:
-            plot = self._add_plot(series, axis)
-        self._plot_t, self._plot_w = [], []
-        return self._tag(Plot.OMEGA, plot=plot)
-
-    def _add_plot(self, series, axis):
-        zeros = np.zeros(2)
-        return self.gui.add_uplot(
-            data=(np.array([0.0, 1.0]), zeros, zeros, zeros),
-            series=tuple(series),
-            title="ω in the body frame",
-            scales={"x": {"time": False, "auto": True}, "y": {"auto": True}},
-            axes=(axis, axis),  # type: ignore[arg-type]
-            aspect=1.7,
-            order=2.0,
-        )
 
     # -- mirroring the session's state ---------------------------------------------------
     def show_preset(self, preset: Preset) -> None:
-        self.handles["preset"].value = preset.label
-        self.handles["source"].content = self._source_text(preset)
+        set_value(self.preset, preset.label)
+        self.source.content = self._source_text(preset)
 
     @staticmethod
     def _source_text(preset: Preset) -> str:
         return f"<small>_Source:_ {preset.source}</small>"
 
     def show_status(self, message: str) -> None:
-        handle = self.handles["status"]
         text = f"**⚠ {message}**" if message else ""
-        if handle.content != text:
-            handle.content = text
+        if self.status.content != text:
+            self.status.content = text
 
     def show_parameters(self, params: Parameters) -> None:
         """Mirror parameters into the sliders (and the D slider's range and marks)."""
-        for i in range(3):
-            slider = self.handles.get(f"I{i + 1}")
-            if slider is not None:
-                slider.value = float(params.inertia[i])
-        energy = self.handles.get("energy")
-        if energy is not None:
-            lo, hi = params.D_range
-            energy.min, energy.max = lo, hi
-            energy.marks = self._energy_marks(params)
-            energy.value = float(params.D)
-        if "omega_norm" in self.handles:
-            self.handles["omega_norm"].value = float(params.omega_norm)
+        w = self.widgets
+        for slider, moment in zip(w.inertia, params.inertia, strict=False):
+            set_value(slider, float(moment))
+        if w.energy is not None:
+            w.energy.min, w.energy.max = params.D_range
+            set_marks(w.energy, self._energy_marks(params))
+            set_value(w.energy, float(params.D))
+        if w.omega_norm is not None:
+            set_value(w.omega_norm, float(params.omega_norm))
 
     def show_playback(self, speed: float, paused: bool, trail: int) -> None:
-        if "speed" in self.handles:
-            self.handles["speed"].value = float(speed)
-        if "trail" in self.handles:
-            self.handles["trail"].value = int(trail)
-        if "pause" in self.handles:
-            pause = self.handles["pause"]
-            pause.label = "Play" if paused else "Pause"
-            pause.icon = viser.Icon.PLAYER_PLAY if paused else viser.Icon.PLAYER_PAUSE
-
-    def show_readouts(self, text: str) -> None:
-        self.handles["readouts"].content = text
-
-    def show_time(self, t: float, paused: bool) -> None:
-        text = readouts.time_markdown(t, paused)
-        if self.handles["time"].content != text:
-            self.handles["time"].content = text
-
-    def clear_plot(self) -> None:
-        self._plot_t, self._plot_w = [], []
-
-    def record_plot(self, t: float, omega: np.ndarray) -> None:
-        """Add a sample (the session does, at the plot's refresh rate, then sends)."""
-        if "plot" not in self.handles:
-            return
-        if self._plot_t and t < self._plot_t[-1]:
-            self.clear_plot()
-        if self._plot_t and t == self._plot_t[-1]:
-            return
-        self._plot_t.append(float(t))
-        self._plot_w.append(np.array(omega, dtype=np.float64))  # a copy: not a batch's view
-        if len(self._plot_t) > PLOT_SAMPLES:
-            del self._plot_t[0], self._plot_w[0]
-
-    def send_plot(self) -> bool:
-        plot = self.handles.get("plot")
-        if plot is None or len(self._plot_t) < 2:
-            return False
-        w = np.asarray(self._plot_w)
-        data = (np.asarray(self._plot_t), w[:, 0].copy(), w[:, 1].copy(), w[:, 2].copy())
-        if all(np.all(np.isfinite(a)) for a in data):
-            plot.data = data
-            return True
-        return False
-
-
-def _with_D(p: Parameters, D: float) -> Parameters:
-    lo, hi = p.D_range
-    return Parameters(p.inertia, min(max(D, lo), hi), p.pole_sign, p.omega_norm)
-
-
-def _with_pole(p: Parameters, sign: int) -> Parameters:
-    return Parameters(p.inertia, p.D, sign, p.omega_norm)
-
-
-def _with_omega_norm(p: Parameters, value: float) -> Parameters:
-    if not math.isfinite(value) or value <= 0:
-        return p
-    return Parameters(p.inertia, p.D, p.pole_sign, value)
+        w = self.widgets
+        if w.speed is not None:
+            set_value(w.speed, float(speed))
+        if w.trail is not None:
+            set_value(w.trail, int(trail))
+        if w.pause is not None:
+            w.pause.label = "Play" if paused else "Pause"
+            w.pause.icon = viser.Icon.PLAYER_PLAY if paused else viser.Icon.PLAYER_PAUSE

@@ -59,7 +59,7 @@ def _decode_frame(frame: bytes) -> list[dict[str, Any]]:
         frame[16 : 16 + compressed_len], max_output_size=inner_len
     )
     payload = msgspec.msgpack.decode(inner)
-    buffers: list[np.ndarray] = []
+    buffers: list[memoryview] = []
     offset = 16 + compressed_len
     for length in payload["binaryBufferLengths"]:
         offset += (8 - offset % 8) % 8
@@ -188,21 +188,32 @@ class Probe:
                 self._cond.notify_all()
 
     def _apply(self, m: dict[str, Any]) -> None:
-        kind = m["type"]
+        kind: str = m["type"]
         name = m.get("name")
+        if isinstance(name, str):
+            self._apply_node(kind, name, m)
+        else:
+            self._apply_widget(kind, m)
+
+    def _apply_node(self, kind: str, name: str, m: dict[str, Any]) -> None:
+        node = self.nodes.get(name)
         if kind == "RemoveSceneNodeMessage":
             self.nodes.pop(name, None)
-        elif kind == "SetOrientationMessage" and name in self.nodes:
-            self.nodes[name].wxyz = tuple(m["wxyz"])  # type: ignore[assignment]
-        elif kind == "SetPositionMessage" and name in self.nodes:
-            self.nodes[name].position = tuple(m["position"])  # type: ignore[assignment]
-        elif kind == "SetSceneNodeVisibilityMessage" and name in self.nodes:
-            self.nodes[name].visible = bool(m["visible"])
-        elif kind == "SceneNodeUpdateMessage" and name in self.nodes:
-            self.nodes[name].props.update(m["updates"])
-        elif name is not None and isinstance(m.get("props"), dict):
+        elif kind == "SetOrientationMessage" and node is not None:
+            w, x, y, z = (float(c) for c in m["wxyz"])
+            node.wxyz = (w, x, y, z)
+        elif kind == "SetPositionMessage" and node is not None:
+            x, y, z = (float(c) for c in m["position"])
+            node.position = (x, y, z)
+        elif kind == "SetSceneNodeVisibilityMessage" and node is not None:
+            node.visible = bool(m["visible"])
+        elif kind == "SceneNodeUpdateMessage" and node is not None:
+            node.props.update(m["updates"])
+        elif isinstance(m.get("props"), dict):
             self.nodes[name] = Node(kind, dict(m["props"]))
-        elif kind == "GuiRemoveMessage":
+
+    def _apply_widget(self, kind: str, m: dict[str, Any]) -> None:
+        if kind == "GuiRemoveMessage":
             self.widgets.pop(m["uuid"], None)
         elif kind == "GuiUpdateMessage" and m["uuid"] in self.widgets:
             widget = self.widgets[m["uuid"]]
@@ -247,7 +258,7 @@ class Probe:
 
     def labels(self) -> list[str]:
         with self._cond:
-            return [w.props.get("label") for w in self.widgets.values() if w.props.get("label")]
+            return [str(w.props["label"]) for w in self.widgets.values() if w.props.get("label")]
 
     def has_widget(self, label: str) -> bool:
         return label in self.labels()

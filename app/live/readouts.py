@@ -1,6 +1,6 @@
 """Live text: the conserved quantities and constants of the motion, formatted for a projector.
 
-Formatting only; every number comes from the :class:`physics.FreeRigidBody`.
+Formatting only; every number comes from the :class:`poinsot.physics.FreeRigidBody`.
 """
 
 from __future__ import annotations

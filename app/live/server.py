@@ -1,4 +1,4 @@
-"""The viser server and its sessions: one :class:`~app.session.Session` per browser."""
+"""The viser server and its sessions: one :class:`~poinsot.app.live.session.Session` per browser."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ import threading
 import warnings
 
 import viser
+
 from poinsot.app.live.budget import FrameBudget
 from poinsot.app.live.session import MAX_FPS, Session
 from poinsot.app.presets import DEFAULT_PRESET, Preset

@@ -18,15 +18,19 @@ import time
 from collections.abc import Callable
 
 import viser
+
+from poinsot.app.elements import ALL_ELEMENTS, Element, Solid
 from poinsot.app.live import readouts
 from poinsot.app.live.budget import FrameBudget
 from poinsot.app.live.clock import SimClock
-from poinsot.app.live.ghost import add_ghost_controls
+from poinsot.app.live.ghost_controls import add_ghost_controls
 from poinsot.app.live.lecture import add_lecture_controls
 from poinsot.app.live.panel import ControlPanel
+from poinsot.app.live.widgets import Retirement
 from poinsot.app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters
-from poinsot.app.presets import ALL_ELEMENTS, CUSTOM, DEFAULT_PRESET, Element, Preset, Solid
-from poinsot.app.scene.construction import Frame, PoinsotScene
+from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, Preset
+from poinsot.app.scene.batch import Frame
+from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.view import DEFAULT_VIEW, View, apply_theme
 from poinsot.physics import FreeRigidBody, box_dimensions
 
@@ -88,6 +92,7 @@ class Session:
         self.clock = SimClock(speed=preset.speed)
         self.preset = preset
         self._base = preset  # the last named preset: it supplies the solid
+        self._base_inertia = Parameters.from_preset(preset).inertia
         self.params = Parameters.from_preset(preset)
         self._desired = self.params
         self._dirty = True
@@ -100,18 +105,21 @@ class Session:
         self._applied = threading.Condition()
         self._generation = 0  # bumped after each rebuild (tests wait on it)
         self._thread: threading.Thread | None = None
+        self._last_plot = self._last_time = 0.0  # monotonic times of the last refreshes
 
         apply_theme(client)
         view.apply(client.camera)
         self.scene = PoinsotScene(
             client.scene, preset.elements, preset.trail_points, atomic=client.atomic
         )
-        self.panel = ControlPanel(client.gui, self, preset)
+        #: Widgets removed from the panel, deleted a moment later (frame thread).
+        self.retirement = Retirement()
+        self.panel = ControlPanel(client.gui, self, preset, self.retirement)
         self._apply_preset(preset)
         self._rebuild()
-        # Exports, camera views, theme and hotkeys (issue 5) mount on the session's panel.
+        # Exports, camera views, theme and hotkeys mount on the session's panel.
         self.lecture = add_lecture_controls(self)
-        # The numerical ghost (issue 4): its controls now, the ghost itself only when switched on.
+        # The numerical ghost: its controls now, the ghost itself only when switched on.
         self.ghost = add_ghost_controls(self)
 
     # -- lifecycle -----------------------------------------------------------------------
@@ -197,7 +205,6 @@ class Session:
     # -- frame thread --------------------------------------------------------------------
     def _run(self) -> None:
         next_frame = due = time.monotonic()
-        last_plot = last_time = 0.0
         while not self._stop.is_set():
             delay = next_frame - time.monotonic()
             if delay > 0:
@@ -217,21 +224,26 @@ class Session:
                 elif now >= next_frame:
                     next_frame = due = now + 1.0 / min(self.max_fps, self.budget.fps)
                     self._advance()
+                    self._refresh(now)
                     drawn = True
-                    if now - last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
-                        last_plot = now
-                        self.panel.record_plot(self.frame.t, self.frame.omega)
-                        self.panel.send_plot()
-                    if now - last_time >= 1.0 / TIME_HZ:
-                        last_time = now
-                        shown = self.frame.t if self.frame is not None else 0.0
-                        self.panel.show_time(shown, self.clock.paused)
-                        self.panel.collect(now)
             except Exception as exc:  # the loop must survive anything; the user sees it
                 self._report(exc)
                 next_frame = time.monotonic() + 1.0 / self.max_fps
             if drawn:
                 self.stats.frame_cpu_seconds.append(time.thread_time() - cpu0)
+
+    def _refresh(self, now: float) -> None:
+        """After a frame: the plot at PLOT_HZ, the time readout (and retired widgets) at
+        TIME_HZ."""
+        motion = self.panel.motion
+        if now - self._last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
+            self._last_plot = now
+            motion.record_plot(self.frame.t, self.frame.omega)
+            motion.send_plot()
+        if now - self._last_time >= 1.0 / TIME_HZ:
+            self._last_time = now
+            motion.show_time(self.frame.t if self.frame is not None else 0.0, self.clock.paused)
+            self.retirement.collect(now)
 
     def _drain(self) -> None:
         if self._actions.empty():  # the usual frame: no exception raised and caught
@@ -277,6 +289,7 @@ class Session:
         self.preset = preset
         if preset is not CUSTOM:
             self._base = preset
+            self._base_inertia = Parameters.from_preset(preset).inertia
             self._desired = Parameters.from_preset(preset)
             self.clock.speed = preset.speed
             self.scene.trail_points = preset.trail_points
@@ -318,10 +331,9 @@ class Session:
 
     def _solid(self, params: Parameters) -> Solid | None:
         """The base preset's solid while the moments are still the preset's, otherwise the
-        homogeneous box with the same moments (:func:`physics.box_dimensions`); a flat lamina
-        is drawn with a thin (2 %) side."""
-        base = Parameters.from_preset(self._base)
-        if params.inertia == base.inertia and self._base.solid is not None:
+        homogeneous box with the same moments (:func:`poinsot.physics.box_dimensions`); a flat
+        lamina is drawn with a thin (2 %) side."""
+        if self._base.solid is not None and params.inertia == self._base_inertia:
             return self._base.solid
         sides = box_dimensions(params.inertia)
         return Solid("box", tuple(float(max(a, 0.02 * sides.max())) for a in sides))
@@ -330,35 +342,35 @@ class Session:
         """Build the body for the desired parameters and load it; on a ValueError keep the
         last valid scene and say why."""
         with self.budget.rebuild():
-            self._rebuild_now()
-
-    def _rebuild_now(self) -> None:
-        start = time.perf_counter()
-        desired = self._desired
-        self._dirty = False
-        try:
-            body = desired.build()
-            self.clock.reset(0.0)
-            self.frame = self.scene.load(
-                body, self._solid(desired), t=0.0, frame_time=self.frame_time
-            )
-        except ValueError as exc:
-            reason = str(exc)
-            self._set_status(f"{reason[:1].upper()}{reason[1:]}. Showing the last valid body.")
-        else:
-            self.body, self.params = body, desired
-            self.panel.show_parameters(desired)
-            self.panel.show_readouts(readouts.markdown(body))
-            self.panel.clear_plot()
-            self.panel.record_plot(0.0, self.frame.omega)
-            self._set_status("")
-            # Send now: viser otherwise batches outgoing messages for up to a frame (1/60 s).
-            self.client.flush()
-        self.stats.rebuild_seconds.append(time.perf_counter() - start)
-        self.stats.rebuilds += 1
+            start = time.perf_counter()
+            desired = self._desired
+            self._dirty = False
+            try:
+                body = desired.build()
+                self.clock.reset(0.0)
+                frame = self.scene.load(body, self._solid(desired), frame_time=self.frame_time)
+            except ValueError as exc:
+                reason = str(exc)
+                self._set_status(f"{reason[:1].upper()}{reason[1:]}. Showing the last valid body.")
+            else:
+                self._show_body(body, desired, frame)
+            self.stats.rebuild_seconds.append(time.perf_counter() - start)
+            self.stats.rebuilds += 1
         with self._applied:
             self._generation += 1
             self._applied.notify_all()
+
+    def _show_body(self, body: FreeRigidBody, params: Parameters, frame: Frame) -> None:
+        """The new body is on screen: mirror it into the panel and the "Motion" window."""
+        self.body, self.params, self.frame = body, params, frame
+        self.panel.show_parameters(params)
+        motion = self.panel.motion
+        motion.show_readouts(readouts.markdown(body))
+        motion.clear_plot()
+        motion.record_plot(0.0, frame.omega)
+        self._set_status("")
+        # Send now: viser otherwise batches outgoing messages for up to a frame (1/60 s).
+        self.client.flush()
 
     def _toggle_pause(self) -> None:
         self.clock.paused = not self.clock.paused
@@ -371,7 +383,7 @@ class Session:
 
     def _reset(self) -> None:
         self.clock.reset(0.0)
-        self.panel.clear_plot()
+        self.panel.motion.clear_plot()
 
     def _show_playback(self) -> None:
         self.panel.show_playback(self.clock.speed, self.clock.paused, self.scene.trail_points)

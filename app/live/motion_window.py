@@ -1,0 +1,98 @@
+"""The floating "Motion" window of a session: the time, the readouts of the motion's constants,
+and the live plot of ω in the body frame.
+
+It floats at the bottom left of the 3D view, so that a lecture sees the numbers beside the
+scene without scrolling the control panel. The plot exists only while the preset declares it
+(:class:`~poinsot.app.elements.Plot`); the session records a sample and sends the window of the
+last PLOT_SAMPLES at the plot's refresh rate.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import viser
+import viser.uplot
+
+from poinsot.app.live import readouts
+from poinsot.app.scene import palette
+
+#: Number of plot samples kept (one per plot refresh, 10 per second: the last 30 s).
+PLOT_SAMPLES = 300
+#: Width of the floating window [CSS px].
+WINDOW_WIDTH = 360
+
+
+class MotionWindow:
+    """Time, readouts and (when declared) the plot of ω. Driven by the session's frame thread."""
+
+    def __init__(self, gui: viser.GuiApi, order: float) -> None:
+        self.gui = gui
+        window = gui.add_panel(order=order)
+        self.tab = window.add_tab("Motion", viser.Icon.CHART_LINE)
+        with self.tab:
+            self.time = gui.add_markdown(readouts.time_markdown(0.0, False), order=0.0)
+            self.readouts = gui.add_markdown("", order=1.0)
+        window.float(x=16, y=-16, width=WINDOW_WIDTH)
+        self.plot: viser.GuiUplotHandle | None = None
+        self._t: list[float] = []
+        self._omega: list[np.ndarray] = []
+
+    # -- the plot's lifecycle (the panel declares and retires it) ---------------------------
+    def add_plot(self) -> viser.GuiUplotHandle:
+        series = [viser.uplot.Series(label="t")]
+        for i, color in enumerate(palette.PLOT_SERIES):
+            series.append(viser.uplot.Series(label=f"ω{'₁₂₃'[i]}", stroke=color, width=2))
+        zeros = np.zeros(2)
+        # Created with two samples, not empty: viser's uPlot keeps the x range relative to the
+        # data's extent, and an empty first data set (extent -inf..inf) leaves it NaN forever.
+        with self.tab:
+            self.plot = self.gui.add_uplot(
+                data=(np.array([0.0, 1.0]), zeros, zeros, zeros),
+                series=tuple(series),
+                title="ω in the body frame",
+                scales=palette.plot_scales(),
+                axes=palette.plot_axes(),
+                aspect=1.7,
+                order=2.0,
+            )
+        self.clear_plot()
+        return self.plot
+
+    def forget_plot(self) -> None:
+        """The plot was removed (by the panel): stop recording."""
+        self.plot = None
+
+    # -- mirroring the session's state ---------------------------------------------------
+    def show_readouts(self, text: str) -> None:
+        self.readouts.content = text
+
+    def show_time(self, t: float, paused: bool) -> None:
+        text = readouts.time_markdown(t, paused)
+        if self.time.content != text:
+            self.time.content = text
+
+    def clear_plot(self) -> None:
+        self._t, self._omega = [], []
+
+    def record_plot(self, t: float, omega: np.ndarray) -> None:
+        """Add a sample (the session does, at the plot's refresh rate, then sends)."""
+        if self.plot is None:
+            return
+        if self._t and t < self._t[-1]:
+            self.clear_plot()
+        if self._t and t == self._t[-1]:
+            return
+        self._t.append(float(t))
+        self._omega.append(np.array(omega, dtype=np.float64))  # a copy: not a batch's view
+        if len(self._t) > PLOT_SAMPLES:
+            del self._t[0], self._omega[0]
+
+    def send_plot(self) -> bool:
+        if self.plot is None or len(self._t) < 2:
+            return False
+        w = np.asarray(self._omega)
+        data = (np.asarray(self._t), w[:, 0].copy(), w[:, 1].copy(), w[:, 2].copy())
+        if all(np.all(np.isfinite(a)) for a in data):
+            self.plot.data = data
+            return True
+        return False
