@@ -1,1 +1,1 @@
-"""Poinsot's web app: a viser server that shows the exact solution from :mod:`physics`."""
+"""Poinsot's web app: a viser server that shows the exact solution from :mod:`poinsot.physics`."""

@@ -1,8 +1,9 @@
-"""Benchmark of the live app: ``python -m poinsot.app.benchmark [--clients 1 20] [--seconds 5]``.
+"""Benchmark of the live app: ``poinsot benchmark [--clients 1 20] [--seconds 5]`` (also
+``python -m poinsot.app.benchmark``).
 
-For each number of connected clients it starts a real Poinsot server in this process and the
-clients in a *separate* process (so that their decoding does not count as server time). The
-clients are :class:`app.probe.Probe` websockets speaking viser's protocol like a browser. It
+For each number of connected clients it starts a real Poinsot server in this process and the clients
+in a *separate* process (so that their decoding does not count as server time). The clients are
+:class:`poinsot.app.live.probe.Probe` websockets speaking viser's protocol like a browser. It
 prints:
 
 - server time per client-frame, two ways: the CPU time of the session's frame thread per
@@ -17,19 +18,24 @@ prints:
   ellipsoid (the scale of ``/space/body/ellipsoid``), median and p95, and the server's
   rebuild time alone.
 
-Targets (issue 3): <= 1 ms per client-frame, <= 30 ms per redraw.
+Targets: <= 1 ms per client-frame, <= 30 ms per redraw.
 """
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import math
 import multiprocessing as mp
+import os
 import statistics
 import sys
 import time
-from typing import Any
+from collections.abc import Callable, Sequence
+from multiprocessing.connection import Connection
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from poinsot.app.live.probe import Probe
 
 #: Values the benchmark's slider alternates between (I2 of the default preset: valid bodies).
 SLIDER_LABEL = "I₂"
@@ -45,7 +51,7 @@ def _percentile(values: list[float], q: float) -> float:
 
 
 # -- the client process ----------------------------------------------------------------------
-def _clients_main(port: int, count: int, seconds: float, redraws: int, conn) -> None:
+def _clients_main(port: int, count: int, seconds: float, redraws: int, conn: Connection) -> None:
     """Runs in a child process: connect, measure traffic, then measure slider round trips."""
     from poinsot.app.live.probe import Probe
 
@@ -58,21 +64,33 @@ def _clients_main(port: int, count: int, seconds: float, redraws: int, conn) -> 
             return
     conn.send(("ready", None))
     assert conn.recv() == "go"
-    start = [(len(p.batches), p.bytes_received) for p in probes]
+    conn.send(("traffic", _traffic(probes, seconds)))
+    assert conn.recv() == "redraw"
+    conn.send(("latencies", _slider_latencies(probes, redraws)))
+    for probe in probes:
+        probe.close()
+
+
+def _traffic(probes: list[Probe], seconds: float) -> list[tuple[int, int, int]]:
+    """(scene bytes, GUI bytes, websocket messages) each probe receives in ``seconds``."""
+    start = [len(p.batches) for p in probes]
     time.sleep(seconds)
     traffic = []
-    for probe, (n0, _) in zip(probes, start, strict=True):
+    for probe, n0 in zip(probes, start, strict=True):
         batches = probe.batches[n0:]
         gui = sum(b.nbytes for b in batches if "GuiUpdateMessage" in b.types)
         total = sum(b.nbytes for b in batches)
         traffic.append((total - gui, gui, len(batches)))
-    conn.send(("traffic", traffic))
-    assert conn.recv() == "redraw"
+    return traffic
 
+
+def _slider_latencies(probes: list[Probe], redraws: int) -> list[float]:
+    """Seconds from a probe moving the slider to the same probe receiving the new ellipsoid;
+    the probes take turns at the slider."""
     latencies: list[float] = []
     arrivals: dict[int, float] = {}
 
-    def listener_for(index: int):
+    def listener_for(index: int) -> Callable[[dict[str, Any], float], None]:
         def listener(message: dict[str, Any], arrived: float) -> None:
             if (
                 message["type"] == "SceneNodeUpdateMessage"
@@ -83,10 +101,11 @@ def _clients_main(port: int, count: int, seconds: float, redraws: int, conn) -> 
 
         return listener
 
+    count = len(probes)
     for i, probe in enumerate(probes):
         probe.add_listener(listener_for(i))
     for k in range(redraws):
-        index = k % count  # the clients take turns at the slider
+        index = k % count
         probe = probes[index]
         uuid, _ = probe.widget(SLIDER_LABEL)
         value = SLIDER_VALUES[k % 2] if count == 1 else SLIDER_VALUES[(k // count) % 2]
@@ -99,9 +118,7 @@ def _clients_main(port: int, count: int, seconds: float, redraws: int, conn) -> 
         if index in arrivals:
             latencies.append(arrivals[index] - sent)
         time.sleep(0.12)
-    conn.send(("latencies", latencies))
-    for probe in probes:
-        probe.close()
+    return latencies
 
 
 # -- the server side ---------------------------------------------------------------------------
@@ -253,22 +270,14 @@ def format_result(r: Result) -> str:
     )
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(
-        prog="python -m poinsot.app.benchmark", description=__doc__.split("\n")[0]
-    )
-    parser.add_argument("--clients", type=int, nargs="+", default=[1, 20])
-    parser.add_argument("--seconds", type=float, default=5.0, help="steady-state window")
-    parser.add_argument("--redraws", type=int, default=30, help="slider moves per run")
-    args = parser.parse_args(argv)
-    import os
-
+def main(clients: Sequence[int] = (1, 20), seconds: float = 5.0, redraws: int = 30) -> int:
+    """Run the benchmark for each number of ``clients`` and print the results."""
     print(
         f"Poinsot app benchmark (python {sys.version.split()[0]}, {os.cpu_count()} CPUs, "
         f"load average {os.getloadavg()[0]:.1f})"
     )
-    for n in args.clients:
-        print(format_result(run(n, args.seconds, args.redraws)), flush=True)
+    for n in clients:
+        print(format_result(run(n, seconds, redraws)), flush=True)
     print(
         f"viser floor: a bare viser server sending one pose per frame costs "
         f"{viser_floor():.3f} ms CPU per client-frame here (no Poinsot code)"
@@ -276,5 +285,7 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+if __name__ == "__main__":  # the command line is poinsot.app.cli's
+    from poinsot.app.cli import main as cli_main
+
+    raise SystemExit(cli_main(["benchmark", *sys.argv[1:]]))

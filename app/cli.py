@@ -1,38 +1,59 @@
-"""Command line: ``poinsot [serve] [--host H] [--port P] [--preset NAME]``.
+"""Command line: ``poinsot [serve] [--host H] [--port P] [--preset NAME]`` and offline commands.
 
-Subcommands are registered in :func:`build_parser`; each sets ``func`` (a callable taking the
-parsed arguments and returning the exit code). ``poinsot`` with no subcommand serves.
+``poinsot`` serves the live app; ``report``, ``screenshot``, ``export-html`` and ``benchmark``
+are the offline commands.
+
+Every option of every command is declared here (:func:`build_parser`). Each subcommand sets
+``func``, its implementation, which takes its options as plain typed keyword arguments named
+as its parameters (the parser's ``type=`` converters turn the text into values) and returns
+the exit code.
+``poinsot`` with no subcommand serves.
 """
 
 from __future__ import annotations
 
 import argparse
+import inspect
+import pathlib
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
-from poinsot.app.presets import PRESETS, preset_by_key
+from poinsot.app.exports.html import HTML_FPS
+from poinsot.app.exports.screenshot import parse_size, resolve_scene
+from poinsot.app.presets import PRESETS, Preset, preset_by_key
+from poinsot.app.scene.cameras import CAMERA_NAMES
 
-
-def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--host",
-        default="127.0.0.1",
-        help="interface to listen on (0.0.0.0 lets students on the room's network connect)",
-    )
-    parser.add_argument("--port", type=int, default=8080, help="TCP port (0 = any free port)")
-    parser.add_argument(
-        "--preset",
-        default=PRESETS[0].key,
-        choices=[p.key for p in PRESETS],
-        help="scene each new browser starts with",
-    )
+DESCRIPTION = "Poinsot: torque-free rigid-body motion, live in the browser and offline."
 
 
-def serve(args: argparse.Namespace) -> int:
+# -- converters (text -> value; a readable error for argparse) ------------------------------
+def _preset(key: str) -> Preset:
+    try:
+        return preset_by_key(key)
+    except KeyError as exc:
+        raise argparse.ArgumentTypeError(exc.args[0]) from exc
+
+
+def _scene(name: str) -> Preset:
+    try:
+        return resolve_scene(name)
+    except KeyError as exc:
+        raise argparse.ArgumentTypeError(exc.args[0]) from exc
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        return parse_size(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from exc
+
+
+# -- the commands ---------------------------------------------------------------------------
+def serve(host: str, port: int, preset: str) -> int:
     """Serve until interrupted (Ctrl-C)."""
     from poinsot.app.live.server import PoinsotApp
 
-    app = PoinsotApp(args.host, args.port, preset=preset_by_key(args.preset))
+    app = PoinsotApp(host, port, preset=preset_by_key(preset))
     print(f"Poinsot is running at {app.url}  (Ctrl-C to stop)", flush=True)
     try:
         while True:
@@ -53,55 +74,172 @@ def report(args: argparse.Namespace) -> int:
     return run_report(Path(args.out), quick=args.quick)
 
 
-def screenshot(args: argparse.Namespace) -> int:
-    """Write a PNG of a scene through headless Chromium (see :mod:`app.screenshot`)."""
+def screenshot(
+    out: pathlib.Path,
+    scene: Preset,
+    t: float | None,
+    size: tuple[int, int],
+    view: str,
+    background: str,
+    fit: bool,
+) -> int:
+    """Write a PNG of a scene through headless Chromium (see
+    :mod:`poinsot.app.exports.screenshot`)."""
     from poinsot.app.exports.screenshot import screenshot_command
 
-    return screenshot_command(args)
+    return screenshot_command(out, scene, t=t, size=size, view=view, background=background, fit=fit)
 
 
-def export_html(args: argparse.Namespace) -> int:
-    """Write a standalone animated HTML page (see :mod:`app.export`)."""
-    from poinsot.app.exports.export import export_html_command
+def export_html(
+    out: pathlib.Path, preset: Preset, seconds: float, fps: float, view: str, light: bool
+) -> int:
+    """Write a standalone animated HTML page (see :mod:`poinsot.app.exports.html`)."""
+    from poinsot.app.exports.html import export_html_command
 
-    return export_html_command(args)
+    return export_html_command(out, preset, seconds=seconds, fps=fps, view=view, light=light)
+
+
+def benchmark(clients: list[int], seconds: float, redraws: int) -> int:
+    """Measure the live server (see :mod:`poinsot.app.benchmark`)."""
+    from poinsot.app.benchmark import main as benchmark_main
+
+    return benchmark_main(clients, seconds, redraws)
+
+
+# -- the parser -----------------------------------------------------------------------------
+def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--host",
+        default="127.0.0.1",
+        help="interface to listen on (0.0.0.0 lets students on the room's network connect)",
+    )
+    parser.add_argument("--port", type=int, default=8080, help="TCP port (0 = any free port)")
+    parser.add_argument(
+        "--preset",
+        default=PRESETS[0].key,
+        choices=[p.key for p in PRESETS],
+        help="scene each new browser starts with",
+    )
+    parser.set_defaults(func=serve)
+
+
+def _add_report_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--quick", action="store_true", help="a reduced case matrix and fewer settings (< 60 s)"
+    )
+    parser.add_argument("--out", default="out/report", help="output directory (created)")
+    parser.set_defaults(func=report)
+
+
+def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
+    keys = "{" + ",".join(p.key for p in PRESETS) + "}"
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument(
+        "--preset",
+        dest="scene",
+        type=_preset,
+        metavar=keys,
+        help="scene to draw (default: the first)",
+    )
+    which.add_argument(
+        "--scene",
+        type=_scene,
+        metavar="NAME",
+        help="scene by preset key or label, e.g. 'Sphere (a cube)'",
+    )
+    parser.add_argument(
+        "--time",
+        dest="t",
+        metavar="TIME",
+        type=float,
+        default=None,
+        help="simulation time of the picture (default: one period of omega)",
+    )
+    parser.add_argument("--size", type=_size, default="1920x1080", help="WIDTHxHEIGHT in pixels")
+    parser.add_argument(
+        "--view",
+        choices=CAMERA_NAMES,
+        default="default",
+        help="camera: the scene's default view, along L (top), side, or fixed in the body",
+    )
+    parser.add_argument(
+        "--background",
+        choices=("dark", "light", "transparent"),
+        default="dark",
+        help="opaque dark or light theme background, or a transparent PNG",
+    )
+    parser.add_argument(
+        "--no-fit",
+        dest="fit",
+        action="store_false",
+        help="keep the view's field of view instead of framing the construction",
+    )
+    parser.add_argument("--out", type=pathlib.Path, required=True, help="output .png file")
+    parser.set_defaults(func=screenshot, scene=PRESETS[0])
+
+
+def _add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
+    keys = "{" + ",".join(p.key for p in PRESETS) + "}"
+    parser.add_argument(
+        "--preset", type=_preset, default=PRESETS[0].key, metavar=keys, help="scene to record"
+    )
+    parser.add_argument("--seconds", type=float, default=20.0, help="clip length (wall seconds)")
+    parser.add_argument("--fps", type=float, default=HTML_FPS, help="recorded frames per second")
+    parser.add_argument(
+        "--view",
+        default="default",
+        choices=("default", "top", "side"),
+        help="initial camera (the viewer can still orbit)",
+    )
+    parser.add_argument("--light", action="store_true", help="light theme (default: dark)")
+    parser.add_argument("--out", type=pathlib.Path, required=True, help="output .html file")
+    parser.set_defaults(func=export_html)
+
+
+def _add_benchmark_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--clients", type=int, nargs="+", default=[1, 20])
+    parser.add_argument("--seconds", type=float, default=5.0, help="steady-state window")
+    parser.add_argument("--redraws", type=int, default=30, help="slider moves per run")
+    parser.set_defaults(func=benchmark)
+
+
+#: Subcommand -> (help, how its options are declared).
+_SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] = {
+    "serve": ("serve the interactive scene (the default)", _add_serve_arguments),
+    "report": (
+        "work-precision report: the exact solution beside numerical integrators",
+        _add_report_arguments,
+    ),
+    "screenshot": ("a PNG of a scene, rendered by headless Chromium", _add_screenshot_arguments),
+    "export-html": (
+        "a standalone animated HTML page that plays from a file",
+        _add_export_html_arguments,
+    ),
+    "benchmark": (
+        "server time per client-frame, bytes per frame and slider-to-redraw time",
+        _add_benchmark_arguments,
+    ),
+}
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="poinsot", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="poinsot", description=DESCRIPTION)
     _add_serve_arguments(parser)  # `poinsot --host ...` is `poinsot serve --host ...`
-    parser.set_defaults(func=serve)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    serve_parser = sub.add_parser("serve", help="serve the interactive scene (the default)")
-    _add_serve_arguments(serve_parser)
-    serve_parser.set_defaults(func=serve)
-    report_parser = sub.add_parser(
-        "report", help="work-precision report: the exact solution beside numerical integrators"
-    )
-    report_parser.add_argument(
-        "--quick", action="store_true", help="a reduced case matrix and fewer settings (< 60 s)"
-    )
-    report_parser.add_argument("--out", default="out/report", help="output directory (created)")
-    report_parser.set_defaults(func=report)
-    from poinsot.app.exports.export import add_export_html_arguments
-    from poinsot.app.exports.screenshot import add_screenshot_arguments
-
-    screenshot_parser = sub.add_parser(
-        "screenshot", help="a PNG of a scene, rendered by headless Chromium"
-    )
-    add_screenshot_arguments(screenshot_parser)
-    screenshot_parser.set_defaults(func=screenshot)
-    html_parser = sub.add_parser(
-        "export-html", help="a standalone animated HTML page that plays from a file"
-    )
-    add_export_html_arguments(html_parser, [p.key for p in PRESETS])
-    html_parser.set_defaults(func=export_html)
+    for name, (help_text, add_arguments) in _SUBCOMMANDS.items():
+        add_arguments(sub.add_parser(name, help=help_text))
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    return int(args.func(args))
+    if args.func is report:  # the report's own entry point takes the parsed options as they are
+        return int(report(args))
+    # A command takes the options named by its parameters (the top-level parser's serve
+    # options are in every namespace).
+    options = vars(args)
+    names = inspect.signature(args.func).parameters
+    return int(args.func(**{name: options[name] for name in names}))
 
 
 if __name__ == "__main__":  # python -m poinsot.app.cli behaves as python -m poinsot.app and poinsot

@@ -4,19 +4,18 @@ A picture is rendered by a browser (viser's ``get_render``: WebGL, at any size, 
 control panel or notices), comes back RGBA with a transparent background, and is laid on the
 theme's background colour unless a transparent PNG is asked for (:func:`png_bytes`).
 
-``poinsot screenshot`` starts a :class:`app.stage.Stage` (the app's own scene construction on a
-viser server at a free port), seeks it to the requested time, opens it in headless Chromium
-through playwright, renders, and writes the PNG. The camera is a named view
-(:mod:`app.cameras`); unless ``--no-fit`` is given, its field of view is then narrowed so that
-the construction fills the picture (narrowing the field of view scales the image about its
-centre, so one small probe render tells the exact factor). Chromium and the server are
-stopped in ``finally`` blocks, and SIGTERM is turned into a normal exit so that they are also
-stopped when the command is killed.
+``poinsot screenshot`` starts a :class:`~poinsot.app.exports.stage.Stage` (the app's own scene
+construction on a viser server at a free port), seeks it to the requested time, opens it in headless
+Chromium through playwright, renders, and writes the PNG. The camera is a named view
+(:mod:`poinsot.app.scene.cameras`); unless ``--no-fit`` is given, its field of view is then narrowed
+so that the construction fills the picture (narrowing the field of view scales the image about its
+centre, so one small probe render tells the exact factor). Chromium and the server are stopped in
+``finally`` blocks, and SIGTERM is turned into a normal exit so that they are also stopped when the
+command is killed.
 """
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import dataclasses
 import io
@@ -29,13 +28,21 @@ import signal
 import sys
 import time
 from collections.abc import Iterator
+from types import FrameType
+from typing import TYPE_CHECKING
 
 import numpy as np
+import viser
+from scipy.spatial.transform import Rotation
+
+from poinsot.app.exports.stage import Stage
 from poinsot.app.presets import PRESETS, Preset, preset_by_key
-from poinsot.app.scene.cameras import CAMERA_NAMES, space_view
+from poinsot.app.scene.cameras import space_view
 from poinsot.app.scene.frames import wxyz as to_wxyz
 from poinsot.app.scene.view import View
-from scipy.spatial.transform import Rotation
+
+if TYPE_CHECKING:
+    from playwright.sync_api import Browser, ViewportSize
 
 RGB = tuple[int, int, int]
 
@@ -198,7 +205,7 @@ def sigterm_exits() -> Iterator[None]:
     Chromium and the server) run when the command is killed. Main thread only."""
     previous = signal.getsignal(signal.SIGTERM)
 
-    def handler(signum, frame):
+    def handler(signum: int, frame: FrameType | None) -> None:
         raise SystemExit(128 + signum)
 
     signal.signal(signal.SIGTERM, handler)
@@ -209,7 +216,7 @@ def sigterm_exits() -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def headless_chromium(executable: str) -> Iterator[object]:
+def headless_chromium(executable: str) -> Iterator[Browser]:
     """A launched playwright Browser; closed (and its processes gone) on exit."""
     try:
         from playwright.sync_api import sync_playwright
@@ -239,7 +246,7 @@ class Shot:
     seconds: float
 
 
-def _wait_for_client(stage, timeout: float):
+def _wait_for_client(stage: Stage, timeout: float) -> viser.ClientHandle:
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         clients = stage.server.get_clients()
@@ -249,8 +256,54 @@ def _wait_for_client(stage, timeout: float):
     raise TimeoutError("the browser did not connect to the scene server")
 
 
+def _open(browser: Browser, stage: Stage, size: tuple[int, int]) -> viser.ClientHandle:
+    """Open ``stage`` in a window of WINDOW_HEIGHT CSS pixels with the picture's aspect."""
+    width, height = size
+    window: ViewportSize = {
+        "width": max(16, round(WINDOW_HEIGHT * width / height)),
+        "height": WINDOW_HEIGHT,
+    }
+    scale = min(MAX_WINDOW_SCALE, max(1.0, height / WINDOW_HEIGHT))
+    context = browser.new_context(viewport=window, device_scale_factor=scale)
+    context.new_page().goto(stage.url, timeout=PAGE_TIMEOUT * 1000)
+    return _wait_for_client(stage, PAGE_TIMEOUT)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Camera:
+    """Renders of one browser's scene from one camera pose."""
+
+    client: viser.ClientHandle
+    wxyz: np.ndarray
+    position: np.ndarray
+
+    def render(self, width: int, height: int, fov: float) -> np.ndarray:
+        return self.client.get_render(
+            height,
+            width,
+            wxyz=self.wxyz,
+            position=self.position,
+            fov=fov,
+            transport_format="png",
+            timeout=RENDER_TIMEOUT,
+        )
+
+    def settled(self, width: int, height: int, fov: float) -> np.ndarray:
+        """A render once the browser has decoded every mesh (it does so asynchronously): render
+        until two renders agree."""
+        deadline = time.monotonic() + SETTLE_TIMEOUT
+        previous = self.render(width, height, fov)
+        while True:
+            current = self.render(width, height, fov)
+            if np.array_equal(current, previous) and current[..., 3].any():
+                return current
+            if time.monotonic() > deadline:
+                raise TimeoutError("the scene did not settle in the browser")
+            previous = current
+
+
 def capture(
-    stage,
+    stage: Stage,
     view: View,
     size: tuple[int, int],
     *,
@@ -263,41 +316,14 @@ def capture(
     width, height = size
     probe_w = min(width, PROBE_WIDTH)
     probe_h = max(16, round(height * probe_w / width))
-    position = np.asarray(view.position, dtype=np.float64)
-    orientation = camera_wxyz(view)
     fov = math.radians(view.fov_degrees)
     with headless_chromium(chromium) as browser:
-        window = {"width": max(16, round(WINDOW_HEIGHT * width / height)), "height": WINDOW_HEIGHT}
-        scale = min(MAX_WINDOW_SCALE, max(1.0, height / WINDOW_HEIGHT))
-        context = browser.new_context(viewport=window, device_scale_factor=scale)  # type: ignore[attr-defined]
-        page = context.new_page()
-        page.goto(stage.url, timeout=PAGE_TIMEOUT * 1000)
-        client = _wait_for_client(stage, PAGE_TIMEOUT)
-
-        def render(w: int, h: int, fov_: float) -> np.ndarray:
-            return client.get_render(
-                h,
-                w,
-                wxyz=orientation,
-                position=position,
-                fov=fov_,
-                transport_format="png",
-                timeout=RENDER_TIMEOUT,
-            )
-
-        # The browser decodes meshes asynchronously: render until two probes agree.
-        deadline = time.monotonic() + SETTLE_TIMEOUT
-        previous = render(probe_w, probe_h, fov)
-        while True:
-            current = render(probe_w, probe_h, fov)
-            if np.array_equal(current, previous) and current[..., 3].any():
-                break
-            if time.monotonic() > deadline:
-                raise TimeoutError("the scene did not settle in the browser")
-            previous = current
+        client = _open(browser, stage, size)
+        camera = _Camera(client, camera_wxyz(view), np.asarray(view.position, dtype=np.float64))
+        probe = camera.settled(probe_w, probe_h, fov)
         if fit:
-            fov = fitted_fov(fov, content_extent(current))
-        rgba = render(width, height, fov)
+            fov = fitted_fov(fov, content_extent(probe))
+        rgba = camera.render(width, height, fov)
     if rgba.shape[:2] != (height, width):
         raise RuntimeError(
             f"the browser returned {rgba.shape[1]}x{rgba.shape[0]}, not {width}x{height}"
@@ -321,73 +347,35 @@ def default_time(period: float) -> float:
     return period if math.isfinite(period) and 0 < period <= 120 else 20.0
 
 
-def add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
-    which = parser.add_mutually_exclusive_group()
-    which.add_argument(
-        "--preset", choices=[p.key for p in PRESETS], help="scene to draw (default: the first)"
-    )
-    which.add_argument(
-        "--scene", metavar="NAME", help="scene by preset key or label, e.g. 'Sphere (a cube)'"
-    )
-    parser.add_argument(
-        "--time",
-        type=float,
-        default=None,
-        help="simulation time of the picture (default: one period of omega)",
-    )
-    parser.add_argument("--size", default="1920x1080", help="WIDTHxHEIGHT in pixels")
-    parser.add_argument(
-        "--view",
-        choices=CAMERA_NAMES,
-        default="default",
-        help="camera: the scene's default view, along L (top), side, or fixed in the body",
-    )
-    parser.add_argument(
-        "--background",
-        choices=("dark", "light", "transparent"),
-        default="dark",
-        help="opaque dark or light theme background, or a transparent PNG",
-    )
-    parser.add_argument(
-        "--no-fit",
-        dest="fit",
-        action="store_false",
-        help="keep the view's field of view instead of framing the construction",
-    )
-    parser.add_argument("--out", required=True, help="output .png file")
+def screenshot_command(
+    out: pathlib.Path,
+    scene: Preset,
+    *,
+    t: float | None = None,
+    size: tuple[int, int] = (1920, 1080),
+    view: str = "default",
+    background: str = "dark",
+    fit: bool = True,
+) -> int:
+    """``poinsot screenshot``: 0 on success, EXIT_NO_BROWSER without Chromium, 1 on failure.
 
-
-def screenshot_command(args: argparse.Namespace) -> int:
-    """``poinsot screenshot``: 0 on success, EXIT_NO_BROWSER without Chromium, 1 on failure."""
-    from poinsot.app.exports.stage import Stage
-
+    ``t``: simulation time of the picture (None: one period of omega); ``view``: a camera of
+    :data:`~poinsot.app.scene.cameras.CAMERA_NAMES`; ``background``: "dark", "light" or
+    "transparent"; ``fit``: frame the construction (else keep the view's field of view).
+    """
     try:
         chromium = find_chromium()
     except BrowserMissing as exc:
         print(f"poinsot screenshot: {exc}", file=sys.stderr)
         return EXIT_NO_BROWSER
-    try:
-        size = parse_size(args.size)
-        preset = resolve_scene(args.scene or args.preset or PRESETS[0].key)
-    except (ValueError, KeyError) as exc:
-        print(f"poinsot screenshot: {exc}", file=sys.stderr)
-        return 2
-    out = pathlib.Path(args.out)
     with sigterm_exits():
-        stage = Stage.from_preset(preset, dark_mode=args.background != "light")
+        stage = Stage.from_preset(scene, dark_mode=background != "light")
         try:
-            t = args.time if args.time is not None else default_time(float(stage.body.period))
-            frame = stage.seek(t)
-            view = space_view(args.view, frame.wxyz)
-            stage.set_initial_camera(view)
-            background = (
-                None
-                if args.background == "transparent"
-                else THEME_BACKGROUND[args.background == "dark"]
-            )
-            shot = capture(
-                stage, view, size, chromium=chromium, background=background, fit=args.fit
-            )
+            t = t if t is not None else default_time(float(stage.body.period))
+            camera = space_view(view, stage.seek(t).wxyz)
+            stage.set_initial_camera(camera)
+            ground = None if background == "transparent" else THEME_BACKGROUND[background == "dark"]
+            shot = capture(stage, camera, size, chromium=chromium, background=ground, fit=fit)
         except BrowserMissing as exc:
             print(f"poinsot screenshot: {exc}", file=sys.stderr)
             return EXIT_NO_BROWSER
@@ -399,7 +387,7 @@ def screenshot_command(args: argparse.Namespace) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_bytes(shot.png)
     print(
-        f"wrote {out} ({shot.width}x{shot.height}, scene {preset.key}, t = {t:g}, "
-        f"view {args.view}, fov {shot.fov_degrees:.1f} deg) in {shot.seconds:.1f} s"
+        f"wrote {out} ({shot.width}x{shot.height}, scene {scene.key}, t = {t:g}, "
+        f"view {view}, fov {shot.fov_degrees:.1f} deg) in {shot.seconds:.1f} s"
     )
     return 0

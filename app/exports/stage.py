@@ -2,8 +2,9 @@
 with no control panel and no session.
 
 What the standalone HTML export records and what ``poinsot screenshot`` photographs: the same
-:class:`app.scene.PoinsotScene` the live app draws for each browser, driven here by explicit
-times instead of a clock, so that a picture at time T or a clip of S seconds is reproducible.
+:class:`~poinsot.app.scene.construction.PoinsotScene` the live app draws for each browser, driven
+here by explicit times instead of a clock, so that a picture at time T or a clip of S seconds is
+reproducible.
 """
 
 from __future__ import annotations
@@ -15,9 +16,12 @@ import warnings
 
 import numpy as np
 import viser
+
+from poinsot.app.elements import Element, Solid
 from poinsot.app.parameters import Parameters
-from poinsot.app.presets import Element, Preset, Solid
-from poinsot.app.scene.construction import Frame, PoinsotScene
+from poinsot.app.presets import Preset
+from poinsot.app.scene.batch import Frame
+from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.view import View, apply_lighting, configure_theme
 
 #: Largest step of simulation time between two trail updates while seeking [time units]. The
