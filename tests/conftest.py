@@ -4,9 +4,11 @@ Browser tests use Debian's Chromium through playwright (``executable_path``, no
 ``playwright install``). If Chromium is missing they are skipped locally with the reason, but
 FAIL when ``CI`` is set: CI must never pass by silently skipping them.
 
-Reusable pieces (also for the screenshot/export tests of issue 5):
-- ``poinsot_app`` (factory ``make_app``): a :class:`app.server.PoinsotApp` on a free port;
-- ``probe`` (factory ``make_probe``): a headless websocket client (:mod:`app.probe`);
+Reusable pieces (also for the screenshot and export tests):
+- ``poinsot_app`` (factory ``make_app``): a :class:`poinsot.app.live.server.PoinsotApp` on a
+  free port;
+- ``probe`` (factory ``make_probe``): a headless websocket client
+  (:mod:`poinsot.app.live.probe`);
 - ``chromium`` (session scope): a launched playwright Browser;
 - ``open_page``: ``open_page(url, width=..., height=...) -> BrowserPage`` with the console
   errors collected, the canvas ready and the software-WebGL notice dismissed;
@@ -22,15 +24,20 @@ import re
 import shutil
 import time
 from collections.abc import Callable, Iterator
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pytest
+
 from poinsot.app.exports.screenshot import CHROMIUM_ARGS, CHROMIUM_ENV, DEFAULT_CHROMIUM
 from poinsot.app.live.lecture import LectureControls
 from poinsot.app.live.probe import Probe
 from poinsot.app.live.server import PoinsotApp
 from poinsot.app.live.session import Session
 from poinsot.app.presets import DEFAULT_PRESET, Preset
+
+if TYPE_CHECKING:
+    from playwright.sync_api import FloatRect, Page
 
 CHROMIUM = os.environ.get(CHROMIUM_ENV, DEFAULT_CHROMIUM)
 #: Console messages that are not errors of ours (they are emitted at "warning" level anyway;
@@ -150,47 +157,51 @@ def chromium():
 class BrowserPage:
     """A page on the app with its console errors; helpers drive viser's widgets by label."""
 
-    page: object  # playwright.sync_api.Page
+    page: Page
     errors: list[str]
 
     def widget_id(self, label: str) -> str:
         exact = re.compile(f"^{re.escape(label)}$")
-        loc = self.page.locator("label").filter(has_text=exact)  # type: ignore[attr-defined]
-        return loc.first.get_attribute("for")
+        loc = self.page.locator("label").filter(has_text=exact)
+        widget = loc.first.get_attribute("for")
+        assert widget is not None, f"the label {label!r} names no widget"
+        return widget
 
     def control_count(self, label: str) -> int:
         """How many input widgets carry this label (0 once a control is removed)."""
         exact = re.compile(f"^{re.escape(label)}$")
-        return self.page.locator("label").filter(has_text=exact).count()  # type: ignore[attr-defined]
+        return self.page.locator("label").filter(has_text=exact).count()
 
     def press_slider(self, label: str, key: str, times: int = 1) -> None:
         """Move a slider with the keyboard (each press = one step, like a user would)."""
-        thumb = self.page.locator(f"[id='{self.widget_id(label)}'] [role=slider]")  # type: ignore[attr-defined]
+        thumb = self.page.locator(f"[id='{self.widget_id(label)}'] [role=slider]")
         thumb.focus()
         for _ in range(times):
             thumb.press(key)
 
     def slider_value(self, label: str) -> float:
-        thumb = self.page.locator(f"[id='{self.widget_id(label)}'] [role=slider]")  # type: ignore[attr-defined]
-        return float(thumb.get_attribute("aria-valuenow"))
+        thumb = self.page.locator(f"[id='{self.widget_id(label)}'] [role=slider]")
+        value = thumb.get_attribute("aria-valuenow")
+        assert value is not None, f"the slider {label!r} has no value"
+        return float(value)
 
     def choose(self, label: str, option: str) -> None:
         """Pick ``option`` in the dropdown labelled ``label``."""
-        self.page.locator(f"[id='{self.widget_id(label)}']").click()  # type: ignore[attr-defined]
-        self.page.get_by_role("option", name=option, exact=True).click()  # type: ignore[attr-defined]
+        self.page.locator(f"[id='{self.widget_id(label)}']").click()
+        self.page.get_by_role("option", name=option, exact=True).click()
 
     def dropdown_value(self, label: str) -> str:
-        return self.page.locator(f"[id='{self.widget_id(label)}']").input_value()  # type: ignore[attr-defined]
+        return self.page.locator(f"[id='{self.widget_id(label)}']").input_value()
 
     def click_button(self, text: str) -> None:
-        self.page.get_by_role("button", name=text, exact=True).click()  # type: ignore[attr-defined]
+        self.page.get_by_role("button", name=text, exact=True).click()
 
     def open_folder(self, title: str) -> None:
         """Expand a collapsed folder of the control panel by clicking its title."""
-        self.page.get_by_text(title, exact=True).first.click()  # type: ignore[attr-defined]
+        self.page.get_by_text(title, exact=True).first.click()
 
     def set_checkbox(self, label: str, checked: bool) -> None:
-        box = self.page.locator(f"[id='{self.widget_id(label)}']")  # type: ignore[attr-defined]
+        box = self.page.locator(f"[id='{self.widget_id(label)}']")
         if box.is_checked() != checked:
             box.click()
 
@@ -198,11 +209,13 @@ class BrowserPage:
         """The viewport as an (H, W, 3) uint8 array."""
         from PIL import Image
 
-        png = self.page.screenshot(type="png")  # type: ignore[attr-defined]
+        png = self.page.screenshot(type="png")
         return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
 
-    def canvas_box(self) -> dict[str, float]:
-        return self.page.locator("canvas").first.bounding_box()  # type: ignore[attr-defined]
+    def canvas_box(self) -> FloatRect:
+        box = self.page.locator("canvas").first.bounding_box()
+        assert box is not None, "the canvas is not visible"
+        return box
 
 
 _CLOSE_NOTICE_JS = """() => {

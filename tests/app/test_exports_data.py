@@ -19,20 +19,23 @@ import pytest
 import trimesh
 import zstandard
 from PIL import Image
-from poinsot.app.exports import export, screenshot
+
+from poinsot.app.exports import glb, run_csv, screenshot
+from poinsot.app.exports import html as html_export
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import PRESETS, preset_by_key
 from poinsot.app.scene.cameras import BODY_VIEW, ride_along, space_view
-from poinsot.app.scene.construction import HERPOLHODE_LIFT, POLHODE_INFLATE, Geometry
-from poinsot.app.scene.frames import wxyz
+from poinsot.app.scene.frames import wxyz, xyzw_from_wxyz
+from poinsot.app.scene.geometry import HERPOLHODE_LIFT, POLHODE_INFLATE, Geometry
 from poinsot.app.scene.view import VIEWS
+from poinsot.physics import rotations
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: Relative agreement of independently computed quantities (double rounding only).
 CLOSE = 1e-12
 #: glTF stores vertices as float32: positions of size ~1 round to ~6e-8.
 FLOAT32 = 1e-6
-#: The ellipsoid mesh is an icosphere with chord error ~2e-3 of the radius (app.solids).
+#: The ellipsoid mesh is an icosphere with chord error ~2e-3 of the radius (app/scene/meshes.py).
 MESH_CHORD = 3e-3
 
 
@@ -40,20 +43,18 @@ def body_of(key: str):
     return Parameters.from_preset(preset_by_key(key)).build()
 
 
-def hamilton(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """q v q^-1 for scalar-first unit quaternions (N, 4) and vectors (N, 3), written out
-    independently of scipy: v' = v + 2 w (u x v) + 2 u x (u x v)."""
-    w, u = q[:, :1], q[:, 1:]
-    uv = np.cross(u, v)
-    return v + 2.0 * w * uv + 2.0 * np.cross(u, uv)
+def turned(q_wxyz: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """q v q^-1 for scalar-first unit quaternions (N, 4) and vectors (N, 3), by the project's
+    one quaternion algebra (physics.rotations, independent of scipy)."""
+    return rotations.rotate(xyzw_from_wxyz(q_wxyz), v)
 
 
 # -- CSV -------------------------------------------------------------------------------------
 @pytest.mark.parametrize("key", ["major", "t_handle", "separatrix", "sphere"])
 def test_csv_round_trips_to_the_same_doubles(key):
     body = body_of(key)
-    text = export.run_csv(body, 25.0, name=key, source=preset_by_key(key).source)
-    run = export.read_run_csv(text)
+    text = run_csv.run_csv(body, 25.0, name=key, source=preset_by_key(key).source)
+    run = run_csv.read_run_csv(text)
     assert run.t[0] == 0.0 and run.t[-1] == 25.0
     assert np.all(np.diff(run.t) > 0)
     omega, rotation = body.state(run.t)
@@ -62,7 +63,7 @@ def test_csv_round_trips_to_the_same_doubles(key):
     assert np.array_equal(np.abs(run.quaternion), np.abs(wxyz(rotation)))
     assert run.meta["scene"] == key
     assert run.meta["regime"] == body.regime.name
-    assert run.meta["quaternion"] == export.QUATERNION_CONVENTION
+    assert run.meta["quaternion"] == run_csv.QUATERNION_CONVENTION
     inertia = [float(x) for x in run.meta["inertia I1, I2, I3"].split(",")]
     assert inertia == list(body.inertia)
 
@@ -71,33 +72,33 @@ def test_csv_quaternion_follows_the_convention_in_its_header():
     """The header says scalar first, body -> space, continuous sign: check each claim against
     physics' contact point R(t) omega(t), computed by physics, not from the quaternion."""
     body = body_of("t_handle")
-    run = export.read_run_csv(export.run_csv(body, 40.0))
+    run = run_csv.read_run_csv(run_csv.run_csv(body, 40.0))
     assert "scalar first" in run.meta["quaternion"] and "body -> space" in run.meta["quaternion"]
     assert np.allclose(np.linalg.norm(run.quaternion, axis=1), 1.0, atol=CLOSE)
     assert run.quaternion[0, 0] >= 0.0
     assert np.all(np.einsum("ij,ij->i", run.quaternion[1:], run.quaternion[:-1]) > 0.0)
-    rotated = hamilton(run.quaternion, run.omega)
+    rotated = turned(run.quaternion, run.omega)
     assert np.allclose(rotated, body.contact_point(run.t), rtol=0, atol=1e-12)
     # L = R (I omega) is constant and along +z in the space frame.
-    L = hamilton(run.quaternion, run.omega * np.asarray(body.inertia))
+    L = turned(run.quaternion, run.omega * np.asarray(body.inertia))
     assert np.allclose(L, body.angular_momentum, atol=1e-12)
     assert np.allclose(L[:, :2], 0.0, atol=1e-12)
 
 
 def test_csv_covers_the_run_or_one_period():
     body = body_of("major")
-    assert export.run_span(body, 0.0) == pytest.approx(body.period)
-    assert export.run_span(body, 12.5) == 12.5
-    assert export.run_span(body_of("sphere"), 0.0) == export.DEFAULT_SPAN
-    t = export.sample_times(body, 1e6)
-    assert len(t) == export.MAX_ROWS
+    assert run_csv.run_span(body, 0.0) == pytest.approx(body.period)
+    assert run_csv.run_span(body, 12.5) == 12.5
+    assert run_csv.run_span(body_of("sphere"), 0.0) == run_csv.DEFAULT_SPAN
+    t = run_csv.sample_times(body, 1e6)
+    assert len(t) == run_csv.MAX_ROWS
 
 
 def test_csv_reader_rejects_other_files():
     with pytest.raises(ValueError, match="column header"):
-        export.read_run_csv("# a comment\na,b,c\n1,2,3\n")
+        run_csv.read_run_csv("# a comment\na,b,c\n1,2,3\n")
     with pytest.raises(ValueError, match="no column header"):
-        export.read_run_csv("# only comments\n")
+        run_csv.read_run_csv("# only comments\n")
 
 
 # -- GLB -------------------------------------------------------------------------------------
@@ -113,7 +114,7 @@ def world_vertices(scene: trimesh.Scene, node: str) -> np.ndarray:
 
 def space_vertices(scene: trimesh.Scene, node: str) -> np.ndarray:
     """A node's vertices in the app's z-up space frame (undoing the glTF y-up root)."""
-    return trimesh.transform_points(world_vertices(scene, node), np.linalg.inv(export.Z_UP_TO_Y_UP))
+    return trimesh.transform_points(world_vertices(scene, node), np.linalg.inv(glb.Z_UP_TO_Y_UP))
 
 
 @pytest.mark.parametrize("key,t", [("major", 3.7), ("t_handle", 11.0), ("oblate", 2.0)])
@@ -121,8 +122,8 @@ def test_glb_loads_back_with_the_named_geometries_and_the_incidences(key, t):
     preset = preset_by_key(key)
     body = Parameters.from_preset(preset).build()
     geometry = Geometry.from_body(body, preset.solid)
-    scene = load_glb(export.scene_glb(body, t, geometry=geometry))
-    assert set(export.GLB_NAMES) <= set(scene.geometry)
+    scene = load_glb(glb.scene_glb(body, t, geometry=geometry))
+    assert set(glb.GLB_NAMES) <= set(scene.geometry)
     assert "solid" in scene.geometry
     s, h = geometry.scale, geometry.plane_height
     R = body.attitude(t).as_matrix()
@@ -142,11 +143,11 @@ def test_glb_loads_back_with_the_named_geometries_and_the_incidences(key, t):
     assert np.allclose(plane[:, 2], h, rtol=0, atol=FLOAT32)
     # The herpolhode tube runs on the plane (its centre line is lifted against z-fighting).
     herpolhode = space_vertices(scene, "herpolhode")
-    assert np.all(np.abs(herpolhode[:, 2] - h - HERPOLHODE_LIFT) <= export.TUBE_RADIUS + FLOAT32)
+    assert np.all(np.abs(herpolhode[:, 2] - h - HERPOLHODE_LIFT) <= glb.TUBE_RADIUS + FLOAT32)
     # The polhode tube lies on the (drawn, slightly inflated) ellipsoid in the body frame.
     polhode = space_vertices(scene, "polhode") @ R
     r = np.sqrt(np.sum((polhode / (geometry.semi_axes * POLHODE_INFLATE)) ** 2, axis=1))
-    assert np.all(np.abs(r - 1.0) <= 1.05 * export.TUBE_RADIUS / geometry.semi_axes.min())
+    assert np.all(np.abs(r - 1.0) <= 1.05 * glb.TUBE_RADIUS / geometry.semi_axes.min())
     # glTF is y-up: L, vertical in the app, points along +y of the file's world.
     arrow = world_vertices(scene, "L")
     assert arrow[:, 1].max() == pytest.approx(h + 0.65, abs=FLOAT32)
@@ -156,7 +157,7 @@ def test_glb_loads_back_with_the_named_geometries_and_the_incidences(key, t):
 def test_tube_follows_its_polyline_without_twisting():
     angles = np.linspace(0, 2 * np.pi, 200)
     helix = np.stack([np.cos(angles), np.sin(angles), 0.1 * angles], 1)
-    mesh = export.tube(helix, radius=0.05, sides=8)
+    mesh = glb.tube(helix, radius=0.05, sides=8)
     ring = mesh.vertices.reshape(len(helix), 8, 3)
     distance = np.linalg.norm(ring - helix[:, None, :], axis=2)
     assert np.allclose(distance, 0.05, atol=1e-12)
@@ -164,7 +165,7 @@ def test_tube_follows_its_polyline_without_twisting():
     step = np.linalg.norm(np.diff(ring, axis=0), axis=2)
     assert step.max() < 3 * np.linalg.norm(np.diff(helix, axis=0), axis=1).max()
     with pytest.raises(ValueError):
-        export.tube(np.zeros((5, 3)))
+        glb.tube(np.zeros((5, 3)))
 
 
 # -- HTML ------------------------------------------------------------------------------------
@@ -182,7 +183,7 @@ def embedded_recording(html: str) -> dict:
 
 def test_html_is_self_contained_and_records_every_frame():
     preset = preset_by_key("t_handle")
-    html = export.preset_html(preset, 2.0, fps=15)
+    html = html_export.preset_html(preset, 2.0, fps=15)
     assert html.startswith("<!doctype html>")
     assert f"<title>Poinsot: {preset.label}</title>" in html
     # Nothing is fetched: no external scripts, styles or URLs besides the SVG namespace.
@@ -205,7 +206,7 @@ def test_html_is_self_contained_and_records_every_frame():
 
 
 def test_html_of_a_20_second_clip_is_small():
-    html = export.preset_html(preset_by_key("major"), 20.0)
+    html = html_export.preset_html(preset_by_key("major"), 20.0)
     size = len(html.encode("utf-8"))
     # ~0.82 MB is viser's client itself; the 600 recorded frames add ~0.12 MB.
     assert size < 1.1e6, size
@@ -216,9 +217,9 @@ def test_html_of_a_20_second_clip_is_small():
 def test_html_rejects_bad_lengths():
     preset = preset_by_key("major")
     with pytest.raises(ValueError):
-        export.preset_html(preset, 0.0)
+        html_export.preset_html(preset, 0.0)
     with pytest.raises(ValueError):
-        export.preset_html(preset, 5.0, fps=500)
+        html_export.preset_html(preset, 5.0, fps=500)
 
 
 # -- screenshot pieces -----------------------------------------------------------------------

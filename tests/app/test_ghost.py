@@ -1,5 +1,6 @@
-"""The numerical ghost (issue 4, app/ghost.py), server-side on a real ViserServer(port=0) observed
-through the websocket probe, and once in a real browser.
+"""The numerical ghost (app/scene/ghost.py and its controls, app/live/ghost_controls.py),
+server-side on a real ViserServer(port=0) observed through the websocket probe, and once in a
+real browser.
 
 Layers: nothing exists until the ghost is switched on, and everything goes when it is switched
 off; what travels per frame; the readout and the plot; restarts (method, setting, Reset, a new
@@ -16,25 +17,26 @@ import numpy as np
 import pytest
 import viser
 from conftest import session_of, wait_until
-from poinsot.app.live import ghost as ghost_module
-from poinsot.app.live.ghost import (
+from scipy.spatial.transform import Rotation
+
+from poinsot.app.live.ghost_controls import METHOD_LABELS
+from poinsot.app.live.widgets import RETIRE_SECONDS
+from poinsot.app.parameters import Parameters
+from poinsot.app.presets import DEFAULT_PRESET, preset_by_key
+from poinsot.app.scene import ghost as ghost_module
+from poinsot.app.scene.batch import Frame
+from poinsot.app.scene.frames import wxyz_from_xyzw
+from poinsot.app.scene.geometry import Geometry
+from poinsot.app.scene.ghost import (
     DEFAULT_TOLERANCE,
-    METHOD_LABELS,
-    RETIRE_SECONDS,
     Ghost,
     GhostConfig,
     GhostErrors,
-    geodesic_angle,
-    rotate,
     time_scale,
 )
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import DEFAULT_PRESET, preset_by_key
-from poinsot.app.scene.construction import Frame, Geometry
-from poinsot.app.scene.frames import wxyz_from_xyzw
 from poinsot.app.scene.sampling import evaluate
 from poinsot.physics.integrators import State
-from scipy.spatial.transform import Rotation
+from poinsot.physics.rotations import geodesic_angle, rotate_vector
 
 GHOST_NODES = {
     "/space/ghost",
@@ -345,7 +347,7 @@ def test_geodesic_angle_is_accurate_at_every_scale(angle):
     a = Rotation.random(random_state=rng)
     axis = rng.normal(size=3)
     b = a * Rotation.from_rotvec(angle * axis / np.linalg.norm(axis))
-    got = geodesic_angle(a.as_quat(), -b.as_quat())  # either sign of q
+    got = float(geodesic_angle(a.as_quat(), -b.as_quat()))  # either sign of q
     assert got == pytest.approx(angle, rel=1e-6)
 
 
@@ -353,7 +355,7 @@ def test_rotate_matches_scipy():
     rng = np.random.default_rng(3)
     for _ in range(5):
         r, v = Rotation.random(random_state=rng), rng.normal(size=3)
-        np.testing.assert_allclose(rotate(r.as_quat(), v), r.apply(v), atol=1e-14)
+        np.testing.assert_allclose(rotate_vector(r.as_quat(), v), r.apply(v), atol=1e-14)
 
 
 def test_errors_refuse_non_finite_numbers():

@@ -1,7 +1,7 @@
-"""The lecture panel of a live session, driven by a headless websocket client (app.probe): the
-CSV and GLB buttons hand files to the browser that parse back to the session's body and time,
-and a screenshot that the client never renders ends in a message in the panel, not a hang.
-(The real-browser side is in browser/test_exports_page.py.)"""
+"""The lecture panel of a live session, driven by a headless websocket client (app/live/probe.py):
+the CSV and GLB buttons hand files to the browser that parse back to the session's body and time,
+and a screenshot that the client never renders ends in a message in the panel, not a hang. (The
+real-browser side is in browser/test_exports_page.py.)"""
 
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 import trimesh
 from conftest import lecture_of, session_of, wait_until
-from poinsot.app.exports import export
+
+from poinsot.app.exports import glb, run_csv
 
 
 class Downloads:
@@ -71,7 +72,7 @@ def test_csv_button_downloads_the_run_so_far(live):
     assert wait_until(lambda: any(n.endswith(".csv") for n in downloads.complete()), 10)
     name, data = next((n, d) for n, d in downloads.complete().items() if n.endswith(".csv"))
     assert name.startswith(f"poinsot_{session.preset.key}_t")
-    run = export.read_run_csv(data.decode("utf-8"))
+    run = run_csv.read_run_csv(data.decode("utf-8"))
     # The run up to the click: t from 0 to the session's time then, from the session's body.
     assert run.t[0] == 0.0
     assert t_click <= run.t[-1] <= session.clock.now()
@@ -88,7 +89,7 @@ def test_glb_button_downloads_the_current_construction(live):
     assert wait_until(lambda: any(n.endswith(".glb") for n in downloads.complete()), 10)
     data = next(d for n, d in downloads.complete().items() if n.endswith(".glb"))
     scene = trimesh.load(io.BytesIO(data), file_type="glb", force="scene")
-    assert set(export.GLB_NAMES) <= set(scene.geometry)
+    assert set(glb.GLB_NAMES) <= set(scene.geometry)
     # The same sizes as the scene the session draws.
     transform, geometry = scene.graph.get("plane")
     plane_y = trimesh.transform_points(scene.geometry[geometry].vertices, transform)[:, 1]

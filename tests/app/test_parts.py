@@ -12,22 +12,17 @@ import urllib.request
 import numpy as np
 import pytest
 from conftest import session_of, wait_until
+from scipy.spatial.transform import Rotation
+
 from poinsot.app import cli
+from poinsot.app.elements import ALL_ELEMENTS, Element
 from poinsot.app.live.clock import SimClock
 from poinsot.app.parameters import Parameters
-from poinsot.app.presets import (
-    ALL_ELEMENTS,
-    CUSTOM,
-    PRESETS,
-    Element,
-    preset_by_key,
-    preset_by_label,
-)
+from poinsot.app.presets import CUSTOM, PRESETS, preset_by_key, preset_by_label
 from poinsot.app.scene.frames import rotation_from_wxyz, wxyz
 from poinsot.app.scene.meshes import solid_mesh
 from poinsot.app.scene.trail import Trail
 from poinsot.physics import Regime
-from scipy.spatial.transform import Rotation
 
 EXPECTED_REGIME = {
     "major": Regime.MAJOR_AXIS,
@@ -42,7 +37,7 @@ EXPECTED_REGIME = {
 
 
 # -- presets ---------------------------------------------------------------------------
-def test_the_issue_s_presets_are_all_there():
+def test_the_presets_are_all_there():
     assert [p.key for p in PRESETS] == list(EXPECTED_REGIME)
     assert len({p.label for p in (*PRESETS, CUSTOM)}) == len(PRESETS) + 1
     assert CUSTOM.elements == ALL_ELEMENTS

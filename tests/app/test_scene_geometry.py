@@ -1,6 +1,6 @@
 """The rolling is visibly right, checked on the geometry the browser actually receives.
 
-A websocket probe (app/probe.py) decodes viser's wire messages and rebuilds the scene as the
+A websocket probe (app/live/probe.py) decodes viser's wire messages and rebuilds the scene as the
 browser would: the ellipsoid mesh vertices, its node scale, the body pose, the plane height,
 the contact marker and the omega arrow. From those alone:
 - the ellipsoid mesh is the unit sphere scaled by the sent semi-axes;
@@ -17,8 +17,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from conftest import session_of, wait_until
+
+from poinsot.app.elements import Control
 from poinsot.app.live.probe import Probe
-from poinsot.app.presets import PRESETS, Control
+from poinsot.app.presets import PRESETS
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.meshes import ELLIPSOID_SUBDIVISIONS
 

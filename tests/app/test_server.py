@@ -1,5 +1,5 @@
 """Server-side behaviour on a real ViserServer(port=0), observed through websocket probes that
-speak viser's protocol like a browser (app/probe.py): what is created, what is sent per
+speak viser's protocol like a browser (app/live/probe.py): what is created, what is sent per
 frame, the frame rate, sessions, invalid input, and robustness."""
 
 from __future__ import annotations
@@ -10,19 +10,13 @@ import time
 import numpy as np
 import pytest
 from conftest import session_of, wait_until
+from test_scene_geometry import check_finite
+
+from poinsot.app.elements import Control, Element, Plot
 from poinsot.app.live.panel import ELEMENT_LABELS
 from poinsot.app.live.session import MAX_FPS, STEP_SECONDS
-from poinsot.app.presets import (
-    CUSTOM,
-    DEFAULT_PRESET,
-    PRESETS,
-    Control,
-    Element,
-    Plot,
-    preset_by_key,
-)
+from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, PRESETS, preset_by_key
 from poinsot.app.scene.trail import CHUNK_SEGMENTS
-from test_scene_geometry import check_finite
 
 #: Nodes each element creates (trail chunks "…/c<n>" come and go under their group).
 ELEMENT_NODES: dict[Element, set[str]] = {

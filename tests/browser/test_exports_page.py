@@ -27,7 +27,8 @@ import numpy as np
 import pytest
 from conftest import chromium_or_fail, lecture_of, session_of, wait_until
 from PIL import Image
-from poinsot.app.exports import export
+
+from poinsot.app.exports import html as html_export
 from poinsot.app.exports.screenshot import THEME_BACKGROUND
 from poinsot.app.live.lecture import LARGE_TEXT_PERCENT
 from poinsot.app.presets import preset_by_key
@@ -84,7 +85,7 @@ def screenshot_rgb(page) -> np.ndarray:
 # -- standalone HTML ---------------------------------------------------------------------------
 def test_html_export_plays_from_a_file_url_without_any_server(chromium, tmp_path):
     path = tmp_path / "poinsot.html"
-    path.write_text(export.preset_html(preset_by_key("major"), 3.0, fps=20), encoding="utf-8")
+    path.write_text(html_export.preset_html(preset_by_key("major"), 3.0, fps=20), encoding="utf-8")
     context = chromium.new_context(viewport={"width": 960, "height": 540})
     refused: list[str] = []
 

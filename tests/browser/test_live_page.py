@@ -10,7 +10,9 @@ import colorsys
 import numpy as np
 import pytest
 from conftest import session_of, wait_until
-from poinsot.app.presets import DEFAULT_PRESET, Element, preset_by_key
+
+from poinsot.app.elements import Element
+from poinsot.app.presets import DEFAULT_PRESET, preset_by_key
 from poinsot.app.scene import palette
 
 pytestmark = pytest.mark.browser
