@@ -183,6 +183,16 @@ def test_the_loop_stops_when_the_client_leaves(poinsot_app, make_probe):
     assert session.stats.frames == frames
 
 
+#: Frames (about a second's worth at 60 Hz) the stalled client's session draws before the
+#: measurement starts: the stalled socket's buffers fill meanwhile.
+STALL_FILL_FRAMES = 60
+#: Frames each session, and websocket messages the live client, must get past during the
+#: measurement (about two seconds' worth at 60 Hz; a loaded machine just takes longer).
+STALL_FRAMES = 120
+#: Bounds a hang only: an unloaded machine needs about 3 s.
+STALL_TIMEOUT = 120.0
+
+
 def test_a_stalled_client_does_not_stall_the_others(poinsot_app, make_probe):
     slow = make_probe(poinsot_app)
     slow_session = session_of(poinsot_app, 1)
@@ -191,15 +201,27 @@ def test_a_stalled_client_does_not_stall_the_others(poinsot_app, make_probe):
     assert fast_session is not slow_session
     assert wait_until(lambda: fast_session.stats.frames > 10, 10)
     slow.stall()
-    time.sleep(1.0)  # let the stalled socket's buffers fill
+    f_slow = slow_session.stats.frames
+    assert wait_until(lambda: slow_session.stats.frames > f_slow + STALL_FILL_FRAMES, 60)
+    received = len(slow.batches)
     f_fast, f_slow = fast_session.stats.frames, slow_session.stats.frames
-    n_batches = len(fast.batches)
-    time.sleep(2.0)
-    assert fast_session.stats.frames - f_fast > 60  # the other session keeps animating
-    assert len(fast.batches) - n_batches > 60  # and its browser keeps receiving
-    assert slow_session.stats.frames - f_slow > 60  # the stalled one never blocks its thread
+    n_fast = len(fast.batches)
+
+    def all_moved_on() -> bool:
+        return (
+            fast_session.stats.frames - f_fast > STALL_FRAMES  # the other session animates
+            and len(fast.batches) - n_fast > STALL_FRAMES  # and its browser keeps receiving
+            and slow_session.stats.frames - f_slow > STALL_FRAMES  # the stalled one never blocks
+        )
+
+    assert wait_until(all_moved_on, STALL_TIMEOUT), (
+        fast_session.stats.frames - f_fast,
+        len(fast.batches) - n_fast,
+        slow_session.stats.frames - f_slow,
+    )
+    assert len(slow.batches) == received  # while the stalled browser read nothing
     slow.stall(False)
-    assert slow.wait_for(lambda p: p.messages_received > 0, 5)
+    assert slow.wait_for(lambda p: len(p.batches) > received, 5)
 
 
 def test_two_clients_have_independent_sessions(poinsot_app, make_probe):
