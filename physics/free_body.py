@@ -101,7 +101,7 @@ class FreeRigidBody:
         D: ``|L|²/2T`` [moment units], in ``[min I, max I]``; exactly ``I2`` on the separatrix.
         parameter, complementary_parameter: ``m = k²`` and ``1 - m`` of the Jacobi functions.
         plane_normal: (3,) ``L̂`` in space; plane_distance: ``2T/G`` [rad per time unit], the
-            invariable plane ``x·L = 2T`` [FM06 §7.9, Eq. 7.55].
+            invariable plane ``x·L = 2T`` [FM06 Eq. 7.55].
     """
 
     def __init__(
@@ -146,6 +146,7 @@ class FreeRigidBody:
                 and finite (or both norms given), or an ``attitude0`` that is not one Rotation.
         """
         checked = check_inertia(inertia)
+        check_moment_span(checked)
         d = check_energy_parameter(D, checked)
         if omega_norm is not None and momentum_norm is not None:
             raise ValueError("give |omega0| (omega_norm) or |L| (momentum_norm), not both")
@@ -400,7 +401,7 @@ class FreeRigidBody:
         [rad per time unit].
 
         It lies on the invariable plane ``x·L = 2T``, where the energy ellipsoid touches it
-        [FM06 §7.9].
+        [FM06 Eq. 7.55].
         """
         return self.sample(t)[2]
 

@@ -1,10 +1,11 @@
 """Initial states for a scene: ω0 on the polhode of a given D, and an attitude with L along z.
 
-``D = |L|²/2T`` (Pars' D [Pars65 §13.12], Fasano-Marmi's J₀ [FM06 §7.9]) picks the polhode;
-within the sorted plane ``ω2 = 0`` it crosses the momentum sphere ``|m| = G`` and the ellipsoid
-``Σ mi²/Ii = G²/D`` at ``m1² = G² I1 (I3 - D)/(D (I3 - I1))``, ``m3² = G² I3 (D - I1)/(D (I3 -
-I1))`` [LL76 §37]. The public functions check their input; the ``*_checked`` kernels serve
-:meth:`~poinsot.physics.free_body.FreeRigidBody.from_energy`, which checks it once.
+``D = |L|²/2T`` (Pars' D [Pars65 §13.12], Fasano-Marmi's J₀ [FM06 Eq. 7.57]) picks the
+polhode; within the sorted plane ``ω2 = 0`` it crosses the momentum sphere ``|m| = G`` and the
+ellipsoid ``Σ mi²/Ii = G²/D`` at ``m1² = G² I1 (I3 - D)/(D (I3 - I1))``,
+``m3² = G² I3 (D - I1)/(D (I3 - I1))`` [LL76 §37]. The public functions check their input;
+the ``*_checked`` kernels serve :meth:`~poinsot.physics.free_body.FreeRigidBody.from_energy`,
+which checks it once.
 """
 
 from __future__ import annotations

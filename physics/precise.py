@@ -5,11 +5,9 @@ the precession angle ``ν t``. Computed naively, the rounding of λ (a few ulps)
 product ``λ t`` give an error ``~eps·λt`` that grows with time, and reducing the phase modulo a
 period known to only 16 digits adds ``~eps·u`` more. Here the rates and periods are computed
 once, at 45 significant digits from the exact rational value of the data (``decimal``), kept
-as ``hi + lo`` double pairs, and the phase is formed with an error-free product (Dekker) and
-reduced with a three-part Cody-Waite constant. What is left is the rounding of ``t`` itself.
-
-References: T. J. Dekker, Numer. Math. 18 (1971) 224 (exact products); W. J. Cody and
-W. Waite, Software Manual for the Elementary Functions (1980) (argument reduction).
+as ``hi + lo`` double pairs, and the phase is formed with Dekker's error-free product
+(Veltkamp's split) and reduced with a three-part Cody-Waite constant. What is left is the
+rounding of ``t`` itself.
 """
 
 from __future__ import annotations

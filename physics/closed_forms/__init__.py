@@ -15,7 +15,7 @@ perform the same operations in the same order and so return the same bits.
 
 from __future__ import annotations
 
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,6 +34,7 @@ Triple = tuple[float, float, float]
 ScalarQuaternion = tuple[float, float, float, float]
 
 
+@runtime_checkable
 class ClosedForm(Protocol):
     """What :class:`~poinsot.physics.free_body.FreeRigidBody` needs from a closed form.
 

@@ -39,12 +39,13 @@ from poinsot.physics import FreeRigidBody
 
 CONSTANT_RTOL = 1e-13
 """``m``, ``1 - m``, ``lambda``, ``4K/lambda``, ``D``, ``T``: each is a handful of roundings of
-cancellation-free sums and products (PHYSICS.md 'Cancellation'), i.e. ~10 eps; a formula with a
-subtraction near the separatrix or near symmetry loses all digits and fails by orders."""
+cancellation-free sums and products (``Δi = G² - 2T Ii`` as sums of same-signed terms), i.e.
+~10 eps; a formula with a subtraction near the separatrix or near symmetry loses all digits and
+fails by orders."""
 
 PRECESSION_RTOL = 1e-12
-"""Precession angle per period (Landau 37.16 integrated over 4K): a sum of ``G P / I`` and a
-``Pi(N|m)`` term of opposite-sign-free parts, a few tens of roundings."""
+"""Precession angle per period ([LL76 §37, Eq. 37.16] integrated over 4K): a sum of ``G P / I``
+and a ``Pi(N|m)`` term of opposite-sign-free parts, a few tens of roundings."""
 
 GENERIC = {
     "minor-123": ((1.0, 2.0, 3.0), (1.0, 0.3, 0.5)),
@@ -69,8 +70,8 @@ EXACT_SEPARATRIX = {
 
 
 def _attitude0(key: str) -> Rotation:
-    seed = sum(map(ord, key))
-    return Rotation.from_rotvec(np.random.default_rng(seed).normal(size=3))
+    stream = sum(map(ord, key))
+    return Rotation.from_rotvec(np.random.default_rng(stream).normal(size=3))
 
 
 @functools.cache
@@ -89,8 +90,8 @@ def _errors(body: FreeRigidBody, ref: ReferenceBody, t: np.ndarray) -> tuple[np.
     return dw, dr
 
 
-def _times(period: float, n_periods: float, seed: int, n_random: int = 14) -> np.ndarray:
-    rng = np.random.default_rng(seed)
+def _times(period: float, n_periods: float, stream: int, n_random: int = 14) -> np.ndarray:
+    rng = np.random.default_rng(stream)
     return np.sort(
         np.concatenate(
             [
@@ -107,7 +108,7 @@ def test_generic_within_100_periods(key: str) -> None:
     inertia, omega0 = GENERIC[key]
     ref = _reference(inertia, omega0, key)
     body = FreeRigidBody(inertia=inertia, omega0=omega0, attitude0=_attitude0(key))
-    t = _times(ref.period_float, 100.0, seed=len(key))
+    t = _times(ref.period_float, 100.0, stream=len(key))
     dw, dr = _errors(body, ref, t)
     scale = np.linalg.norm(omega0)
     k, j = int(np.argmax(dw)), int(np.argmax(dr))
@@ -212,7 +213,7 @@ def test_near_symmetric(key: str) -> None:
     body = FreeRigidBody(inertia=inertia, omega0=omega0, attitude0=_attitude0(key))
     m_exact = float(ref.m)
     assert abs(body.parameter - m_exact) <= CONSTANT_RTOL * m_exact, (body.parameter, m_exact)
-    t = _times(ref.period_float, 100.0, seed=5)
+    t = _times(ref.period_float, 100.0, stream=5)
     dw, dr = _errors(body, ref, t)
     scale = np.linalg.norm(omega0)
     assert np.max(dw) <= OMEGA_RTOL_GENERIC * scale, (

@@ -2,7 +2,7 @@
 
 The parameter is passed as the float pair ``(m, mc)``; the reference takes the smaller of the
 two as exact (``reference.mp_parameter``) and evaluates ``mpmath.ellipfun`` at ``MP_DPS`` digits
-after an argument reduction done at high precision. The cases are the ones the issue names:
+after an argument reduction done at high precision. The cases are the hard ones:
 ``1 - m`` = 1e-2 ... 1e-16 with ``u`` up to and beyond several quarter periods (``u ~ 39`` at
 ``1 - m = 1e-10`` is where ``scipy.special.ellipj`` returns ``|cn| ~ 1e5``), ``m`` near 0, and
 large ``|u|`` (argument reduction).
@@ -49,12 +49,12 @@ def _k_float(m: float, mc: float) -> float:
         return float(mp.ellipk(mp_parameter(m, mc)))
 
 
-def _grid(m: float, mc: float, n_quarter: float, n: int, seed: int) -> np.ndarray:
+def _grid(m: float, mc: float, n_quarter: float, n: int, stream: int) -> np.ndarray:
     """Points from -n_quarter K to +n_quarter K: the quarter periods themselves (where sn = +-1
     and cn = 0 change branch), the midpoints, and random points."""
     k = _k_float(m, mc)
     quarters = np.arange(-n_quarter, n_quarter + 1) * k
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(stream)
     rand = rng.uniform(-n_quarter * k, n_quarter * k, size=n)
     return np.concatenate([quarters, quarters[:-1] + 0.5 * k, rand, [0.0, 1e-9, -1e-300]])
 
@@ -70,7 +70,7 @@ def _max_err(u: np.ndarray, m: float, mc: float) -> float:
 def test_sncndn_near_separatrix_several_periods(mc: float) -> None:
     """1 - m down to 1e-16 (and 1e-30), u over +-8 quarter periods (two full periods)."""
     m = 1.0 - mc
-    u = _grid(m, mc, 8, 40, seed=int(-math.log10(mc)))
+    u = _grid(m, mc, 8, 40, stream=int(-math.log10(mc)))
     err = _max_err(u, m, mc)
     assert err <= SNCNDN_ATOL, f"1-m={mc:g}: max |error| {err:.3e} over |u| <= {abs(u).max():.1f}"
 
@@ -87,7 +87,7 @@ def test_sncndn_scipy_trap_u39() -> None:
 def test_sncndn_near_circular(m: float) -> None:
     """m -> 0: sn, cn, dn -> sin, cos, 1 (the near-symmetric body)."""
     mc = 1.0 - m
-    u = _grid(m, mc, 8, 40, seed=7)
+    u = _grid(m, mc, 8, 40, stream=7)
     err = _max_err(u, m, mc)
     assert err <= SNCNDN_ATOL, f"m={m:g}: max |error| {err:.3e}"
 
@@ -95,7 +95,7 @@ def test_sncndn_near_circular(m: float) -> None:
 @pytest.mark.parametrize("m", [0.1, 0.5, 0.9, 0.999])
 def test_sncndn_generic(m: float) -> None:
     mc = 1.0 - m
-    u = _grid(m, mc, 8, 30, seed=3)
+    u = _grid(m, mc, 8, 30, stream=3)
     err = _max_err(u, m, mc)
     assert err <= SNCNDN_ATOL, f"m={m:g}: max |error| {err:.3e}"
 

@@ -4,7 +4,7 @@
   ``|I x| = G``, and it is the curve omega(t) actually traces;
 * ``plane_distance == 2T/|L|``, ``plane_normal == L/|L|``;
 * ``precession_per_period`` is the angle the attitude really turns about L in one period of
-  omega (``R(t + P) R(t)^T = Rot(L, angle)``), and equals the reference (Landau 37.16);
+  omega (``R(t + P) R(t)^T = Rot(L, angle)``), and equals the reference [LL76 §37, Eq. 37.16];
 * ``omega_from_energy`` and ``attitude_with_L_along_z`` do what they say.
 """
 
@@ -105,7 +105,7 @@ def test_invariable_plane(key: str) -> None:
 @pytest.mark.parametrize("key", PERIODIC)
 def test_precession_per_period_is_what_the_attitude_does(key: str) -> None:
     """R(t0 + P) R(t0)^T is the rotation about L by ``precession_per_period`` (mod 2 pi), for
-    any t0; and the unwrapped angle equals the reference's integral of Landau 37.16."""
+    any t0; and the unwrapped angle equals the reference's integral of [LL76 §37, Eq. 37.16]."""
     inertia, omega0 = CASES[key]
     body = FreeRigidBody(inertia=inertia, omega0=omega0, attitude0=ROT0)
     ref = ReferenceBody(inertia, omega0, ROT0)

@@ -1,11 +1,11 @@
 """Literature values, measured on the motion rather than read off the implementation's formulas.
 
-* Landau 37.12: the period of omega is ``4K(m)/lambda`` -- against zero crossings of omega
+* [LL76 §37, Eq. 37.12]: the period of omega is ``4K(m)/lambda`` -- against zero crossings of omega
   measured on a DOP853 integration (no elliptic function involved).
-* Seed 003 (axisymmetric body): the symmetry axis precesses about L at ``p = G/I`` while the body
-  spins relative to the precessing frame at ``s = ((I - J)/I) omega3``; the whole attitude is
-  ``R(t) = Rot(L, p t) R0 Rot(e3, s t)``.
-* Landau §37 problem 1: small oscillations about a stable axis have angular frequency
+* [FM06 §7.11], [GPS02 §5.6] (axisymmetric body): the symmetry axis precesses about L at
+  ``p = G/I`` while the body spins relative to the precessing frame at
+  ``s = ((I - J)/I) omega3``; the whole attitude is ``R(t) = Rot(L, p t) R0 Rot(e3, s t)``.
+* [LL76 §37, Problem 1]: small oscillations about a stable axis have angular frequency
   ``Omega3 sqrt((I3/I1 - 1)(I3/I2 - 1))`` (and the same with 3 -> 1 about the minor axis).
 * Instability of the intermediate axis: a perturbation grows like ``exp(sigma t)``,
   ``sigma = Omega2 sqrt((I2 - I1)(I3 - I2)/(I1 I3))``; the Dzhanibekov flip time (half a period
@@ -52,7 +52,7 @@ O((1-m) ln(1-m)) and ``lambda/sigma - 1 = O(eps_perturbation^2)``; both ~1e-8 he
 
 DOP853_FLIP_RTOL = 1e-7
 """Flip time measured on DOP853 near the separatrix: the passage close to the unstable pole
-amplifies DOP853's local errors (PHYSICS.md: no tolerance gets it below ~6e-10 there); measured
+amplifies DOP853's local errors (measured: no tolerance gets it below ~6e-10 there); measured
 3e-9 at 1 - m ~ 1e-8."""
 
 ROT0 = Rotation.from_rotvec([1.1, 0.2, -0.5])
@@ -88,11 +88,13 @@ def _crossings_of(body: FreeRigidBody, component: int, t_end: float, n: int = 40
     ],
 )
 def test_period_vs_dop853_zero_crossings(inertia, omega0, component) -> None:
-    """Landau 37.12: period of omega = 4K/lambda, measured on an independent integration.
+    """[LL76 §37, Eq. 37.12]: period of omega = 4K/lambda, measured on an independent integration.
     The measured component is one that changes sign (an sn or cn one, not the pole's dn)."""
     body = FreeRigidBody(inertia=inertia, omega0=omega0)
     ref = ReferenceBody(inertia, omega0)
-    assert body.period == pytest.approx(ref.period_float, rel=1e-13)  # 4K/lambda, Landau
+    assert body.period == pytest.approx(
+        ref.period_float, rel=1e-13
+    )  # 4K/lambda [LL76 §37, Eq. 37.12]
     crossings = dop853_zero_crossings(inertia, omega0, component, 3.2 * ref.period_float)
     crossings = crossings[crossings > 1e-9 * ref.period_float]  # not the start itself
     assert crossings.size >= 3
@@ -117,12 +119,12 @@ def test_period_vs_dop853_zero_crossings(inertia, omega0, component) -> None:
     ],
 )
 def test_symmetric_top_precession_and_spin(inertia, omega0, axis) -> None:
-    """Seed 003: R(t) = Rot(L, G t / I) R0 Rot(e_axis, s t), s = ((I - J)/I) w_axis; the
+    """[FM06 §7.11]: R(t) = Rot(L, G t / I) R0 Rot(e_axis, s t), s = ((I - J)/I) w_axis; the
     transverse omega turns in the body at -s; precession per period = G/I * 2 pi / |s|."""
     ii = np.asarray(inertia)
     w0 = np.asarray(omega0)
     J = ii[axis]
-    I = ii[(axis + 1) % 3]  # noqa: E741 - the transverse moment, as in the seed
+    I = ii[(axis + 1) % 3]  # noqa: E741 - the transverse moment, as in [FM06 §7.11]
     body = FreeRigidBody(inertia=inertia, omega0=omega0, attitude0=ROT0)
     assert body.regime is Regime.SYMMETRIC
     G = np.linalg.norm(ii * w0)
@@ -149,7 +151,7 @@ def test_symmetric_top_precession_and_spin(inertia, omega0, axis) -> None:
 
 @pytest.mark.parametrize("pole", ["major", "minor"])
 def test_small_oscillation_frequency(pole: str) -> None:
-    """Landau §37 problem 1 (about I3), and its mirror about I1."""
+    """[LL76 §37, Problem 1] (about I3), and its mirror about I1."""
     i1, i2, i3 = 1.0, 2.0, 3.0
     omega_pole = 1.3
     amp = 1e-5

@@ -90,7 +90,7 @@ def _rate(body: FreeRigidBody) -> float:
         [(i2 - i3) * w[1] * w[2] / i1, (i3 - i1) * w[2] * w[0] / i2, (i1 - i2) * w[0] * w[1] / i3]
     )
     nw = _norm(w)
-    # the precession rate phi' (Landau 37.16) is a weighted mean of G/I_i: at most G/min(I)
+    # the precession rate phi' [LL76 §37, Eq. 37.16] is a weighted mean of G/I_i: at most G/min(I)
     precession = _norm(body.inertia * w) / float(np.min(body.inertia))
     return max(nw, _norm(dw) / nw, body.frequency, precession)
 

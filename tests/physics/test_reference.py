@@ -5,7 +5,7 @@
   uniqueness of ODE solutions it *is* the motion, whatever the derivation.
 * Its precision is what it claims: ``MP_DPS`` and ``MP_DPS + 20`` digits agree, also at 1e6
   periods.
-* Its ``ellippi`` precession angle equals a direct quadrature of Landau 37.16.
+* Its ``ellippi`` precession angle equals a direct quadrature of [LL76 §37, Eq. 37.16].
 * It agrees with DOP853 (no elliptic function at all) over a few periods to what DOP853 itself
   achieves at rtol 1e-13, and the separatrix constructions hit exactly ``Delta_2 = 0``.
 """
@@ -124,7 +124,8 @@ def test_reference_precision_is_what_it_claims(inertia, omega0) -> None:
 @pytest.mark.slow
 @pytest.mark.parametrize(("inertia", "omega0"), [CASES[0], CASES[1], CASES[5], CASES[7]])
 def test_reference_precession_angle_matches_quadrature(inertia, omega0) -> None:
-    """``phi`` from ``ellippi`` (or the separatrix atan form) vs quadrature of Landau 37.16."""
+    """``phi`` from ``ellippi`` (or the separatrix atan form) vs quadrature of
+    [LL76 §37, Eq. 37.16]."""
     ref = ReferenceBody(inertia, omega0, dps=30)
     ia, ib, _ = ref.Ip
     per = ref.period_float if np.isfinite(ref.period_float) else 12.0 / ref.lam_float
@@ -169,7 +170,7 @@ def test_exact_separatrix_constructions() -> None:
         inv = exact_invariants(inertia, omega0)
         assert inv["Delta"][1] == 0
         assert family(inertia, omega0) == "separatrix"
-        # also in floating point, as the issue states for (2, 3, 6)
+        # also in floating point, for these small integers
         i = np.array(inertia)
         w = np.array(omega0)
         assert (i * i * w * w).sum() - (i * w * w).sum() * i[1] == 0.0

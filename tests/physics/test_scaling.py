@@ -6,7 +6,7 @@ attitude path ``R_c(t) = R(c t)``; scaling the moments changes nothing in omega(
 ``G^2 ~ I^2 w^2`` nor underflow of ``2T``) and obey these laws.
 
 With ``c`` a power of two the scaled inputs are exact and the laws must hold to rounding; with
-the decimal factors of the issue (1e-200, 1e150, 1e+-100) the scaled inputs are rounded
+decimal factors (1e-200, 1e150, 1e+-100) the scaled inputs are rounded
 (relative 1e-16), which moves the motion by at most ~1e-16 times its condition number over the
 compared span (a few periods here).
 """
