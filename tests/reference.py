@@ -1,14 +1,15 @@
-"""Reference solutions for the physics tests, independent of ``physics/``.
+"""Reference solutions for the physics tests, independent of the closed forms they check.
 
-Three references, each built without any code from ``physics/``:
+Three references, each built without any closed form or elliptic function from ``physics/``
+(they share only its error measure, :mod:`poinsot.physics.errors`):
 
-* :class:`ReferenceBody` -- the closed form of Landau-Lifshitz §37 (eqs. 37.10, 37.13-37.16),
+* :class:`ReferenceBody` -- the closed form of [LL76 §37, Eqs. 37.10, 37.13-37.16],
   re-derived here in mpmath at ``MP_DPS`` significant digits *from the float inputs*: the
   invariants ``2T``, ``G^2`` and ``Delta_i = G^2 - 2T I_i`` are computed exactly as rationals
   (:mod:`fractions`), so the regime (including the exact separatrix ``Delta_2 == 0``) is decided
   exactly and no digit is lost to cancellation near the separatrix. Jacobi functions come from
   ``mpmath.ellipfun`` after an explicit argument reduction modulo ``2K`` done at high precision;
-  the precession angle from ``mpmath.ellippi`` (Landau 37.16 integrated in closed form).
+  the precession angle from ``mpmath.ellippi`` ([LL76 §37, Eq. 37.16] integrated in closed form).
   ``tests/physics/test_reference.py`` proves this reference by (a) plugging it into Euler's
   equations and ``R' = R [omega]x`` with high-precision numerical derivatives, (b) comparing it
   with DOP853, and (c) comparing the ``ellippi`` precession angle with a direct quadrature.
@@ -31,6 +32,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
+from poinsot.physics.errors import attitude_error
+
 EPS = float(np.finfo(float).eps)
 
 # --------------------------------------------------------------------------------------------
@@ -49,7 +52,7 @@ reducing ``u`` modulo ``2K`` and in the Euler-angle products)."""
 SNCNDN_ATOL = 1e-13
 """Absolute error allowed for sn, cn, dn (all bounded by 1) for ``|u|`` up to ~100. A double
 result carries ~1e-16; an evaluation on the complementary parameter (descending Landen / AGM
-or the nome route) measured ~1e-13 down to ``1 - m = 1e-16`` (PHYSICS.md, 'Numerical traps').
+[Bul65] or the nome route) measured ~1e-13 down to ``1 - m = 1e-16``.
 scipy.special.ellipj misses this by up to 18 orders of magnitude near ``m = 1``."""
 
 SNCNDN_REDUCTION_EPS_FACTOR = 8.0
@@ -60,34 +63,34 @@ factor 8 covers the few roundings in ``K`` and in ``u - 4 j K``; an implementati
 not reduce (or reduces in a lossy way) fails by orders of magnitude."""
 
 OMEGA_RTOL_GENERIC = 1e-13
-"""Generic regimes within 100 periods: ``max |omega - omega_ref| / |omega0|`` (issue
-requirement)."""
+"""Generic regimes within 100 periods: ``max |omega - omega_ref| / |omega0|`` (the accuracy
+the product promises)."""
 
 ATTITUDE_ATOL_GENERIC = 1e-12
 """Generic regimes within 100 periods: geodesic angle [rad] between the attitude and the
-reference (issue requirement)."""
+reference (the accuracy the product promises)."""
 
 OMEGA_ATOL_SEPARATRIX = 1e-12
 """Near and on the separatrix (``1 - m`` down to 1e-16 and exactly 0): absolute omega error with
-omega scaled to 1, over at least two flips (issue requirement). Looser than the generic 1e-13
-because the motion itself is ill-conditioned there (it spends a time ~ln(1/(1-m)) next to the
-unstable pole, where a phase error is amplified)."""
+omega scaled to 1, over at least two flips (the accuracy the product promises). Looser than the
+generic 1e-13 because the motion itself is ill-conditioned there (it spends a time
+~ln(1/(1-m)) next to the unstable pole, where a phase error is amplified)."""
 
 ATTITUDE_ATOL_SEPARATRIX = 1e-12
-"""Near and on the separatrix: geodesic angle [rad] over at least two flips. The issue sets no
-number here; the generic 1e-12 is kept (measured: 1.5e-13 at ``1 - m = 1e-16``), although the
+"""Near and on the separatrix: geodesic angle [rad] over at least two flips. No number is promised
+here; the generic 1e-12 is kept (measured: 1.5e-13 at ``1 - m = 1e-16``), although the
 precession angle accumulates over a flip time ~ln(1/(1-m)) longer than a generic period."""
 
 LONG_TIME_EPS_FACTOR = 100.0
 """At ``t`` = 1e6 periods the float inputs themselves limit the phase: ``lambda`` rounded to
-double is off by ~eps, so ``u = lambda t`` is off by ~``eps lambda t`` (PHYSICS.md). Allowed:
-``LONG_TIME_EPS_FACTOR * eps * lambda * t`` (relative to ``|omega0|``, issue requirement); for the
+double is off by ~eps, so ``u = lambda t`` is off by ~``eps lambda t`` [vZS07]. Allowed:
+``LONG_TIME_EPS_FACTOR * eps * lambda * t`` (relative to ``|omega0|``, as promised); for the
 attitude, whose fastest angle is the precession ``~|omega| t``, the same factor times
 ``eps * (lambda + |omega0|) * t`` [rad]."""
 
 INVARIANT_RTOL = 1e-12
 """Property tests: energy, ``|L|`` and the space vector ``L = R I omega`` conserved to 1e-12
-relative (issue requirement), over inertia ratios up to 1e6."""
+relative (as promised), over inertia ratios up to 1e6."""
 
 ROTATION_ORTHO_ATOL = 1e-13
 """``R^T R = 1`` and ``det R = 1`` to 1e-13: a rotation assembled from a handful of unit
@@ -107,7 +110,7 @@ scaled by |omega0|, R entries <= 1)."""
 DOP853_FEW_PERIODS_ATOL = 3e-11
 """What DOP853 at rtol 1e-13 actually achieves over ~3 periods on a generic body, measured
 against the mpmath reference (self-test ``physics/test_reference.py``): a few 1e-12 growing with
-t (PHYSICS.md: error ~ t^2). Omega relative to |omega0| and attitude in rad."""
+t (like t^2, as any non-geometric method's). Omega relative to |omega0| and attitude in rad."""
 
 
 # --------------------------------------------------------------------------------------------
@@ -121,21 +124,10 @@ def hat(w: np.ndarray) -> np.ndarray:
 
 
 def geodesic_angle(ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
-    """Angle [rad] of ``ra^T rb`` for stacks of rotation matrices, accurate near 0 and pi.
-
-    Uses ``atan2(|vee(A - A^T)| / 2, (tr A - 1) / 2)``, which keeps full relative accuracy for
-    tiny angles (an ``arccos`` of the trace would lose half the digits).
-    """
-    ra = np.asarray(ra, dtype=float)
-    rb = np.asarray(rb, dtype=float)
-    a = np.einsum("...ji,...jk->...ik", ra, rb)
-    s = 0.5 * np.sqrt(
-        (a[..., 2, 1] - a[..., 1, 2]) ** 2
-        + (a[..., 0, 2] - a[..., 2, 0]) ** 2
-        + (a[..., 1, 0] - a[..., 0, 1]) ** 2
-    )
-    c = 0.5 * (a[..., 0, 0] + a[..., 1, 1] + a[..., 2, 2] - 1.0)
-    return np.arctan2(s, c)
+    """Angle [rad] of ``ra^T rb`` for (3, 3) or (N, 3, 3) rotation matrices (broadcasting):
+    the project's one attitude error measure, :func:`poinsot.physics.errors.attitude_error`,
+    on their quaternions (accurate near 0 and near pi)."""
+    return attitude_error(Rotation.from_matrix(ra), Rotation.from_matrix(rb))
 
 
 def as_matrices(rot: Rotation) -> np.ndarray:
@@ -222,7 +214,7 @@ def mp_sncndn(u: float | mp.mpf, m: mp.mpf, dps: int = MP_DPS) -> tuple[mp.mpf, 
 
 
 # --------------------------------------------------------------------------------------------
-# The closed-form reference (Landau §37) in mpmath
+# The closed-form reference [LL76 §37] in mpmath
 # --------------------------------------------------------------------------------------------
 
 
@@ -246,14 +238,14 @@ _SWAP_POLE = np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]])
 
 
 class ReferenceBody:
-    """Torque-free rigid body in closed form at high precision (Landau §37, re-derived).
+    """Torque-free rigid body in closed form at high precision ([LL76 §37], re-derived).
 
     Frames: the caller's body axes; the *pole frame* ``(a, b, c)`` obtained by a proper signed
     permutation ``P`` so that ``I_b`` is the intermediate moment and the conserved-sign
     component (the pole of the polhode) is ``c``. With ``Delta_i = G^2 - 2T I_i`` (exact):
 
     * ``A_a^2 = -Delta_c / (I_a (I_c - I_a))``, ``A_b^2 = -Delta_c / (I_b (I_c - I_b))``,
-      ``A_c^2 = Delta_a / (I_c (I_c - I_a))`` (Landau 37.10);
+      ``A_c^2 = Delta_a / (I_c (I_c - I_a))`` [LL76 §37, Eq. 37.10];
     * ``lambda^2 = (I_c - I_b) Delta_a / (I_a I_b I_c)``,
       ``m = (I_b - I_a)(-Delta_c) / ((I_c - I_b) Delta_a)``,
       ``1 - m = Delta_b (I_c - I_a) / (Delta_a (I_c - I_b))`` (exact, no cancellation);
@@ -261,8 +253,8 @@ class ReferenceBody:
       omega_c(0)``, ``sigma = s sign(I_c - I_b)`` (from Euler's equations: the minor family in
       the relabelled frame has ``I_c < I_b``), ``u0 = F(atan2(omega_b/A_b, omega_a/A_a) | m)``;
     * separatrix (``Delta_b = 0``): ``omega = (s_a A_a sech u, A_b tanh u, s_c A_c sech u)``,
-      ``sigma = s_a s_c``, ``u0 = atanh(omega_b(0)/A_b)`` (Landau §37 problem 2);
-    * attitude: Z-X-Z Euler angles about ``L = G e_z`` (Landau 37.13-37.16):
+      ``sigma = s_a s_c``, ``u0 = atanh(omega_b(0)/A_b)`` [LL76 §37, Problem 2];
+    * attitude: Z-X-Z Euler angles about ``L = G e_z`` [LL76 §37, Eqs. 37.13-37.16]:
       ``m/G = (sin th sin psi, sin th cos psi, cos th)`` in the pole frame, and
       ``phi' = G (m_a^2/I_a + m_b^2/I_b) / (m_a^2 + m_b^2)
       = G/I_c + G (I_c - I_a)/(I_a I_c) / (1 - N sn^2 u)``, ``N = -I_c (I_b - I_a)/(I_a (I_c

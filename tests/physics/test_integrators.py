@@ -19,6 +19,7 @@ from scipy.spatial.transform import Rotation
 
 import poinsot.physics.integrators.attitudes as attitudes_module
 from poinsot.physics import FreeRigidBody
+from poinsot.physics.errors import attitude_error, energy, omega_error, relative_drift
 from poinsot.physics.integrators import INTEGRATORS, Trajectory, integrate
 
 EPS = float(np.finfo(float).eps)
@@ -96,10 +97,8 @@ def time_scale(inertia: np.ndarray, omega0: np.ndarray) -> float:
 
 def errors(traj: Trajectory, body: FreeRigidBody, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(relative omega error, geodesic attitude angle [rad]) at every time."""
-    w = body.omega(t)
-    rel = np.linalg.norm(traj.omega - w, axis=1) / np.linalg.norm(w, axis=1)
-    angle = (traj.attitude * body.attitude(t).inv()).magnitude()
-    return rel, angle
+    w, attitude = body.state(t)
+    return omega_error(traj.omega, w), attitude_error(traj.attitude, attitude)
 
 
 def slope(x: list[float], y: list[float]) -> float:
@@ -107,8 +106,7 @@ def slope(x: list[float], y: list[float]) -> float:
 
 
 def relative_energy_error(inertia: np.ndarray, omega0: np.ndarray, omega: np.ndarray):
-    energy0 = 0.5 * float(np.sum(inertia * omega0**2))
-    return np.abs(0.5 * np.sum(inertia * omega**2, axis=1) - energy0) / energy0
+    return relative_drift(energy(inertia, omega), float(energy(inertia, omega0)))
 
 
 # --------------------------------------------------------------------------------------------
