@@ -27,6 +27,8 @@ from scipy.spatial.transform import Rotation
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.fit.omega import free_omega
 
+#: Starting points keep each second moment at least this fraction of their sum (see angles).
+START_FLOOR = 1e-2
 #: The six orders of three axes (as index tuples).
 ASSIGNMENTS = ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0))
 
@@ -52,9 +54,11 @@ class Layout:
         return slice(start, start + 3) if self.bias else slice(0, 0)
 
     def pack(self, inertia, omega0, rotvec=None, bias=None) -> NDArray[np.float64]:
-        """The parameter vector of moments (3,), ω0 (3,) and, as the layout has them, a rotation
-        vector (3,) and a bias (3,) (``None``: zero)."""
-        parts = [angles(np.asarray(inertia, dtype=float)), np.asarray(omega0, dtype=float)]
+        """The starting parameter vector of moments (3,), ω0 (3,) and, as the layout has them,
+        a rotation vector (3,) and a bias (3,) (``None``: zero). The moments are kept off the
+        edge of the triangle inequality (see :func:`angles`)."""
+        start = angles(np.asarray(inertia, dtype=float), START_FLOOR)
+        parts = [start, np.asarray(omega0, dtype=float)]
         if self.rotation:
             parts.append(np.zeros(3) if rotvec is None else np.asarray(rotvec, dtype=float))
         if self.bias:
@@ -71,13 +75,16 @@ def moments(x: NDArray[np.float64]) -> NDArray[np.float64]:
     return inertia / np.max(inertia)
 
 
-def angles(inertia: NDArray[np.float64]) -> NDArray[np.float64]:
+def angles(inertia: NDArray[np.float64], floor: float = 0.0) -> NDArray[np.float64]:
     """(2,) the parameters ``x[0:2]`` of positive moments (3,), any scale.
 
-    Moments that break the triangle inequality (a noisy first estimate can) are moved onto the
-    nearest admissible ones by raising the negative second moments to zero.
+    Second moments below ``floor`` times their sum are raised to it: moments that break the
+    triangle inequality (a noisy first estimate can) move onto admissible ones. A start needs
+    ``floor > 0``: exactly on the edge (a second moment zero) the derivative with respect to
+    the angle that would bring it back vanishes, and the fit could never leave the edge.
     """
     s = np.maximum(0.5 * np.sum(inertia) - inertia, 0.0)  # sx = (Iy + Iz - Ix) / 2, ...
+    s = np.maximum(s / np.sum(s), floor)
     r = np.sqrt(s / np.sum(s))
     return np.array([np.arccos(np.clip(r[2], 0.0, 1.0)), np.arctan2(r[1], r[0])])
 
@@ -132,17 +139,6 @@ def body_omega(x: NDArray[np.float64], tau: NDArray[np.float64]) -> NDArray[np.f
     """(N, 3) the body's ω [rad/s], principal axes, at the times ``tau`` (N,) after the first
     (the fast evaluation of :func:`~poinsot.physics.fit.omega.free_omega`)."""
     return free_omega(moments(x), x[2:5], tau)
-
-
-def predict(x: NDArray[np.float64], layout: Layout, tau: NDArray[np.float64]) -> NDArray:
-    """(N, 3) the modelled sensor reading [rad/s] at the times ``tau`` (N,) after the first."""
-    w = body_omega(x, tau)
-    matrix = rotation_matrix(x, layout)
-    if matrix is not None:
-        w = w @ matrix  # row form of Rᵀ ω: the principal components back in sensor axes
-    if layout.bias:
-        w = w + x[layout.bias_slice]
-    return w
 
 
 def separatrix_distance(inertia: NDArray[np.float64], omega0: NDArray[np.float64]) -> float:

@@ -28,7 +28,9 @@ class AngularVelocityFit:
     Axes: the moments and ω0 are given in the principal axes, ordered as the sensor's axes
     (without a fitted rotation they *are* the sensor's axes; with one, principal axis k is the
     one nearest sensor axis k). Sigmas are 1-σ, from the fit's Jacobian ``J``: covariance
-    ``s² (JᵀJ)⁻¹``, ``s²`` the residual variance. No field is ever NaN.
+    ``s² (JᵀJ)⁻¹``, ``s²`` the residual variance. They are linearised: where one is large (more
+    than ~10 % of its moment, as for a spin close to one axis with a small wobble) the error is
+    not Gaussian and can exceed it. No field is ever NaN.
 
     Attributes:
         inertia: (3,) principal moments up to scale, the largest normalised to 1.

@@ -80,8 +80,8 @@ class Smoothed:
     """Local cubic least-squares fits around each sample (see :func:`smooth`).
 
     Attributes:
-        value: (N, 3) smoothed ω [rad/s] at the sample times.
-        derivative: (N, 3) dω/dt [rad/s²] at the sample times.
+        value: (N, K) smoothed samples (ω [rad/s]) at the sample times.
+        derivative: (N, K) their time derivative (dω/dt [rad/s²]).
         noise: estimated standard deviation of the noise of one component [rad/s].
     """
 
@@ -99,11 +99,11 @@ def smooth(t: NDArray[np.float64], y: NDArray[np.float64], half_width: int) -> S
     ``scipy.signal.savgol_filter(y, 2 half_width + 1, 3, mode="interp")`` (and ``deriv=1``); on
     a phone's jittered time stamps it stays exact, where resampling first would not. The noise
     is estimated from the residuals and the weight ``h`` of each sample in its own fit:
-    ``σ² = Σ r² / Σ (1 - h)`` per component.
+    ``σ² = Σ r² / Σ (1 - h)``, averaged over the components.
 
     Args:
-        t: (N,) strictly increasing times [s].
-        y: (N, 3) samples.
+        t: (N,) strictly increasing times [s], N >= 2.
+        y: (N, K) samples.
         half_width: samples on each side (the window is clipped to N).
     """
     n = t.shape[0]
@@ -111,7 +111,7 @@ def smooth(t: NDArray[np.float64], y: NDArray[np.float64], half_width: int) -> S
     first = np.clip(np.arange(n) - width // 2, 0, n - width)
     index = first[:, None] + np.arange(width)
     tau = t[index] - t[:, None]
-    scale = np.max(np.abs(tau), axis=1)
+    scale = np.maximum(np.max(np.abs(tau), axis=1), np.finfo(float).tiny)
     basis = (tau / scale[:, None])[..., None] ** np.arange(4)  # (N, width, 4)
     pinv = np.linalg.pinv(basis)  # (N, 4, width)
     coef = pinv @ y[index]  # (N, 4, 3)
@@ -119,7 +119,7 @@ def smooth(t: NDArray[np.float64], y: NDArray[np.float64], half_width: int) -> S
     value = coef[:, 0, :]
     residual = y - value
     dof = max(float(np.sum(1.0 - own)), 1.0)
-    noise = float(np.sqrt(np.sum(residual**2) / (3.0 * dof)))
+    noise = float(np.sqrt(np.sum(residual**2) / (y.shape[1] * dof)))
     return Smoothed(value, coef[:, 1, :] / scale[:, None], noise)
 
 

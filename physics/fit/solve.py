@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,7 +63,15 @@ class _Problem:
     columns reuse the last ω computed (cached by parameter vector).
     """
 
-    def __init__(self, t, omega, smoothed: Smoothed, layout: Layout, threshold: float, counts):
+    def __init__(
+        self,
+        t: NDArray[np.float64],
+        omega: NDArray[np.float64],
+        smoothed: Smoothed,
+        layout: Layout,
+        threshold: float,
+        counts: NDArray[np.int_],
+    ):
         self.t, self.omega, self.smoothed, self.layout = t, omega, smoothed, layout
         self.threshold = threshold  # of the sign changes [rad/s]
         self.counts = counts  # (3,) sign changes of the smoothed data
@@ -232,15 +241,15 @@ def _search(problem: _Problem, x0s: list[NDArray[np.float64]]) -> _Candidate:
     """Fit from every start on growing windows of the data, keep the promising, choose.
 
     Near the separatrix a small error in the parameters shifts the flips by a time that grows
-    like ``exp(σ t)``, ``σ <= |ω|`` [LL76 §37, Problem 1]: fitting the first ``3/|ω|`` seconds
-    first, then windows twice as long, brings each start close enough at every step for the
-    longer record to be fitted without crawling along a narrow valley. The rotation and the
-    bias are held at their starts on the shorter windows (on a short stretch they trade off
-    against the moments and ω0) and fitted on the whole record. After each window the
-    candidates whose cost exceeds :data:`_PROMISING` times the best's are dropped; the rest
-    are polished on the whole record. The smallest residual wins, unless its components
-    change sign where the data's do not (or the reverse) and a candidate that agrees with
-    the data has a comparable residual.
+    like ``exp(σ t)``, ``σ <= |ω|`` [LL76 §37; FM06 Theorem 7.3]: fitting the first
+    ``3/|ω|`` seconds first, then windows twice as long, brings each start close enough at
+    every step for the longer record to be fitted without crawling along a narrow valley. The
+    rotation and the bias are held at their starts on the shorter windows (on a short stretch
+    they trade off against the moments and ω0) and fitted on the whole record. After each
+    window the candidates whose cost exceeds :data:`_PROMISING` times the best's are dropped;
+    the rest are polished on the whole record. The smallest residual wins, unless its
+    components change sign where the data's do not (or the reverse) and a candidate that
+    agrees with the data has a comparable residual.
     """
     xs = x0s
     for count in _window_counts(problem):
@@ -322,27 +331,45 @@ def _solve_all(fun, jac, x0: NDArray[np.float64], max_nfev: int) -> tuple[NDArra
     return result.x, float(result.cost)
 
 
-def _result(problem: _Problem, best: _Candidate) -> AngularVelocityFit:
-    """The result at the chosen parameters, its axes labelled after the sensor's.
+@dataclass(frozen=True)
+class _Uncertainty:
+    """The covariance of ``y = (the two smaller moments, ω0, rotation, bias)`` at the fit.
 
-    The covariance is computed for ``y = (the two smaller moments, ω0, rotation, bias)``;
-    the flip period and the distance to the separatrix are propagated from it.
+    Reported for the moments themselves rather than the angles the search moves: at the edge
+    of the triangle inequality d(moments)/d(angles) vanishes and a covariance of the angles
+    would make a flat body's moments look exact.
     """
-    layout = problem.layout
-    x = model.relabelled(best.x, layout)
+
+    inertia: NDArray[np.float64]  # (3,) the fitted moments, largest 1
+    free: list[int]  # the axes of the two smaller moments
+    y: NDArray[np.float64]
+    cov: NDArray[np.float64]
+
+    def moments(self, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        out = self.inertia.copy()
+        out[self.free] = y[:2]
+        return out
+
+    def sigma_of(self, f: Callable[[NDArray[np.float64], NDArray[np.float64]], float]) -> float:
+        """1-σ of ``f(moments (3,), ω0 (3,))`` by propagation."""
+        return float(propagate(lambda y: f(self.moments(y), y[2:5]), self.y, self.cov)[0])
+
+
+def _uncertainty(problem: _Problem, x: NDArray[np.float64]) -> _Uncertainty:
     inertia = model.moments(x)
     free = [k for k in range(3) if k != int(np.argmax(inertia))]
     cov = covariance(problem.moment_jacobian(x, free), problem.residuals(x))
-    sigma = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    return _Uncertainty(inertia, free, np.concatenate([inertia[free], x[2:]]), cov)
+
+
+def _result(problem: _Problem, best: _Candidate) -> AngularVelocityFit:
+    """The result at the chosen parameters, its axes labelled after the sensor's."""
+    layout = problem.layout
+    x = model.relabelled(best.x, layout)
+    unc = _uncertainty(problem, x)
+    sigma = np.sqrt(np.maximum(np.diag(unc.cov), 0.0))
     inertia_sigma = np.zeros(3)
-    inertia_sigma[free] = sigma[:2]
-    y = np.concatenate([inertia[free], x[2:]])
-
-    def moments_of(y: NDArray[np.float64]) -> NDArray[np.float64]:
-        out = inertia.copy()
-        out[free] = y[:2]
-        return out
-
+    inertia_sigma[unc.free] = sigma[:2]
     fitted = model.body(x)
     matrix = model.rotation_matrix(x, layout)
     bias = x[layout.bias_slice].copy() if layout.bias else None
@@ -350,9 +377,9 @@ def _result(problem: _Problem, best: _Candidate) -> AngularVelocityFit:
     rms = float(np.sqrt(np.mean(residual**2)))
     scale = float(np.sqrt(np.mean(np.sum(problem.omega**2, axis=1))))
     explained, message = quality_message(rms, scale, problem.smoothed.noise, best.consistent)
-    intermediate = int(np.argsort(inertia)[1])
+    intermediate = int(np.argsort(unc.inertia)[1])
     return AngularVelocityFit(
-        inertia=inertia,
+        inertia=unc.inertia,
         inertia_sigma=inertia_sigma,
         omega0=x[2:5].copy(),
         omega0_sigma=sigma[2:5],
@@ -369,14 +396,10 @@ def _result(problem: _Problem, best: _Candidate) -> AngularVelocityFit:
         intermediate_axis=intermediate,
         period=float(fitted.period),
         flip_period=flip_period(fitted),
-        flip_period_sigma=float(
-            propagate(lambda y: flip_period(FreeRigidBody(moments_of(y), y[2:5])), y, cov)[0]
-        ),
+        flip_period_sigma=unc.sigma_of(lambda i, w: flip_period(FreeRigidBody(i, w))),
         measured_flip_period=_measured_flip(problem, x, intermediate),
-        separatrix_distance=model.separatrix_distance(inertia, x[2:5]),
-        separatrix_sigma=float(
-            propagate(lambda y: model.separatrix_distance(moments_of(y), y[2:5]), y, cov)[0]
-        ),
+        separatrix_distance=model.separatrix_distance(unc.inertia, x[2:5]),
+        separatrix_sigma=unc.sigma_of(model.separatrix_distance),
         family_confirmed=best.consistent,
         explained=explained,
         message=message,

@@ -65,22 +65,21 @@ def euler_estimate(
 
 @dataclass(frozen=True)
 class Start:
-    """One starting point: moments (3,) in the principal axes' order, and what it assumes.
-
-    ``intermediate`` is the axis given the intermediate moment; ``steady`` the axis whose
-    component keeps its sign in this family (``dn`` in [LL76 §37, Eq. 37.10]): the largest
-    moment's axis in the major-axis family, the smallest's in the minor-axis family.
+    """One starting point: moments (3,) in the principal axes' order, and ``steady``, the axis
+    whose component keeps its sign in the family this start lies in (``dn`` in [LL76 §37, Eq.
+    37.10]): the largest moment's axis in the major-axis family, the smallest's in the
+    minor-axis family.
     """
 
     inertia: NDArray[np.float64]
-    intermediate: int
     steady: int
 
 
 def family_starts(inertia: NDArray[np.float64], omega0: NDArray[np.float64]) -> list[Start]:
     """Up to 12 starts: every assignment of the sorted moments to the axes, in both families.
 
-    The first is the estimate itself, the second the same axes in the other family. For the
+    The first is the estimate itself (kept 5 % of ``v3 - v1`` from the separatrix), the second
+    the same axes in the other family. For the
     axes ``(a1, a2, a3)`` of the smallest, intermediate and largest moment ``(v1, v2, v3)``, the
     separatrix value of ``I2`` for this ω0 is ``I2* = (v1² ω1² + v3² ω3²) / (v1 ω1² + v3 ω3²)``
     (``Δ2 = G² - 2T I2 = 0``, [LL76 §37]); ``I2 < I2*`` is the major-axis family. Each start
@@ -109,5 +108,5 @@ def family_starts(inertia: NDArray[np.float64], omega0: NDArray[np.float64]) -> 
                 continue
             moments = np.empty(3)
             moments[[a1, a2, a3]] = v1, float(np.clip(i2, lo, hi)), v3
-            starts.append(Start(moments, a2, a3 if side > 0 else a1))
+            starts.append(Start(moments, a3 if side > 0 else a1))
     return starts
