@@ -102,7 +102,10 @@ def read_recording(path: str | Path, *, degrees: bool = False) -> Recording:
         data_name, text, meta = _from_folder(path)
     elif zipfile.is_zipfile(path):
         _check_size(path.stat().st_size, str(path))
-        data_name, text, meta = _from_zip(path)
+        try:
+            data_name, text, meta = _from_zip(path)
+        except (zipfile.BadZipFile, zipfile.LargeZipFile, NotImplementedError) as exc:
+            raise ValueError(f"{path}: a damaged or unsupported zip archive ({exc})") from None
     else:
         _check_size(path.stat().st_size, str(path))
         data_name, text, meta = str(path), _decode(path.read_bytes(), str(path)), None
@@ -153,7 +156,10 @@ def _from_folder(folder: Path) -> tuple[str, str, str | None]:
             headers[n] = _first_line(handle.read(4096))
     chosen = _pick(names, headers, str(folder))
     meta_path = folder / "meta" / "time.csv"
-    meta = _decode(meta_path.read_bytes(), str(meta_path)) if meta_path.is_file() else None
+    meta = None
+    if meta_path.is_file():
+        _check_size(meta_path.stat().st_size, str(meta_path))
+        meta = _decode(meta_path.read_bytes(), str(meta_path))
     return chosen, _decode(Path(chosen).read_bytes(), chosen), meta
 
 
@@ -163,7 +169,10 @@ def _from_zip(path: Path) -> tuple[str, str, str | None]:
         names = sorted(n for n in infos if _is_data_csv(n))
         for n in names:  # the uncompressed size: a small zip can hold a huge file
             _check_size(infos[n].file_size, f"{path}:{n}")
-        headers = {n: _first_line(archive.open(n).read(4096)) for n in names}
+        headers = {}
+        for n in names:
+            with archive.open(n) as handle:
+                headers[n] = _first_line(handle.read(4096))
         chosen = _pick(names, headers, str(path))
         prefix = chosen.rsplit("/", 1)[0] + "/" if "/" in chosen else ""
         meta_name = prefix + "meta/time.csv"
@@ -210,7 +219,7 @@ def parse_table(text: str, name: str, *, degrees: bool = False) -> tuple[NDArray
         raise ValueError(f"{name} is empty")
     sep = _separator(lines[0][1])
     header = _fields(lines[0][1], sep)
-    has_header = _floats(header, sep != ",") is None
+    has_header = _floats([f for f in header if f], sep != ",") is None
     data = lines[1:] if has_header else lines
     if not data:
         raise ValueError(f"{name} has a header but no data")
