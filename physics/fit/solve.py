@@ -351,8 +351,10 @@ class _Uncertainty:
         return out
 
     def sigma_of(self, f: Callable[[NDArray[np.float64], NDArray[np.float64]], float]) -> float:
-        """1-σ of ``f(moments (3,), ω0 (3,))`` by propagation."""
-        return float(propagate(lambda y: f(self.moments(y), y[2:5]), self.y, self.cov)[0])
+        """1-σ of ``f(moments (3,), ω0 (3,))`` by propagation (through ``y[:5]`` only: the
+        rotation and the bias do not enter)."""
+        body = self.y[:5]
+        return float(propagate(lambda y: f(self.moments(y), y[2:5]), body, self.cov[:5, :5])[0])
 
 
 def _uncertainty(problem: _Problem, x: NDArray[np.float64]) -> _Uncertainty:

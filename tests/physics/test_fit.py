@@ -40,6 +40,7 @@ TOSSES = [
     ("flip, major side of the separatrix", (3.06, 10.0, 2.0), 1.0, Regime.MAJOR_AXIS),
     ("flip, minor side of the separatrix", (3.14, 10.0, 2.0), 1.0, Regime.MINOR_AXIS),
     ("flip, 2.5 s record", (3.06, 10.0, 2.0), 2.5, Regime.MAJOR_AXIS),
+    ("T-handle flipping every 0.6 s, 2 s record", (2.0, 10.0, 5.0), 2.0, Regime.MAJOR_AXIS),
 ]
 
 
@@ -77,6 +78,17 @@ def test_recovers_moments_and_family(name, omega0, duration, regime, seed):
     assert abs(fit.flip_period - body.period / 2) < 4.0 * fit.flip_period_sigma + 1e-9
     if fit.measured_flip_period is not None:
         assert fit.measured_flip_period == pytest.approx(fit.flip_period, rel=0.03)
+
+
+def test_measured_flip_period_matches_the_prediction():
+    """The T-handle flips three times in 2 s: the spacing of the sign changes of the
+    intermediate component is the predicted 2K/λ [ACC91]."""
+    t, w = synthetic_toss(I_TRUE, (2.0, 10.0, 5.0), duration=2.0, bias=BIAS, seed=11)
+    fit = fit_angular_velocity(t, w, fit_bias=True)
+    assert fit.intermediate_axis == 1
+    truth = FreeRigidBody(I_TRUE, (2.0, 10.0, 5.0)).period / 2
+    assert fit.flip_period == pytest.approx(truth, abs=4 * fit.flip_period_sigma)
+    assert fit.measured_flip_period == pytest.approx(truth, rel=0.01)
 
 
 @pytest.mark.parametrize("order", [(2, 0, 1), (1, 2, 0), (0, 2, 1)])
