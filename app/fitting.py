@@ -78,13 +78,27 @@ def run_fit(
         return 1
     results = fit_segments(segments, fit_rotation=fit_rotation, fit_bias=fit_bias)
     print(format_table(results, recording.source), file=out)
-    status = 0 if any(r.fit is not None for r in results) else 1
+    written = _write_files(recording, results, json_out, plot_out, err)
+    return 0 if written and any(r.fit is not None for r in results) else 1
+
+
+def _write_files(
+    recording: Recording,
+    results: list[SegmentFit],
+    json_out: str | Path | None,
+    plot_out: str | Path | None,
+    err: TextIO,
+) -> bool:
+    """Write the JSON and the plot asked for; False (after saying why on ``err``) if one
+    could not be written."""
+    ok = True
     if json_out is not None:
         try:
-            Path(json_out).write_text(json.dumps(to_json(results, recording.source), indent=2))
+            text = json.dumps(to_json(results, recording.source), indent=2, allow_nan=False)
+            Path(json_out).write_text(text)
         except OSError as exc:
             print(f"poinsot fit: cannot write {json_out}: {exc}", file=err)
-            status = 1
+            ok = False
     if plot_out is not None:
         try:
             plot_fits(recording, results, plot_out)
@@ -94,11 +108,11 @@ def run_fit(
                 "(pip install 'poinsot[report]'); the table above was printed without the plot",
                 file=err,
             )
-            status = 1
+            ok = False
         except OSError as exc:
             print(f"poinsot fit: cannot write {plot_out}: {exc}", file=err)
-            status = 1
-    return status
+            ok = False
+    return ok
 
 
 def fit_segments(
