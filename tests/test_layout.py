@@ -82,3 +82,70 @@ def test_every_package_folder_ships():
             rel = init.parent.relative_to(ROOT).parts
             found.add(".".join(("poinsot",) + rel))
     assert listed == found
+
+
+#: A module holds one concern: about 500 lines at most.
+MAX_MODULE_LINES = 500
+#: A function does one step: about 60 lines at most, unless the line before it says why
+#: (a comment starting with "# long:").
+MAX_FUNCTION_LINES = 60
+
+
+def _code_files() -> list[pathlib.Path]:
+    return sorted(p for top in ("physics", "app") for p in (ROOT / top).rglob("*.py"))
+
+
+def test_modules_are_small_rooms():
+    big = {}
+    for f in _code_files():
+        n = len(f.read_text().splitlines())
+        if n > MAX_MODULE_LINES:
+            big[str(f.relative_to(ROOT))] = n
+    assert not big, f"modules over {MAX_MODULE_LINES} lines: {big}"
+
+
+def test_functions_do_one_step():
+    long = {}
+    for f in _code_files():
+        lines = f.read_text().splitlines()
+        for node in ast.walk(ast.parse("\n".join(lines))):
+            if not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                continue
+            assert node.end_lineno is not None
+            first = min([node.lineno] + [d.lineno for d in node.decorator_list])
+            length = node.end_lineno - node.lineno + 1
+            said_why = first >= 2 and lines[first - 2].strip().startswith("# long:")
+            if length > MAX_FUNCTION_LINES and not said_why:
+                long[f"{f.relative_to(ROOT)}:{node.lineno} {node.name}"] = length
+    assert not long, f"functions over {MAX_FUNCTION_LINES} lines: {long}"
+
+
+def test_comments_cite_only_what_the_repo_holds():
+    """Sources are cited by the keys of docs/REFERENCES.md, never by private notes, seed
+    files or issue numbers that a reader of the repository cannot open."""
+    import re
+
+    pattern = re.compile(r"\bseed \d|\bissue \d|shared/|PHYSICS\.md", re.IGNORECASE)
+    hits = []
+    for f in _code_files() + sorted((ROOT / "tests").rglob("*.py")):
+        if f == pathlib.Path(__file__).resolve():
+            continue
+        for k, line in enumerate(f.read_text().splitlines(), 1):
+            if pattern.search(line):
+                hits.append(f"{f.relative_to(ROOT)}:{k}: {line.strip()}")
+    assert not hits, "\n".join(hits)
+
+
+def test_cited_keys_are_in_the_reference_list():
+    import re
+
+    listed = set(
+        re.findall(
+            r"^\| \*\*([A-Za-z0-9]+)\*\* \|", (ROOT / "docs" / "REFERENCES.md").read_text(), re.M
+        )
+    )
+    assert {"LL76", "FM06", "Pars65", "DLMF"} <= listed
+    cited = set()
+    for f in _code_files():
+        cited.update(re.findall(r"\[([A-Z][A-Za-z]*\d\d)[\] ,§]", f.read_text()))
+    assert cited - listed == set(), f"cited but not in docs/REFERENCES.md: {sorted(cited - listed)}"
