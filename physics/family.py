@@ -27,10 +27,7 @@ Landau's view [LL76 §37] is the same picture in momentum space: ``m = I ω`` li
 ``|m| = G`` and on the ellipsoid ``Σ mᵢ²/Iᵢ = 2T`` (semi-axes ``sqrt(2T Iᵢ)``); their
 intersection is the polhode mapped by ``I``.
 
-:class:`PolhodeArc` reads, for any :class:`FreeRigidBody`, how far the tip of ω (the contact
-point, seen in the body) has travelled along its polhode: the readout behind the long-cylinder
-remark [FM06 Remark 7.5], where the contact point circles the herpolhode many times while it
-creeps along the polhode.
+:class:`PolhodeArc`: how far the contact point has crept along its polhode [FM06 Remark 7.5].
 """
 
 from __future__ import annotations
@@ -56,10 +53,9 @@ __all__ = [
     "polhode_progress",
 ]
 
-#: Fourier samples of |dω/dt| per circuit: start, and the most before giving up.
-_ARC_SAMPLES_MIN = 64
 _EPS = float(np.finfo(float).eps)
-_ARC_SAMPLES_MAX = 1 << 21
+#: Fourier samples of |dω/dt| per circuit: start, and the most before giving up.
+_ARC_SAMPLES_MIN, _ARC_SAMPLES_MAX = 64, 1 << 21
 #: The series of |dω/dt| is converged when its coefficients in the upper quarter of the
 #: spectrum fall below this fraction of the mean, or below the rounding noise of the samples,
 #: _ARC_NOISE_EPS · eps · max|dω/dt| (a bursty speed, next to the separatrix, has a mean far
