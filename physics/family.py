@@ -52,7 +52,6 @@ __all__ = [
     "polhode_points",
     "polhode_progress",
 ]
-
 _EPS = float(np.finfo(float).eps)
 #: Fourier samples of |dω/dt| per circuit: start, and the most before giving up.
 _ARC_SAMPLES_MIN, _ARC_SAMPLES_MAX = 64, 1 << 21
