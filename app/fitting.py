@@ -178,9 +178,11 @@ def format_table(results: list[SegmentFit], source: str) -> str:
     lines = [
         f"{source}: {len(results)} toss{'es' if len(results) != 1 else ''}; moments up to scale "
         "(largest = 1) in the sensor's axes, ± 1σ",
-        "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)),
+        "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)).rstrip(),
     ]
-    lines += ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)) for row in rows]
+    lines += [
+        "  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows
+    ]
     return "\n".join([*lines, *notes])
 
 
