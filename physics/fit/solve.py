@@ -203,8 +203,10 @@ def fit_angular_velocity(
     )
     rotvec0 = Rotation.from_matrix(matrix0).as_rotvec() if fit_rotation else None
     omega0 = matrix0 @ problem.smoothed.value[0]
-    starts = family_starts(inertia0, omega0)
-    x0s = [problem.layout.pack(s.inertia, omega0, rotvec0) for s in _plausible(starts, problem)]
+    # The data's sign changes in the estimated principal axes (the sensor's without a rotation).
+    counts = sign_change_counts(problem.t, problem.smoothed.value @ matrix0.T, problem.threshold)
+    starts = _plausible(family_starts(inertia0, omega0), counts)
+    x0s = [problem.layout.pack(s.inertia, omega0, rotvec0) for s in starts]
     best = _search(problem, x0s)
     return _result(problem, best)
 
@@ -225,15 +227,16 @@ def _problem(t, omega, fit_rotation: bool, fit_bias: bool) -> _Problem:
     return _Problem(t_arr, w_arr, smoothed, Layout(fit_rotation, fit_bias), threshold, counts)
 
 
-def _plausible(starts: list[Start], problem: _Problem) -> list[Start]:
-    """The starts whose family lets the data's sign changes happen.
+def _plausible(starts: list[Start], counts: NDArray[np.int_]) -> list[Start]:
+    """The starts whose family lets the data's sign changes (``counts`` (3,), principal axes)
+    happen.
 
     In each family one component never changes sign (``dn``, [LL76 §37, Eq. 37.10]): a start
     that gives that role to a component the data see changing sign cannot be right. Of the 12
     starts this keeps 4 once the data show two components changing sign (both families, either
     of the two as the intermediate axis); all of them if the data show none.
     """
-    kept = [s for s in starts if problem.counts[s.steady] == 0]
+    kept = [s for s in starts if counts[s.steady] == 0]
     return kept or starts
 
 
