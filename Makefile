@@ -7,7 +7,7 @@ PORT   ?= 8080
 CHROMIUM ?= /usr/bin/chromium
 SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: run test install install-test chromium bench lint clean
+.PHONY: run test install install-test chromium bench load lint clean
 
 $(VENV)/bin/activate:
 	$(PYTHON) -m venv $(VENV)
@@ -43,6 +43,11 @@ test: install-test chromium
 
 bench: install
 	$(PY) -m poinsot.physics.benchmark
+
+# Load test of the live server on loopback (about 8 minutes; exits 1 when a goal is missed).
+# Options go in ARGS, e.g. make load ARGS="--phase soak storm --clients 10 --seconds 60".
+load: install
+	$(PY) -m poinsot.app.load $(ARGS)
 
 # mypy checks the folders under their installed names: poinsot.physics, poinsot.app.
 TYPECHECK := $(VENV)/typecheck

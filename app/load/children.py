@@ -1,0 +1,77 @@
+"""Child processes of the tool and the pipe each one talks over.
+
+Every child is started with the ``spawn`` method (a fresh interpreter: no threads or sockets
+inherited from the tool) and gets a pipe. It answers each request with one message; a failure
+comes back as ``("error", text)``. Every wait on a child has a timeout, and a child that does
+not stop when asked is terminated.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+from collections.abc import Callable
+from multiprocessing.connection import Connection
+from typing import Any
+
+
+def receive(conn: Connection, timeout: float, what: str) -> Any:
+    """The next message from a child, or an error naming what was awaited. A ``(kind,
+    payload)`` pair gives its payload; ``("error", text)`` raises."""
+    if not conn.poll(timeout):
+        raise TimeoutError(f"timed out after {timeout:.0f} s waiting for {what}")
+    try:
+        message = conn.recv()
+    except EOFError as exc:
+        raise RuntimeError(f"a child process ended while the tool waited for {what}") from exc
+    if isinstance(message, tuple) and len(message) == 2 and isinstance(message[0], str):
+        kind, payload = message
+        if kind == "error":
+            raise RuntimeError(f"{what}: {payload}")
+        return payload
+    return message
+
+
+class Child:
+    """A spawned process running ``target(conn, *args)``; a context manager that reaps it."""
+
+    def __init__(self, name: str, target: Callable[..., None], *args: Any) -> None:
+        ctx = mp.get_context("spawn")
+        self.conn, child_end = ctx.Pipe()
+        self.name = name
+        self._process = ctx.Process(target=target, args=(child_end, *args), name=name)
+        self._process.start()
+        child_end.close()
+        assert self._process.pid is not None
+        self.pid: int = self._process.pid
+
+    def __enter__(self) -> Child:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.finish()
+
+    @property
+    def alive(self) -> bool:
+        return self._process.is_alive()
+
+    def receive(self, timeout: float, what: str) -> Any:
+        return receive(self.conn, timeout, f"{what} ({self.name})")
+
+    def request(self, message: Any, timeout: float, what: str) -> Any:
+        self.conn.send(message)
+        return self.receive(timeout, what)
+
+    def finish(self, stop_message: Any = "stop", timeout: float = 30.0) -> None:
+        """Ask the child to stop (if alive), wait for it, terminate it if it does not end."""
+        if self._process.is_alive():
+            try:
+                self.conn.send(stop_message)
+                if self.conn.poll(timeout):
+                    self.conn.recv()
+            except (OSError, EOFError):
+                pass
+        self._process.join(timeout)
+        if self._process.is_alive():
+            self._process.terminate()
+            self._process.join(10.0)
+        self.conn.close()

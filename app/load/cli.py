@@ -1,0 +1,100 @@
+"""``python -m poinsot.app.load`` (``make load``): the command line of the load test."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+import sys
+import time
+from collections.abc import Sequence
+
+from poinsot.app.load.figures import Bounds, exit_status, format_table, missed
+from poinsot.app.load.phases import PHASES, Config, Report, run_phase
+
+
+def build_parser() -> argparse.ArgumentParser:
+    cfg, bounds = Config(), Bounds()
+    parser = argparse.ArgumentParser(
+        prog="python -m poinsot.app.load",
+        description="Load test of the live server on this machine's loopback: a soak, a storm "
+        "of connections, a stalled client, a flooding client. Prints a table of figures and "
+        "goals; exits 1 when a goal is missed.",
+    )
+    add = parser.add_argument
+    add("--phase", nargs="+", choices=PHASES, default=list(PHASES), help="phases to run, in order")
+    add("--clients", type=int, default=cfg.clients, help="clients in the soak, stall and flood")
+    add("--seconds", type=float, default=cfg.seconds, help="length of the soak [s]")
+    add("--slider-period", type=float, default=cfg.slider_period, help="a slider move every [s]")
+    add("--storm", type=int, default=cfg.storm, help="connects and departures in the storm")
+    add("--storm-workers", type=int, default=cfg.storm_workers, help="visits at a time")
+    add("--storm-steady", type=int, default=cfg.storm_steady, help="clients kept through it")
+    add("--settle-seconds", type=float, default=cfg.settle_seconds, help="after the storm [s]")
+    add("--stall-seconds", type=float, default=cfg.stall_seconds, help="one client stalls [s]")
+    add("--flood-seconds", type=float, default=cfg.flood_seconds, help="one client floods [s]")
+    add("--flood-rate", type=float, default=cfg.flood_rate, help="messages a second")
+    goals = parser.add_argument_group("goals")
+    goals.add_argument("--min-fps", type=float, default=bounds.min_fps)
+    goals.add_argument("--max-redraw-ms", type=float, default=bounds.max_redraw_ms)
+    goals.add_argument("--max-rss-growth", type=float, default=bounds.max_rss_growth)
+    goals.add_argument("--storm-tolerance", type=float, default=bounds.storm_tolerance)
+    goals.add_argument("--min-keep", type=float, default=bounds.min_keep)
+    goals.add_argument("--max-errors", type=int, default=bounds.max_errors)
+    return parser
+
+
+def _options(args: argparse.Namespace) -> tuple[list[str], Config, Bounds]:
+    fields = vars(args)
+    bounds = Bounds(**{f.name: fields[f.name] for f in dataclasses.fields(Bounds)})
+    names = {f.name for f in dataclasses.fields(Config)} - {"settle_tolerance"}
+    cfg = Config(**{name: fields[name] for name in names}, settle_tolerance=bounds.storm_tolerance)
+    return list(args.phase), cfg, bounds
+
+
+def _check(parser: argparse.ArgumentParser, phases: list[str], cfg: Config) -> None:
+    if cfg.clients < 1 or cfg.seconds <= 0 or cfg.storm < 1 or cfg.storm_workers < 1:
+        parser.error("--clients, --seconds, --storm and --storm-workers must be positive")
+    if {"stall", "flood"} & set(phases) and cfg.clients < 2:
+        parser.error("stall and flood need --clients >= 2 (one stalls, the others are measured)")
+    if min(cfg.stall_seconds, cfg.flood_seconds, cfg.flood_rate, cfg.settle_seconds) <= 0:
+        parser.error("the stall, flood and settle options must be positive")
+
+
+def _load_average() -> str:
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def run(phases: Sequence[str], cfg: Config, verbose: bool = True) -> Report:
+    """Run the phases in order; their figures and notes."""
+    report = Report()
+
+    def say(message: str) -> None:
+        if verbose:
+            print(f"[{time.strftime('%H:%M:%S')}] {message}", file=sys.stderr, flush=True)
+
+    for name in phases:
+        run_phase(name, cfg, report, say)
+    return report
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    phases, cfg, bounds = _options(parser.parse_args(argv))
+    _check(parser, phases, cfg)
+    print(
+        f"Poinsot load test: {' '.join(phases)}; {cfg.clients} clients, soak {cfg.seconds:g} s, "
+        f"storm {cfg.storm}; python {sys.version.split()[0]}, {os.cpu_count()} CPUs, "
+        f"load average {_load_average()} (1, 5, 15 min)",
+        flush=True,
+    )
+    started = time.monotonic()
+    report = run(phases, cfg)
+    print(format_table(report.figures, bounds))
+    for note in report.notes:
+        print(note)
+    status = exit_status(report.figures, bounds)
+    print(
+        f"{len(missed(report.figures, bounds))} goals missed; "
+        f"{time.monotonic() - started:.0f} s; load average now {_load_average()}"
+    )
+    return status

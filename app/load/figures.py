@@ -1,0 +1,114 @@
+"""Figures, the goals some of them are held to, and the printed table.
+
+A phase returns :class:`Figure` s: a number (what a goal compares), the text shown, and
+optionally a :class:`Goal` naming one of the :class:`Bounds`. Whether a goal is met is decided
+here, from the figures and the bounds alone, so the same measurements can be judged against
+other bounds (the tests do).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+
+@dataclasses.dataclass(frozen=True)
+class Bounds:
+    """The goals' numbers (each has a command-line option)."""
+
+    min_fps: float = 30.0  # frames per second, for each client during the soak
+    max_redraw_ms: float = 50.0  # slider-to-redraw p95
+    max_rss_growth: float = 0.10  # over the soak, as a fraction of the early RSS
+    storm_tolerance: float = 0.10  # threads, RSS and sessions after the storm vs before
+    min_keep: float = 0.80  # of their frame rate, for the others while one stalls or floods
+    max_errors: int = 0  # server log error lines, silent clients, lost sessions in the soak
+
+
+@dataclasses.dataclass(frozen=True)
+class Goal:
+    """``value <= bound`` (``at_most``) or ``value >= bound``, with ``bound`` a field of
+    :class:`Bounds` (None: the figure is a yes/no, met when its value is 1). ``template``
+    shows the goal, formatted with the bound times ``scale``."""
+
+    bound: str | None
+    at_most: bool
+    template: str
+    scale: float = 1.0
+
+    def describe(self, bounds: Bounds) -> str:
+        if self.bound is None:
+            return self.template
+        return self.template.format(getattr(bounds, self.bound) * self.scale)
+
+    def met(self, value: float, bounds: Bounds) -> bool:
+        if math.isnan(value):
+            return False  # not measured: not shown to be met
+        if self.bound is None:
+            return value >= 1.0
+        bound = float(getattr(bounds, self.bound))
+        return value <= bound if self.at_most else value >= bound
+
+
+def at_least(bound: str, template: str, scale: float = 1.0) -> Goal:
+    return Goal(bound, False, template, scale)
+
+
+def at_most(bound: str, template: str, scale: float = 1.0) -> Goal:
+    return Goal(bound, True, template, scale)
+
+
+#: The goal of a phase's "completed" figure: a phase that could not run misses it.
+COMPLETES = Goal(None, False, "completes")
+
+
+@dataclasses.dataclass(frozen=True)
+class Figure:
+    phase: str
+    name: str
+    value: float
+    text: str
+    goal: Goal | None = None
+
+    def verdict(self, bounds: Bounds) -> str:
+        """ "met", "MISSED", or "" for a figure without a goal."""
+        if self.goal is None:
+            return ""
+        return "met" if self.goal.met(self.value, bounds) else "MISSED"
+
+
+def info(phase: str, name: str, text: str, value: float = math.nan) -> Figure:
+    return Figure(phase, name, value, text)
+
+
+def missed(figures: list[Figure], bounds: Bounds) -> list[Figure]:
+    return [f for f in figures if f.verdict(bounds) == "MISSED"]
+
+
+def exit_status(figures: list[Figure], bounds: Bounds) -> int:
+    """0 when every goal is met (and there was something to judge), else 1."""
+    judged = [f for f in figures if f.goal is not None]
+    return 0 if judged and not missed(figures, bounds) else 1
+
+
+def format_table(figures: list[Figure], bounds: Bounds) -> str:
+    rows = [("phase", "figure", "value", "goal", "")]
+    for f in figures:
+        goal = f.goal.describe(bounds) if f.goal is not None else ""
+        rows.append((f.phase, f.name, f.text, goal, f.verdict(bounds)))
+    widths = [max(len(r[i]) for r in rows) for i in range(4)]
+    lines = []
+    for k, row in enumerate(rows):
+        cells = [row[i].ljust(widths[i]) for i in range(4)]
+        lines.append("  ".join([*cells, row[4]]).rstrip())
+        if k == 0:
+            lines.append("  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def percentile(values: list[float], q: float) -> float:
+    """The ``q``-quantile (0..1) by nearest rank; NaN for no values."""
+    ordered = sorted(values)
+    if not ordered:
+        return math.nan
+    k = min(len(ordered) - 1, max(0, math.ceil(q * len(ordered)) - 1))
+    return ordered[k]

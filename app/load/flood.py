@@ -1,0 +1,105 @@
+"""One client that floods the server with messages, from a child process of its own.
+
+A :class:`~poinsot.app.load.raw.RawClient` opens a websocket, sends its camera (it becomes a
+client with a session of its own, and keeps reading what it is sent), and on ``go`` writes
+viewer-camera messages, what a browser sends while the user orbits, at ``rate`` messages a
+second for ``seconds``: bursts of pre-built frames every 10 ms, so the flooder's own cost stays
+small next to the server's. If the server stops reading, a burst is abandoned at its deadline
+and the flood ends there (what was written is counted).
+"""
+
+from __future__ import annotations
+
+import time
+from multiprocessing.connection import Connection
+from typing import Any
+
+from poinsot.app.load.children import Child
+from poinsot.app.load.raw import RawClient, camera_message, client_frame
+
+TICK = 0.01  # seconds between bursts
+VARIANTS = 50  # distinct camera messages cycled through
+
+
+def _flood(client: RawClient, rate: float, seconds: float) -> dict[str, Any]:
+    per_tick = max(1, round(rate * TICK))
+    frames = [client_frame(camera_message(i)) for i in range(VARIANTS)]
+    burst = b"".join(frames[i % VARIANTS] for i in range(per_tick))
+    start = time.monotonic()
+    end = start + seconds
+    sent = ticks = 0
+    cut = False
+    while (now := time.monotonic()) < end:
+        due = start + ticks * TICK
+        if now < due:
+            time.sleep(due - now)
+            continue
+        ticks += 1
+        written = client.send(burst, min(end, now + 1.0))
+        if written < len(burst):
+            cut = True
+            break
+        sent += per_tick
+    elapsed = time.monotonic() - start
+    return {
+        "sent": sent,
+        "seconds": elapsed,
+        "rate": sent / elapsed if elapsed > 0 else 0.0,
+        "cut": cut,
+        "closed_by_server": client.closed_by_server,
+    }
+
+
+def _main(conn: Connection, port: int, rate: float, seconds: float, lifetime: float) -> None:
+    deadline = time.monotonic() + lifetime
+    client: RawClient | None = None
+    try:
+        client = RawClient(port)
+        client.open()
+        client.send(client_frame(camera_message()), time.monotonic() + 10.0)
+        # Ready once its session draws: messages keep coming after the initial scene.
+        wait_until = time.monotonic() + 60.0
+        while client.messages_received < 100 and time.monotonic() < wait_until:
+            time.sleep(0.05)
+        if client.messages_received < 100:
+            raise TimeoutError("the flooding client's session never started drawing")
+        conn.send(("ready", client.messages_received))
+        while time.monotonic() < deadline:
+            if not conn.poll(0.5):
+                continue
+            request = conn.recv()
+            if request == "go":
+                conn.send(("flood", _flood(client, rate, seconds)))
+            elif request == "stop":
+                break
+    except EOFError:
+        return
+    except Exception as exc:
+        conn.send(("error", f"{type(exc).__name__}: {exc}"))
+        return
+    finally:
+        if client is not None:
+            client.drop()
+    try:
+        conn.send(("stopped", None))
+    except OSError:
+        pass
+
+
+class Flooder(Child):
+    def __init__(self, port: int, rate: float, seconds: float, lifetime: float):
+        super().__init__("flooder", _main, port, rate, seconds, lifetime)
+        self.seconds = seconds
+        self.receive(90.0, "the flooding client to connect")
+
+    def __enter__(self) -> Flooder:
+        return self
+
+    def begin(self) -> None:
+        self.conn.send("go")
+
+    def end(self) -> dict[str, Any]:
+        """What was sent: ``sent``, ``seconds``, ``rate``, ``cut`` (the server stopped
+        reading), ``closed_by_server``."""
+        result: dict[str, Any] = self.receive(self.seconds + 30.0, "the flood")
+        return result
