@@ -16,8 +16,9 @@ Every loop is bounded in count and in time, and every child process stops by its
 """
 
 from poinsot.app.load.cli import main, run
+from poinsot.app.load.config import Config, Report
 from poinsot.app.load.figures import Bounds, Figure, exit_status, format_table
-from poinsot.app.load.phases import PHASES, Config, Report
+from poinsot.app.load.phases import PHASES
 
 __all__ = [
     "PHASES",

@@ -9,8 +9,9 @@ import sys
 import time
 from collections.abc import Sequence
 
+from poinsot.app.load.config import Config, Report
 from poinsot.app.load.figures import Bounds, exit_status, format_table, missed
-from poinsot.app.load.phases import PHASES, Config, Report, run_phase
+from poinsot.app.load.phases import PHASES, run_phase
 
 
 def build_parser() -> argparse.ArgumentParser:

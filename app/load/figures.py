@@ -63,11 +63,15 @@ COMPLETES = Goal(None, False, "completes")
 
 @dataclasses.dataclass(frozen=True)
 class Figure:
+    """``value`` is what the goal compares, ``text`` what the table shows; ``detail`` holds
+    the counts behind it (clients, moves, visits, messages), for the tests and for reading."""
+
     phase: str
     name: str
     value: float
     text: str
     goal: Goal | None = None
+    detail: dict[str, float] = dataclasses.field(default_factory=dict)
 
     def verdict(self, bounds: Bounds) -> str:
         """ "met", "MISSED", or "" for a figure without a goal."""
@@ -76,8 +80,9 @@ class Figure:
         return "met" if self.goal.met(self.value, bounds) else "MISSED"
 
 
-def info(phase: str, name: str, text: str, value: float = math.nan) -> Figure:
-    return Figure(phase, name, value, text)
+def info(phase: str, name: str, text: str, **detail: float) -> Figure:
+    """A figure without a goal."""
+    return Figure(phase, name, math.nan, text, None, detail)
 
 
 def missed(figures: list[Figure], bounds: Bounds) -> list[Figure]:

@@ -13,6 +13,10 @@
 The raw clients read for 0.1 to 1.45 s before dropping, so some leave while their session is
 being built and most after it started drawing. Before the storm the child warms the server up
 with a few clean visits (first-use imports and caches are not a leak).
+
+The phase (:func:`phase`) keeps ``storm_steady`` clients connected throughout, takes the
+server's threads, RSS and live sessions as the baseline, storms, then gives the server up to
+``settle_seconds`` to come back within the tolerance, and judges where it got.
 """
 
 from __future__ import annotations
@@ -24,9 +28,13 @@ import time
 from multiprocessing.connection import Connection
 from typing import Any
 
+from poinsot.app.load import procfs
 from poinsot.app.load.children import Child
-from poinsot.app.load.fleet import REDRAW_NODE
+from poinsot.app.load.config import MB, Config, Report, Say, fps_text, relative
+from poinsot.app.load.figures import Figure, at_most, info
+from poinsot.app.load.fleet import REDRAW_NODE, Fleet
 from poinsot.app.load.raw import RawClient, camera_message, client_frame
+from poinsot.app.load.server_process import ServerProcess
 
 KINDS = ("clean", "early", "fin", "rst", "half")
 WARMUP_VISITS = 5
@@ -141,3 +149,108 @@ class Storm(Child):
         timeout = VISIT_TIMEOUT * (self.count / max(self.workers, 1) + 2)
         result: dict[str, Any] = self.request("go", timeout, "the storm")
         return result
+
+
+# -- the phase ----------------------------------------------------------------------------------
+P = "storm"
+
+
+def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
+    steady = max(0, min(cfg.storm_steady, cfg.clients))
+    say(f"storm: {steady} steady clients, warm-up visits")
+    with (
+        Fleet(server.port, steady, cfg.lifetime) as fleet,
+        Storm(server.port, cfg.storm, cfg.storm_workers, cfg.lifetime) as visits,
+    ):
+        server.wait_for_sessions(steady, 30.0)
+        time.sleep(2.0)
+        before, status0 = procfs.usage(server.pid), server.status()
+        say(f"storm: {cfg.storm} connects and departures ({', '.join(KINDS)})")
+        result = visits.run()
+        say(f"storm: settling (at most {cfg.settle_seconds:g} s)")
+        start = time.monotonic()
+        while True:
+            after, status1 = procfs.usage(server.pid), server.status()
+            deviations = (
+                relative(after.threads, before.threads),
+                relative(after.rss_bytes, before.rss_bytes),
+                relative(status1["sessions"], status0["sessions"]),
+            )
+            waited = time.monotonic() - start
+            if max(deviations) <= cfg.settle_tolerance or waited >= cfg.settle_seconds:
+                break
+            time.sleep(0.5)
+        steady_window = fleet.window(min(2.0, cfg.settle_seconds)) if steady else None
+    done, failed = result["done"], result["failed"]
+    report.add(
+        info(
+            P,
+            "visits",
+            f"{sum(done.values())} of {cfg.storm} done, {sum(failed.values())} failed, "
+            f"{result['unfinished']} unfinished ("
+            + ", ".join(f"{k} {done.get(k, 0)}" for k in KINDS)
+            + ")",
+            done=sum(done.values()),
+            failed=sum(failed.values()),
+            unfinished=result["unfinished"],
+            **{f"done_{k}": done.get(k, 0) for k in KINDS},
+        ),
+    )
+    report.notes.extend(f"storm: {reason}" for reason in result["reasons"])
+    goal = at_most("storm_tolerance", "back within {:g} %", 100)
+    report.add(
+        Figure(
+            P,
+            "server threads",
+            deviations[0],
+            f"{before.threads} -> {after.threads}",
+            goal,
+            {"before": before.threads, "after": after.threads},
+        ),
+        Figure(
+            P,
+            "server RSS",
+            deviations[1],
+            f"{before.rss_bytes / MB:.0f} -> {after.rss_bytes / MB:.0f} MB "
+            f"({after.rss_bytes / before.rss_bytes - 1:+.1%})",
+            goal,
+        ),
+        Figure(
+            P,
+            "live sessions",
+            deviations[2],
+            f"{status0['sessions']} -> {status1['sessions']} "
+            f"(session threads {status1['session_threads']}, "
+            f"pending departures {status1['pending_departures']})",
+            goal,
+            {
+                "before": status0["sessions"],
+                "after": status1["sessions"],
+                "session_threads": status1["session_threads"],
+                "pending_departures": status1["pending_departures"],
+            },
+        ),
+        info(P, "settle time", f"{waited:.1f} s (at most {cfg.settle_seconds:g} s)"),
+    )
+    changed = _thread_changes(status0["threads"], status1["threads"])
+    if changed:
+        report.notes.append(f"storm: server threads by kind, before -> after: {changed}")
+    if steady_window is not None:
+        report.add(
+            info(
+                P,
+                f"the {steady} steady clients after",
+                f"{fps_text(steady_window.fps)}, {steady_window.silent} silent",
+                clients=len(steady_window.fps),
+                silent=steady_window.silent,
+            )
+        )
+
+
+def _thread_changes(before: dict[str, int], after: dict[str, int]) -> str:
+    kinds = sorted(set(before) | set(after))
+    return ", ".join(
+        f"{k} {before.get(k, 0)} -> {after.get(k, 0)}"
+        for k in kinds
+        if before.get(k, 0) != after.get(k, 0)
+    )
