@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import argparse
 import time
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from scipy import special
@@ -30,7 +32,7 @@ CASES = (
 )
 
 
-def _best(fn, repeat: int) -> float:
+def _best(fn: Callable[[], object], repeat: int) -> float:
     best = float("inf")
     for _ in range(repeat):
         t0 = time.perf_counter()
@@ -39,7 +41,7 @@ def _best(fn, repeat: int) -> float:
     return best
 
 
-def run(n: int = 1_000_000, repeat: int = 5) -> list[dict]:
+def run(n: int = 1_000_000, repeat: int = 5) -> list[dict[str, Any]]:
     """Time the cases; returns one dict of figures per case (ns per point, ratios, µs)."""
     rows = []
     for label, inertia, omega0 in CASES:
@@ -75,7 +77,7 @@ SINGLE_TIME_CASE = ((13.0, 10.0, 5.0), (0.3, 0.6, 0.9))
 SINGLE_TIME = 1e4
 
 
-def _median(fn, n: int) -> float:
+def _median(fn: Callable[[], object], n: int) -> float:
     samples = []
     for _ in range(n):
         t0 = time.perf_counter()
@@ -84,7 +86,7 @@ def _median(fn, n: int) -> float:
     return float(np.median(samples))
 
 
-def single_time(n: int = 1000) -> dict:
+def single_time(n: int = 1000) -> dict[str, float]:
     """Medians [s] of construction, one ``state(t)`` and both together, at t = 1e4."""
     inertia, omega0 = (np.array(v) for v in SINGLE_TIME_CASE)
     body = FreeRigidBody(inertia, omega0)

@@ -9,7 +9,7 @@ family (``D > I2``), the minor-axis family (``D < I2``) and the separatrix (``D 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,8 +27,7 @@ __all__ = ["Motion", "SortedState", "classify"]
 Array = NDArray[np.float64]
 
 
-@dataclass(frozen=True)
-class SortedState:
+class SortedState(NamedTuple):
     """The scaled state in the sorted axes, and what the uniform forms need in the caller's.
 
     Attributes:
@@ -49,8 +48,7 @@ class SortedState:
     w_exp: int
 
 
-@dataclass(frozen=True)
-class Motion:
+class Motion(NamedTuple):
     """A classified motion: its regime, its closed form, and the relabelling caller ->
     the form's internal body axes."""
 

@@ -2,10 +2,10 @@
 
 Solve once, evaluate many. :class:`FreeRigidBody` checks its input, scales it, classifies the
 motion (:mod:`~poinsot.physics.classification`) and keeps one closed form
-(:mod:`~poinsot.physics.closed_forms`); it then evaluates ω(t) and the attitude R(t) on whole
-arrays of times with no integration and no drift. A single float time takes a plain-float
-path with the same operations (the same bits), so that constructing a body and evaluating it
-once costs a fraction of a millisecond.
+(:mod:`~poinsot.physics.closed_forms`); it then evaluates ω(t) and the attitude R(t)
+(:mod:`~poinsot.physics.evaluation`) on whole arrays of times with no integration and no drift.
+A single float time takes a plain-float path with the same operations (the same bits), so that
+constructing a body and evaluating it once costs a fraction of a millisecond.
 
 Frames and conventions:
 
@@ -19,12 +19,8 @@ Frames and conventions:
 To stay finite for any scale (ω0 ~ 1e-200, moments ~ 1e100), the constants are computed in
 units where the largest moment and the largest |ω0| component are powers of two near 1 (exact
 scalings); the classification and the constants come from the exact integers of the caller's
-own numbers (:mod:`~poinsot.physics.exact`), never from the scaled floats.
-
-Policy: for any finite input the API returns finite results, or raises a ValueError that says
-what is out of range and what to change -- a time so far that a phase (rate × t) would pass
-1e300 rad, or a quantity of the motion beyond the double range in the caller's units (an
-energy ~1e400: read through its property, the rest of the motion stays available).
+own numbers (:mod:`~poinsot.physics.exact`). For any finite input the results are finite, or
+a ValueError says what is out of range and what to change.
 """
 
 from __future__ import annotations
@@ -38,19 +34,18 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics.classification import SortedState, classify
-from poinsot.physics.closed_forms import ClosedForm, ScalarQuaternion
+from poinsot.physics.evaluation import Evaluator
 from poinsot.physics.exact import ldexp
 from poinsot.physics.initial_state import attitude_checked, omega_checked
 from poinsot.physics.regime import Regime
 from poinsot.physics.relabelling import sorting_map
-from poinsot.physics.rotations import conjugate, hamilton, rotate, rotate_vector
+from poinsot.physics.rotations import rotate, rotate_vector
 from poinsot.physics.validation import (
     check_attitude,
     check_energy_parameter,
     check_inertia,
     check_moment_span,
     check_positive,
-    check_times,
     check_vector,
 )
 
@@ -62,10 +57,6 @@ Vector = np.ndarray[tuple[int], np.dtype[np.float64]]
 Stack = np.ndarray[tuple[int, int], np.dtype[np.float64]]
 Array = NDArray[np.float64]
 
-# The phases rate·τ of the closed forms are kept below this (FreeRigidBody._scaled_times).
-_PHASE_LIMIT = 1e300
-# Times evaluated per block (see FreeRigidBody._quat_user): ~20 temporaries of 128 KiB fit in L2.
-_BLOCK = 16384
 _SLOWER = "use a longer time unit (ω0 and the times in smaller numbers)"
 _FASTER = "use a shorter time unit (ω0 and the times in larger numbers)"
 _LARGER = "express the moments or ω0 in larger units"
@@ -195,43 +186,11 @@ class FreeRigidBody:
         )
         on_separatrix = on_separatrix and bool(np.all(state.w_exact[[0, 2]] != 0.0))
         motion = classify(state, on_separatrix)
-        self.regime, self._form, self._frame = motion.regime, motion.form, motion.frame
+        self.regime, self._form = motion.regime, motion.form
         self.parameter = motion.form.parameter
         self.complementary_parameter = motion.form.complementary_parameter
-        self._out_of_range: str | None = None  # why ω(t) cannot be returned (_set_ranges)
-        self._set_ranges(motion.form)
-        self._anchor_at_zero(omega_s)
+        self._eval = Evaluator(motion.form, motion.frame, self._w_exp, omega_s, attitude0)
         self._set_invariants(state)
-
-    def _set_ranges(self, form: ClosedForm) -> None:
-        """The ranges of the evaluation (scaled units): the phases rate·τ must stay finite, and
-        so must ω(t), whose components reach the largest amplitude of the closed form."""
-        fastest = max(abs(x) for x in form.rates)
-        self._tau_limit = _PHASE_LIMIT / fastest if fastest > 0.0 else math.inf
-        amplitude = form.amplitude
-        if not math.isfinite(amplitude * self._w_ref):
-            decades = math.log10(amplitude) + self._w_exp * math.log10(2.0)
-            self._out_of_range = (
-                f"during this motion a component of ω reaches about 1e{decades:.0f} in your "
-                "units, beyond the largest double-precision number (1.8e308): use a longer "
-                "time unit (ω0 in smaller numbers)"
-            )
-
-    def _anchor_at_zero(self, omega_s: Array) -> None:
-        """Make ``omega(0)`` return ω0 and ``attitude(0)`` return ``attitude0``.
-
-        The closed form reproduces ω0 only to O(eps · amplitude) (through u0 = F(φ0|m) and back
-        through sn, cn, dn); adding the constant ω0 - f(0) makes omega(0) exact and changes no
-        other value by more than that rounding. ``R_user(t) = S · R_int(t) · C`` with C the
-        relabelling and S fixed so that ``R_user(0) = attitude0``.
-        """
-        cols0, q0 = self._form.quat_scalar(0.0)
-        user0 = self._frame.to_user_tuple(cols0)
-        self._anchor_t = tuple(float(omega_s[k]) - user0[k] for k in range(3))
-        self._anchor = np.array(self._anchor_t)
-        fq = self._frame.quat_tuple
-        q_user = tuple(self.attitude0.as_quat().tolist())
-        self._q_space_t = hamilton(hamilton(q_user, conjugate(fq)), conjugate(q0))
 
     def _set_invariants(self, s: SortedState) -> None:
         """D, the invariable plane, 2T and L in the scaled units, read back by exact powers of
@@ -258,108 +217,6 @@ class FreeRigidBody:
         G_space = math.hypot(*self._L_scaled.tolist())  # no underflow of G² for moments ~1e-300
         self.plane_normal = self._L_scaled / G_space
 
-    # -- evaluation -----------------------------------------------------------------------
-
-    def _omega_user(self, tau: Array) -> Array:
-        if tau.shape[0] > _BLOCK:  # cache-sized blocks, as in _quat_user
-            out = np.empty((tau.shape[0], 3))
-            for start in range(0, tau.shape[0], _BLOCK):
-                out[start : start + _BLOCK] = self._omega_user(tau[start : start + _BLOCK])
-            return out
-        cols = self._form.omega(tau)
-        return (self._frame.to_user_columns(cols) + self._anchor) * self._w_ref
-
-    def _quat_user(self, tau: Array) -> tuple[Array, Array]:
-        """(ω (N,3) in user axes and caller units, attitude quaternions (N, 4) scalar-last).
-
-        Long arrays are processed in blocks of ``_BLOCK`` times: every temporary then stays in
-        the CPU cache, which makes the element-wise numpy work ~2x faster than on whole arrays.
-        """
-        if tau.shape[0] <= _BLOCK:
-            return self._quat_block(tau)
-        w = np.empty((tau.shape[0], 3))
-        q = np.empty((tau.shape[0], 4))
-        for start in range(0, tau.shape[0], _BLOCK):
-            block = slice(start, start + _BLOCK)
-            w[block], q[block] = self._quat_block(tau[block])
-        return w, q
-
-    def _quat_block(self, tau: Array) -> tuple[Array, Array]:
-        cols, q_int = self._form.quat(tau)
-        q = np.stack(hamilton(self._q_space_t, hamilton(q_int, self._frame.quat_tuple)), axis=-1)
-        return (self._frame.to_user_columns(cols) + self._anchor) * self._w_ref, q
-
-    def _scalar(self, tau: float, attitude: bool) -> tuple[list[float], ScalarQuaternion | None]:
-        """ω (user axes, caller units) and, if asked, the attitude quaternion at one τ.
-
-        The single-time path: the operations of :meth:`_omega_user` and :meth:`_quat_block`
-        in plain floats, a few microseconds instead of dozens of numpy calls on 1-element
-        arrays. Where a phase leaves the float range (τ·rate beyond ~1e308) ``round`` raises
-        instead of returning NaN; then, and for any non-finite result, the array path gives
-        the value, so both paths return the same thing for every input.
-        """
-        try:
-            w, q = self._scalar_floats(tau, attitude)
-            if all(map(math.isfinite, w)) and (q is None or all(map(math.isfinite, q))):
-                return w, q
-        except (ArithmeticError, ValueError):
-            pass
-        arr = np.array([tau])
-        if attitude:
-            w_arr, q_arr = self._quat_user(arr)
-            x, y, z, s = q_arr[0].tolist()
-            return w_arr[0].tolist(), (x, y, z, s)
-        return self._omega_user(arr)[0].tolist(), None
-
-    def _scalar_floats(
-        self, tau: float, attitude: bool
-    ) -> tuple[list[float], ScalarQuaternion | None]:
-        q: ScalarQuaternion | None = None
-        if attitude:
-            cols, q_int = self._form.quat_scalar(tau)
-            q = hamilton(self._q_space_t, hamilton(q_int, self._frame.quat_tuple))
-        else:
-            cols = self._form.omega_scalar(tau)
-        user, anchor, w_ref = self._frame.to_user_tuple(cols), self._anchor_t, self._w_ref
-        return [(user[k] + anchor[k]) * w_ref for k in range(3)], q
-
-    def _evaluate(self, t: ArrayLike) -> tuple[Array, Array]:
-        """ω ((3,) or (N, 3)) and unnormalised attitude quaternions ((4,) or (N, 4))."""
-        tau = self._scaled_times(t)
-        if isinstance(tau, float):
-            w, q = self._scalar(tau, True)
-            return np.array(w), np.array(q)
-        return self._quat_user(tau)
-
-    def _scaled_times(self, t: ArrayLike) -> float | Array:
-        """The dimensionless times τ = t·ω_ref, checked against the range of this motion.
-
-        Beyond ``|τ| = _tau_limit`` a phase of the closed form (rate × τ) would exceed 1e300
-        rad and overflow on its way through the reduction: a ValueError then says so. (The
-        results carry an error ~1e-16 × rate × t, so they mean little long before.)
-        """
-        tt = check_times(t)
-        if self._out_of_range is not None:
-            raise ValueError(self._out_of_range)
-        if isinstance(tt, float):
-            tau_s = tt * self._w_ref
-            if abs(tau_s) <= self._tau_limit:
-                return tau_s
-            t_max = abs(tt)
-        else:
-            with np.errstate(over="ignore"):  # an overflow to inf is refused just below
-                tau = tt * self._w_ref
-            if tau.size == 0 or float(np.abs(tau).max()) <= self._tau_limit:
-                return tau
-            t_max = float(np.abs(tt).max())
-        with np.errstate(over="ignore"):
-            limit = self._tau_limit / self._w_ref
-        raise ValueError(
-            f"t = {t_max:g} is too far in time for this motion in double precision: its fastest "
-            f"phase (rate × t) would exceed 1e{math.log10(_PHASE_LIMIT):.0f} rad; keep |t| "
-            f"below {limit:.3g} (and note that the results drift by ~1e-16 × rate × t)"
-        )
-
     @overload
     def omega(self, t: float) -> Vector: ...
     @overload
@@ -373,15 +230,15 @@ class FreeRigidBody:
         Returns:
             (3,) for a scalar ``t``, (N, 3) for an array.
         """
-        tau = self._scaled_times(t)
+        tau = self._eval.times(t)
         if isinstance(tau, float):
-            return np.array(self._scalar(tau, False)[0])
-        return self._omega_user(tau)
+            return np.array(self._eval.scalar(tau, False)[0])
+        return self._eval.omega(tau)
 
     def attitude(self, t: ArrayLike) -> Rotation:
         """Attitude R(t), body -> space, as a scipy Rotation: a single one for a float ``t``,
         a stack of N for a (N,) array. ``attitude(0)`` equals ``attitude0`` to rounding."""
-        return Rotation.from_quat(self._evaluate(t)[1])
+        return Rotation.from_quat(self._eval.evaluate(t)[1])
 
     @overload
     def state(self, t: float) -> tuple[Vector, Rotation]: ...
@@ -389,7 +246,7 @@ class FreeRigidBody:
     def state(self, t: ArrayLike) -> tuple[Stack, Rotation]: ...
     def state(self, t: ArrayLike) -> tuple[Vector | Stack, Rotation]:
         """ω(t) and R(t) from one evaluation: ((3,) or (N, 3), Rotation); see :meth:`sample`."""
-        w, q = self._evaluate(t)
+        w, q = self._eval.evaluate(t)
         return w, Rotation.from_quat(q)
 
     @overload
@@ -422,7 +279,7 @@ class FreeRigidBody:
             stack); (3,) or (N, 3) space-frame contact point. This is what a renderer needs per
             frame, at the cost of one :meth:`attitude` call.
         """
-        w, q = self._evaluate(t)
+        w, q = self._eval.evaluate(t)
         if q.ndim == 1:
             contact = np.array(rotate_vector(q.tolist(), w.tolist()))
             return w, Rotation.from_quat(q), contact
@@ -439,9 +296,7 @@ class FreeRigidBody:
         """
         if int(n) < 2:
             raise ValueError(f"the polhode needs at least 2 points, got n={n}")
-        if self._out_of_range is not None:
-            raise ValueError(self._out_of_range)
-        return self._frame.to_user_columns(self._form.polhode(int(n))) * self._w_ref
+        return self._eval.polhode(int(n))
 
     # -- properties in the caller's units ---------------------------------------------------
     # Each may exceed the double range for extreme units (ω0 ~ 1e200 with moments ~1e100 has an

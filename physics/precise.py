@@ -15,8 +15,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from decimal import Decimal, localcontext
+from typing import TypeVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 #: Working digits of the one-off constant evaluations (double-double needs ~32).
 DIGITS = 45
@@ -28,6 +30,9 @@ _VELTKAMP = 134217729.0
 _SPLIT_LIMIT = 1e290
 #: Phases beyond this many periods get a second reduction (LinearPhase.reduce).
 _REDUCE_LIMIT = 2.0**50
+
+#: A float or an array of them (split works on both).
+T = TypeVar("T", float, NDArray[np.float64])
 
 
 def ratio(numerator: int, denominator: int) -> Decimal:
@@ -44,7 +49,7 @@ def double_double(x: Decimal) -> tuple[float, float]:
     return hi, float(x - Decimal(hi))
 
 
-def split(x):
+def split(x: T) -> tuple[T, T]:
     """Veltkamp split ``x = hi + lo`` with 26-bit halves, so products of halves are exact."""
     c = _VELTKAMP * x
     hi = c - (c - x)
@@ -71,13 +76,14 @@ class LinearPhase:
     period_hi: float
     period_lo: float = 0.0
 
-    def reduce(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def reduce(self, tau: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(r, j)`` for (N,) dimensionless times τ: ``|r| <= period/2``, j as floats."""
         p = self.rate_hi * tau
         j = np.round((p + self.offset) / self.period_hi)
         c1, c2 = split(self.period_hi)
         c3 = self.period_lo
         t_max = float(np.abs(tau).max()) if tau.size else 0.0
+        err: NDArray[np.float64] | float
         if t_max < _SPLIT_LIMIT:
             rh, rl = split(self.rate_hi)
             th, tl = split(tau)

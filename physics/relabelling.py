@@ -29,6 +29,7 @@ class AxisMap:
         quat: (4,) scalar-last quaternion of ``C``, the user -> internal map (it multiplies an
             internal attitude on the right).
         pairs, quat_tuple: plain-float copies for the single-time path.
+        identity: True for the caller's own axes.
     """
 
     def __init__(self, index: tuple[int, ...], sign: tuple[float, ...]) -> None:
@@ -41,6 +42,7 @@ class AxisMap:
         self.quat = Rotation.from_matrix(self.matrix).as_quat()
         self.pairs = tuple((int(i), float(x)) for i, x in zip(index, sign, strict=True))
         self.quat_tuple = tuple(float(x) for x in self.quat)
+        self.identity = self.pairs == ((0, 1.0), (1, 1.0), (2, 1.0))
 
     def to_internal(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """(..., 3) user components -> internal components."""
@@ -48,6 +50,8 @@ class AxisMap:
 
     def to_user_columns(self, cols: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:
         """Stack internal components ``cols[k]`` (each (N,)) into user-order (N, 3)."""
+        if self.identity:
+            return np.stack(cols, axis=-1)
         out = np.empty((cols[0].shape[0], 3))
         for k in range(3):
             out[:, self.index[k]] = self.sign[k] * cols[k]

@@ -1,14 +1,16 @@
 """Real bodies behind a set of principal moments: the triangle inequality and a box.
 
-The free-body mathematics holds for any positive moments, so :class:`~physics.FreeRigidBody`
-accepts them all. A *real* mass distribution also obeys ``I_i <= I_j + I_k`` for every axis
-(since ``I_j + I_k - I_i = 2 Σ m x_i² >= 0``); equality is a flat lamina in the plane normal to
-axis i. These helpers let a scene say so and show a homogeneous box with the same moments.
+The free-body mathematics holds for any positive moments, so
+:class:`~poinsot.physics.FreeRigidBody` accepts them all. A *real* mass distribution also obeys
+``I_i <= I_j + I_k`` for every axis (since ``I_j + I_k - I_i = 2 Σ m x_i² >= 0``); equality is
+a flat lamina in the plane normal to axis i. These helpers let a scene say so and show a
+homogeneous box with the same moments.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from poinsot.physics.validation import check_inertia
 
@@ -19,7 +21,7 @@ __all__ = ["check_real_body", "box_dimensions"]
 _TRIANGLE_RTOL = 8.0 * np.finfo(float).eps
 
 
-def check_real_body(inertia) -> None:
+def check_real_body(inertia: ArrayLike) -> None:
     """Raise ``ValueError`` unless some real body has these principal moments.
 
     Args:
@@ -42,7 +44,7 @@ def check_real_body(inertia) -> None:
             )
 
 
-def box_dimensions(inertia, mass: float = 1.0) -> np.ndarray:
+def box_dimensions(inertia: ArrayLike, mass: float = 1.0) -> NDArray[np.float64]:
     """Side lengths of the homogeneous box with these principal moments about its centre.
 
     ``I1 = m (a2² + a3²)/12`` and cyclic, hence ``a1² = 6 (I2 + I3 - I1)/m``.

@@ -18,8 +18,8 @@ stay exact to the rounding of τ itself over long runs (:mod:`poinsot.physics.pr
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from decimal import Decimal, localcontext
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,8 +43,7 @@ _TINY_SQRT_MC = 1e-280
 _NORMAL_AMPLITUDE = 1e-290
 
 
-@dataclass(frozen=True)
-class _Constants:
+class _Constants(NamedTuple):
     """What the one 45-digit evaluation of a body gives, each rounded once."""
 
     m: float

@@ -72,14 +72,15 @@ class Uniform:
         self.axis = axis
         # Rodrigues' constants e·v and e × v (omega_rotated), also as plain floats.
         self.ev = float(w @ axis)
-        self.exv = np.cross(axis, w)
-        self.w0_tuple = (float(w[0]), float(w[1]), float(w[2]))
-        self.axis_tuple = tuple(float(x) for x in axis)
-        self.exv_tuple = tuple(float(x) for x in self.exv)
-        m = inertia * w
-        G = math.hypot(*m.tolist())  # m·m would underflow for a moment ~1e-300
-        self.ell = m / G if G > 0.0 else np.array([0.0, 0.0, 1.0])
-        self.ell_tuple = tuple(float(x) for x in self.ell)
+        (v1, v2, v3), (e1, e2, e3) = w.tolist(), axis.tolist()
+        self.w0_tuple = (v1, v2, v3)
+        self.axis_tuple = (e1, e2, e3)
+        self.exv_tuple = (e2 * v3 - e3 * v2, e3 * v1 - e1 * v3, e1 * v2 - e2 * v1)  # e × v
+        self.exv = np.array(self.exv_tuple)
+        m = [i * x for i, x in zip(inertia.tolist(), self.w0_tuple, strict=True)]
+        G = math.hypot(*m)  # m·m would underflow for a moment ~1e-300
+        self.ell_tuple = (m[0] / G, m[1] / G, m[2] / G) if G > 0.0 else (0.0, 0.0, 1.0)
+        self.ell = np.array(self.ell_tuple)
         self._init_rates(axis, I_t, J_a, inertia, w_user, w_exp)
         w_perp = w_user - float(w_user @ axis) * axis
         moving = self.spin != 0.0 and bool(np.any(w_perp != 0.0))

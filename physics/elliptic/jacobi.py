@@ -140,7 +140,8 @@ def _decimal_agm_start(
 
 
 def reduce_argument(u: Array, K: float) -> tuple[Array, Array]:
-    """Split ``u = r + 2K j`` with ``|r| <= K`` and integer ``j`` (as float).
+    """Split (N,) arguments ``u = r + 2K j`` with ``|r| <= K`` and integer ``j`` (as float);
+    returns ``(r, j)``, each (N,).
 
     ``sn(u) = (-1)^j sn(r)``, ``cn(u) = (-1)^j cn(r)``, ``dn(u) = dn(r)`` and
     ``am(u) = am(r) + j π``. The rounding error of ``r`` is ``~eps·|u|``, the unavoidable
@@ -261,8 +262,8 @@ def sncndn(u: ArrayLike, m: float, mc: float | None = None) -> tuple[Array, Arra
 
 
 def tanh_sech(u: Array) -> tuple[Array, Array]:
-    """``(tanh u, sech u)`` without overflow warnings for large ``|u|`` (m = 1 limit,
-    [DLMF 22.5.ii]).
+    """``(tanh u, sech u)``, each of the shape of ``u``, without overflow warnings for large
+    ``|u|`` (the m = 1 limit of sn and cn [DLMF 22.5.ii]).
 
     ``sech u = 2h/(1 + h²)`` with ``h = e^{-|u|}``: from h itself, not from ``sqrt(e^{-2|u|})``,
     whose argument underflows beyond |u| ~ 372 while sech stays representable to |u| ~ 745

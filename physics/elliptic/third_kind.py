@@ -44,7 +44,8 @@ _COMPLEMENT_REACH = 150.0
 
 
 def ellippi_from_jacobi(n: float, sn: Array, cn: Array, dn: Array, m: float = 0.0) -> Array:
-    """Incomplete ``Π(n; am u | m)`` from ``sn, cn, dn`` of a reduced argument (``cn >= 0``).
+    """Incomplete ``Π(n; am u | m)`` from ``sn, cn, dn`` (each (N,)) of a reduced argument
+    (``cn >= 0``); returns (N,).
 
     With ``φ = am u``: ``sin φ = sn``, ``cos φ = cn`` and ``1 - m sin²φ = dn²``, so Carlson's
     form [DLMF 19.25.14] needs no subtraction: ``Π = sn R_F(cn², dn², 1)

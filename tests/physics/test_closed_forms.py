@@ -74,7 +74,7 @@ def _body(key: str) -> FreeRigidBody:
 
 def _internal_moments(body: FreeRigidBody) -> np.ndarray:
     """The moments in the form's body axes (any common scale)."""
-    return np.abs(body._frame.matrix) @ body.inertia
+    return np.abs(body._eval.frame.matrix) @ body.inertia
 
 
 @pytest.mark.parametrize("key", list(CASES))
@@ -127,7 +127,7 @@ def test_the_attitude_carries_the_momentum_to_one_vector(key: str) -> None:
 @pytest.mark.parametrize("key", list(CASES))
 def test_free_rigid_body_is_the_form_in_the_callers_frame(key: str) -> None:
     body = _body(key)
-    form, frame, w_ref = body._form, body._frame, body._w_ref
+    form, frame, w_ref = body._form, body._eval.frame, body._w_ref
     t = TAUS / w_ref
     w, attitude = body.state(t)
     cols, q = form.quat(TAUS)
