@@ -11,11 +11,12 @@ regime, plus the geometry of Poinsot's construction (polhode, herpolhode, invari
     'separatrix'
 
 Rooms: :mod:`~poinsot.physics.free_body` (the public object), :mod:`~.classification` and
-:mod:`~.closed_forms` (regimes and their solutions), :mod:`~.elliptic` (Jacobi functions and
-integrals), :mod:`~.exact` and :mod:`~.precise` (exact and extra-precise arithmetic),
-:mod:`~.rotations` and :mod:`~.errors` (the quaternion algebra and the error measures),
-:mod:`~.integrators` (numerical methods to compare against), :mod:`~.initial_state`,
-:mod:`~.validation`, :mod:`~.relabelling`, :mod:`~.solids`.
+:mod:`~.closed_forms` (regimes and their solutions), :mod:`~.evaluation` (a solution in the
+caller's axes, units and attitude), :mod:`~.elliptic` (Jacobi functions and integrals),
+:mod:`~.exact` and :mod:`~.precise` (exact and extra-precise arithmetic), :mod:`~.rotations`
+and :mod:`~.errors` (the quaternion algebra and the error measures), :mod:`~.integrators`
+(numerical methods to compare against), :mod:`~.initial_state`, :mod:`~.validation`,
+:mod:`~.relabelling`, :mod:`~.solids`.
 """
 
 from poinsot.physics.free_body import FreeRigidBody
