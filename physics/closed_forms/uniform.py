@@ -91,7 +91,9 @@ class Uniform:
         self.lam = 0.0
         self.parameter, self.complementary_parameter = 0.0, 1.0
         self.rates = (self.p, self.spin)
-        self.amplitude = 1.0  # the scaled |ω| components are at most 1 + rounding
+        # ω(t) turns ω0 about e, |ω(t)| = |ω0|: nothing refused (a turned component can leave
+        # the double range only where |ω0| itself exceeds 1.8e308 in the caller's units).
+        self.amplitude = 1.0
 
     def _init_rates(
         self, axis: Array, I_t: float, J_a: float, inertia: Array, w_user: Array, w_exp: int
