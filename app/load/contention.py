@@ -80,7 +80,7 @@ def stall(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         late = fleet.window(tail)
         rss1 = procfs.usage(server.pid).rss_bytes
         fleet.stall(0, False)
-        resumed = fleet.window(min(3.0, seconds))
+        resumed = fleet.window(min(2.0, seconds))
         sessions = server.status()["sessions"]
     windows = {f"first {seconds - tail:.0f} s": early, f"last {tail:.0f} s": late}
     after = f"{resumed.fps[0]:.1f} fps (its backlog)" if resumed.fps[0] > 0 else "gone"

@@ -52,6 +52,7 @@ class _Client:
     last_redraw: float = 0.0
     redrawn: threading.Event = dataclasses.field(default_factory=threading.Event)
     stalled: bool = False
+    slider: float | None = None  # the value this client last gave the slider
 
     def listener(self, message: dict[str, Any], arrived: float) -> None:
         kind = message["type"]
@@ -86,14 +87,18 @@ class Window:
 
 
 def _slide(probe: Probe, client: _Client) -> float | None:
-    """Move the slider to the value farther from its current one; the seconds until the
-    redraw arrives, None if it does not within REDRAW_TIMEOUT."""
+    """Move the slider to the other of SLIDER_VALUES; the seconds until the redraw arrives,
+    None if it does not within REDRAW_TIMEOUT."""
     try:
         uuid, widget = probe.widget(SLIDER_LABEL)
     except KeyError:  # the panel is being redeclared: this move is lost
         return None
-    current = float(widget.value) if widget.value is not None else SLIDER_VALUES[0]
-    value = max(SLIDER_VALUES, key=lambda v: abs(v - current))
+    # The server does not echo a value back to the client that set it: remember our own.
+    previous = client.slider
+    if previous is None:
+        previous = float(widget.value) if widget.value is not None else SLIDER_VALUES[0]
+    value = max(SLIDER_VALUES, key=lambda v: abs(v - previous))
+    client.slider = value
     client.redrawn.clear()
     sent = time.perf_counter()
     probe.set_value(uuid, value)

@@ -34,6 +34,12 @@ def thread_kind(name: str) -> str:
     return re.sub(r"[-_ ]?\d.*$", "", name) or name
 
 
+def error_lines(log: str) -> list[str]:
+    """The lines of a log that mention a traceback or an error (so a traceback usually counts
+    twice: its first line, and the last one naming the ...Error)."""
+    return [line.strip() for line in log.splitlines() if ERROR_PATTERN.search(line)]
+
+
 def _status(app: Any) -> dict[str, Any]:
     sessions = app.sessions()
     kinds = collections.Counter(thread_kind(t.name) for t in threading.enumerate())
@@ -112,10 +118,9 @@ class ServerProcess(Child):
     def log_errors(self) -> list[str]:
         """Lines of the server's log that mention a traceback or an error."""
         try:
-            text = self.log_path.read_text(errors="replace")
+            return error_lines(self.log_path.read_text(errors="replace"))
         except OSError:
             return []
-        return [line.strip() for line in text.splitlines() if ERROR_PATTERN.search(line)]
 
     def remove_log(self) -> None:
         self.log_path.unlink(missing_ok=True)

@@ -37,7 +37,7 @@ from poinsot.app.load.raw import RawClient, camera_message, client_frame
 from poinsot.app.load.server_process import ServerProcess
 
 KINDS = ("clean", "early", "fin", "rst", "half")
-WARMUP_VISITS = 5
+WARMUP_VISITS = 3
 #: The longest one visit may take before it is abandoned (each step has its own timeout).
 VISIT_TIMEOUT = 30.0
 

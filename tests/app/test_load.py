@@ -1,0 +1,209 @@
+"""The load test (``python -m poinsot.app.load``) at tiny sizes: every phase runs against a real
+server child on loopback and produces its figures, with the counts behind them; the goals are
+judged from the figures and the bounds alone (met bounds give exit status 0, an impossible one
+gives 1). Counts and events are asserted, never the seconds the server took."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import struct
+
+import pytest
+
+from poinsot.app.load import PHASES, Bounds, Config, Report, cli, exit_status, run
+from poinsot.app.load.figures import COMPLETES, Figure, at_least, at_most, percentile
+from poinsot.app.load.procfs import usage
+from poinsot.app.load.raw import client_frame
+from poinsot.app.load.server_process import error_lines, thread_kind
+from poinsot.app.load.storm import KINDS
+
+TINY = Config(
+    clients=3,
+    seconds=3.0,
+    slider_period=0.5,
+    storm=15,
+    storm_workers=4,
+    storm_steady=2,
+    settle_seconds=2.0,
+    stall_seconds=2.0,
+    flood_seconds=2.0,
+    flood_rate=1000.0,
+)
+#: Bounds every tiny run meets on a working server, however loaded the machine.
+LENIENT = Bounds(
+    min_fps=1.0,
+    max_redraw_ms=60_000.0,
+    max_rss_growth=10.0,
+    storm_tolerance=100.0,
+    min_keep=0.01,
+    max_errors=1000,
+)
+LENIENT_ARGS = [
+    "--min-fps=1",
+    "--max-redraw-ms=60000",
+    "--max-rss-growth=10",
+    "--storm-tolerance=100",
+    "--min-keep=0.01",
+    "--max-errors=1000",
+]
+
+
+@pytest.fixture(scope="module")
+def report() -> Report:
+    return run(PHASES, TINY, verbose=False)
+
+
+# -- the phases, run once ----------------------------------------------------------------------
+@pytest.mark.slow
+def test_every_phase_completes_and_reads_its_server_log(report):
+    failures = [f"{f.phase}: {f.text}" for f in report.figures if f.name == "completed"]
+    assert not failures, failures
+    for phase in PHASES:
+        errors = report.figure(phase, "server log errors")
+        assert errors.value >= 0 and (errors.goal is not None) == (phase == "soak")
+
+
+@pytest.mark.slow
+def test_soak_counts_frames_redraws_and_samples(report):
+    fps = report.figure("soak", "fps per client, each of")
+    assert fps.detail["clients"] == 3
+    assert 0 < fps.value <= fps.detail["p5"] <= fps.detail["p50"]
+    assert report.figure("soak", "frames drawn by the server").detail["fps"] > 0
+    redraw = report.figure("soak", "slider-to-redraw")
+    assert redraw.detail["moves"] >= 2 and redraw.detail["lost"] == 0
+    assert 0 < redraw.value < math.inf
+    assert report.figure("soak", "server RSS").detail["samples"] >= 3
+    assert report.figure("soak", "clients gone silent").value == 0
+    lost = report.figure("soak", "sessions lost")
+    assert lost.value == 0 and lost.detail["fewest"] == 3
+
+
+@pytest.mark.slow
+def test_storm_visits_every_way_and_sessions_come_back(report):
+    visits = report.figure("storm", "visits").detail
+    assert visits["done"] == TINY.storm and visits["failed"] == visits["unfinished"] == 0
+    assert all(visits[f"done_{kind}"] == TINY.storm // len(KINDS) for kind in KINDS)
+    sessions = report.figure("storm", "live sessions")
+    assert sessions.detail["before"] == sessions.detail["after"] == 2
+    assert sessions.detail["session_threads"] == 2
+    assert sessions.detail["pending_departures"] == 0
+    assert sessions.value == 0
+    threads = report.figure("storm", "server threads").detail
+    assert threads["before"] > 0 and threads["after"] > 0
+    steady = report.figure("storm", "the 2 steady clients after").detail
+    assert steady["clients"] == 2 and steady["silent"] == 0
+
+
+@pytest.mark.slow
+def test_stall_stops_one_client_and_measures_the_others(report):
+    stalled = report.figure("stall", "the stalled client").detail
+    assert stalled["late_fps"] == 0  # nothing read while stalled
+    assert stalled["sessions"] == 3
+    keep = report.figure("stall", "others' frame rate")
+    assert keep.detail["clients"] == 2 and keep.detail["before_p50"] > 0
+    assert keep.value > 0
+
+
+@pytest.mark.slow
+def test_flood_sends_and_measures_the_others(report):
+    sent = report.figure("flood", "messages sent").detail
+    assert 0 < sent["sent"] <= TINY.flood_rate * TINY.flood_seconds + TINY.flood_rate
+    assert report.figure("flood", "server CPU").detail["sessions"] == TINY.clients + 1
+    keep = report.figure("flood", "others' frame rate")
+    assert keep.detail["clients"] == 3 and keep.value > 0
+
+
+# -- the goals, judged on the same figures -----------------------------------------------------
+@pytest.mark.slow
+def test_met_bounds_give_zero_and_each_impossible_bound_gives_one(report):
+    assert exit_status(report.figures, LENIENT) == 0
+    impossible = {
+        "min_fps": 1e9,
+        "max_redraw_ms": 0.0,
+        "max_rss_growth": -1.0,
+        "storm_tolerance": -1.0,
+        "min_keep": 1e9,
+        "max_errors": -1,
+    }
+    assert set(impossible) == {f.name for f in dataclasses.fields(Bounds)}
+    for name, value in impossible.items():
+        bounds = dataclasses.replace(LENIENT, **{name: value})
+        assert exit_status(report.figures, bounds) == 1, name
+
+
+@pytest.mark.slow
+def test_main_prints_the_table_and_exits_by_the_goals(report, monkeypatch, capsys):
+    monkeypatch.setattr(cli, "run", lambda phases, cfg: report)
+    assert cli.main(LENIENT_ARGS) == 0
+    out = capsys.readouterr().out
+    assert "0 goals missed" in out and "MISSED" not in out
+    for phase in PHASES:
+        assert f"\n{phase} " in out
+    assert cli.main([*LENIENT_ARGS, "--min-fps=1e9"]) == 1
+    out = capsys.readouterr().out
+    assert "1 goals missed" in out and "MISSED" in out
+
+
+# -- pieces, without a server ------------------------------------------------------------------
+def test_a_phase_that_could_not_run_and_an_empty_run_fail():
+    failed = Figure("soak", "completed", 0.0, "failed: no scene", COMPLETES)
+    assert exit_status([failed], Bounds()) == 1
+    assert exit_status([], Bounds()) == 1  # nothing judged is not a pass
+
+
+def test_a_figure_not_measured_misses_its_goal():
+    assert Figure("x", "y", math.nan, "n/a", at_most("max_redraw_ms", "")).verdict(Bounds()) == (
+        "MISSED"
+    )
+    assert Figure("x", "y", 31.0, "", at_least("min_fps", "")).verdict(Bounds()) == "met"
+    assert Figure("x", "y", 29.0, "", at_least("min_fps", "")).verdict(Bounds()) == "MISSED"
+
+
+def test_stall_and_flood_need_two_clients():
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["--phase", "stall", "--clients", "1"])
+    assert exc.value.code == 2
+
+
+def test_the_server_log_is_read_for_tracebacks_and_errors():
+    log = "\n".join(
+        [
+            "(viser) Server started",
+            "2026-01-01 12:00:00,000 ERROR session 3: KeyError: 'mesh'",
+            "Traceback (most recent call last):",
+            '  File "session.py", line 1, in _run',
+            "KeyError: 'mesh'",
+            "a websocket error",
+            "Connection closed",
+        ]
+    )
+    assert len(error_lines(log)) == 4
+    assert error_lines("") == []
+
+
+def test_percentile_thread_kinds_and_proc():
+    assert percentile([], 0.5) != percentile([], 0.5)  # NaN
+    assert percentile([3.0, 1.0, 2.0, 4.0], 0.5) == 2.0
+    assert percentile([float(i) for i in range(1, 101)], 0.95) == 95.0
+    assert thread_kind("poinsot-session-12") == "poinsot-session"
+    assert thread_kind("ThreadPoolExecutor-0_3") == "ThreadPoolExecutor"
+    assert thread_kind("MainThread") == "MainThread"
+    me = usage(os.getpid())
+    assert me.threads >= 1 and me.rss_bytes > 0 and me.cpu_seconds > 0
+
+
+@pytest.mark.parametrize("size", [0, 5, 125, 126, 70_000])
+def test_client_frames_are_masked_and_unmask_to_the_payload(size):
+    payload = os.urandom(size)
+    frame = client_frame(payload)
+    assert frame[0] == 0x82 and frame[1] & 0x80
+    length, offset = frame[1] & 0x7F, 2
+    if length == 126:
+        length, offset = struct.unpack_from("!H", frame, 2)[0], 4
+    elif length == 127:
+        length, offset = struct.unpack_from("!Q", frame, 2)[0], 10
+    mask, body = frame[offset : offset + 4], frame[offset + 4 :]
+    assert length == size == len(body)
+    assert bytes(b ^ mask[i % 4] for i, b in enumerate(body)) == payload
