@@ -87,6 +87,7 @@ class Evaluator:
         self._q_space_t = hamilton(hamilton(q_user, conjugate(fq)), conjugate(q0))
 
     def omega(self, tau: Array) -> Array:
+        """ω (N, 3) in the caller's axes and units at (N,) dimensionless times τ."""
         if tau.shape[0] > _BLOCK:  # cache-sized blocks, as in state
             out = np.empty((tau.shape[0], 3))
             for start in range(0, tau.shape[0], _BLOCK):
