@@ -67,6 +67,9 @@ def _cylinder_between(radius: float, start, end, sections: int = 64) -> trimesh.
 
 def solid_mesh(solid: Solid) -> trimesh.Trimesh:
     """The solid in its principal axes (centre of mass at the origin), untextured."""
+    if solid.mesh is not None:  # a body made from its mesh: drawn as it is
+        shape = solid.mesh
+        return trimesh.Trimesh(shape.vertices.copy(), shape.faces.copy(), process=False)
     if solid.kind == "box":
         mesh = trimesh.creation.box(extents=solid.dims)
     elif solid.kind == "cylinder":
@@ -94,6 +97,8 @@ def solid_shape(solid: Solid) -> tuple[tuple, trimesh.Trimesh, np.ndarray]:
     ``key`` is equal for solids that share a mesh."""
     if solid.kind == "box":
         return ("box",), trimesh.creation.box(extents=(1.0, 1.0, 1.0)), np.asarray(solid.dims)
+    if solid.mesh is not None:
+        return ("mesh", solid.mesh.digest), solid_mesh(solid), np.ones(3)
     return (solid.kind, solid.dims, solid.axis, solid.offset), solid_mesh(solid), np.ones(3)
 
 
