@@ -6,8 +6,8 @@ product ``λ t`` give an error ``~eps·λt`` that grows with time, and reducing 
 period known to only 16 digits adds ``~eps·u`` more. Here the rates and periods are computed
 once, at 45 significant digits from the exact rational value of the data (``decimal``), kept
 as ``hi + lo`` double pairs, and the phase is formed with Dekker's error-free product
-(Veltkamp's split) and reduced with a three-part Cody-Waite constant. What is left is the
-rounding of ``t`` itself.
+(Veltkamp's split) [Dek71] and reduced with a three-part Cody-Waite constant [CW80]. What is
+left is the rounding of ``t`` itself.
 """
 
 from __future__ import annotations
