@@ -16,7 +16,8 @@ import dataclasses
 from poinsot.app.elements import (
     ALL_CONTROLS,
     ALL_ELEMENTS,
-    ALL_PLOTS,
+    STANDARD_CONTROLS,
+    STANDARD_PLOTS,
     TRACE_ELEMENTS,
     Control,
     Element,
@@ -43,8 +44,8 @@ class Preset:
     #: for a state that rounding must not move (the separatrix).
     omega0: tuple[float, float, float] | None = None
     elements: frozenset[Element] = ALL_ELEMENTS
-    controls: frozenset[Control] = ALL_CONTROLS
-    plots: frozenset[Plot] = ALL_PLOTS
+    controls: frozenset[Control] = STANDARD_CONTROLS
+    plots: frozenset[Plot] = STANDARD_PLOTS
 
     def __post_init__(self) -> None:
         if self.pole_sign not in (1, -1):
@@ -171,27 +172,58 @@ PRESETS: tuple[Preset, ...] = (
     ),
 )
 
-#: What a body edited by hand shows: everything.
+#: What a body edited by hand shows: everything, with the controls that bring a body of one's
+#: own (an uploaded toss or mesh).
 CUSTOM = Preset(
     key="custom",
     label="Custom (edited)",
     source="your own choice of moments and energy",
     inertia=_BOX_INERTIA,
     D=2.45,
+    controls=ALL_CONTROLS,
 )
+
+# The entries for a body of one's own. Until something is uploaded they show these stand-ins
+# (the T-handle's moments, normalised as an upload's are: the largest is 1); a session then
+# shows its own fitted toss or mesh body under the same label (see poinsot.app.own_bodies).
+FITTED_TOSS = Preset(
+    key="fitted_toss",
+    label="Fitted toss",
+    source="no recording yet: throw a phone spinning, record its gyroscope with phyphox and "
+    "upload the export (.zip or .csv) under 'Your own toss'; the exact free motion fitted to "
+    "it plays here, its measured ω drawn over the exact one",
+    inertia=(1.0 / 3.1839, 2.2782 / 3.1839, 1.0),
+    D=2.2782 / 3.1839 * (1.0 + 2e-3),
+    omega_norm=2.0,
+    trail_points=2400,
+    controls=ALL_CONTROLS,
+)
+MESH_BODY = Preset(
+    key="mesh_body",
+    label="Body from a mesh",
+    source="no mesh yet: choose a bundled body or upload a closed mesh (STL, OBJ, PLY, GLB) "
+    "under 'Any body from its mesh'; its moments at uniform density drive the scene",
+    inertia=(5.0 / 13.0, 10.0 / 13.0, 1.0),
+    D=10.0 / 13.0 * (1.0 + 2e-3),
+    omega_norm=2.0,
+    trail_points=2400,
+    controls=ALL_CONTROLS,
+)
+#: The entries of the preset menu, in order.
+MENU: tuple[Preset, ...] = (*PRESETS, FITTED_TOSS, MESH_BODY, CUSTOM)
 
 DEFAULT_PRESET = PRESETS[0]
 
 
 def preset_by_key(key: str) -> Preset:
-    for preset in (*PRESETS, CUSTOM):
+    for preset in MENU:
         if preset.key == key:
             return preset
     raise KeyError(f"no preset named {key!r}; choose from {[p.key for p in PRESETS]}")
 
 
 def preset_by_label(label: str) -> Preset:
-    for preset in (*PRESETS, CUSTOM):
+    for preset in MENU:
         if preset.label == label:
             return preset
     raise KeyError(f"no preset labelled {label!r}")

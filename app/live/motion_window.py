@@ -4,7 +4,8 @@ and the live plot of ω in the body frame.
 It floats at the bottom left of the 3D view, so that a lecture sees the numbers beside the
 scene without scrolling the control panel. The plot exists only while the preset declares it
 (:class:`~poinsot.app.elements.Plot`); the session records a sample and sends the window of the
-last PLOT_SAMPLES at the plot's refresh rate.
+last PLOT_SAMPLES at the plot's refresh rate. For an uploaded toss the plot also shows the
+measured ω (:mod:`poinsot.app.live.overlay`).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import viser
 import viser.uplot
 
 from poinsot.app.live import readouts
+from poinsot.app.live.overlay import Measured, measured_series, merge
 from poinsot.app.scene import palette
 
 #: Number of plot samples kept (one per plot refresh, 10 per second: the last 30 s).
@@ -36,20 +38,28 @@ class MotionWindow:
         self.plot: viser.GuiUplotHandle | None = None
         self._t: list[float] = []
         self._omega: list[np.ndarray] = []
+        #: An uploaded toss's samples, drawn when the plot was added with ``measured=True``.
+        self.measured: Measured | None = None
+        self._with_measured = False
 
     # -- the plot's lifecycle (the panel declares and retires it) ---------------------------
-    def add_plot(self) -> viser.GuiUplotHandle:
+    def add_plot(self, measured: bool = False) -> viser.GuiUplotHandle:
+        """The plot of ω; with ``measured``, three more series: the measured ω as dots."""
         series = [viser.uplot.Series(label="t")]
         for i, color in enumerate(palette.PLOT_SERIES):
             series.append(viser.uplot.Series(label=f"ω{'₁₂₃'[i]}", stroke=color, width=2))
+        if measured:
+            series += measured_series()
+        self._with_measured = measured
+        title = "ω: measured (dots), exact fit (lines)" if measured else "ω in the body frame"
         zeros = np.zeros(2)
         # Created with two samples, not empty: viser's uPlot keeps the x range relative to the
         # data's extent, and an empty first data set (extent -inf..inf) leaves it NaN forever.
         with self.tab:
             self.plot = self.gui.add_uplot(
-                data=(np.array([0.0, 1.0]), zeros, zeros, zeros),
+                data=(np.array([0.0, 1.0]), *[zeros] * (len(series) - 1)),
                 series=tuple(series),
-                title="ω in the body frame",
+                title=title,
                 scales=palette.plot_scales(),
                 axes=palette.plot_axes(),
                 aspect=1.7,
@@ -61,6 +71,7 @@ class MotionWindow:
     def forget_plot(self) -> None:
         """The plot was removed (by the panel): stop recording."""
         self.plot = None
+        self._with_measured = False
 
     # -- mirroring the session's state ---------------------------------------------------
     def show_readouts(self, text: str) -> None:
@@ -92,7 +103,10 @@ class MotionWindow:
             return False
         w = np.asarray(self._omega)
         data = (np.asarray(self._t), w[:, 0].copy(), w[:, 1].copy(), w[:, 2].copy())
-        if all(np.all(np.isfinite(a)) for a in data):
+        if self._with_measured:
+            empty = Measured(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))
+            data = merge(data[0], w, self.measured or empty)
+        if all(np.all(np.isfinite(a)) for a in data[:4]):  # measured NaN: no sample there
             self.plot.data = data
             return True
         return False

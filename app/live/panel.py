@@ -29,6 +29,8 @@ from poinsot.app.parameters import (
     Parameters,
 )
 from poinsot.app.presets import CUSTOM, PRESETS, Preset
+from poinsot.app.scenes import SCENES, scene_by_label
+from poinsot.app.scenes.spec import SceneSpec
 
 ELEMENT_LABELS: dict[Element, str] = {
     Element.ELLIPSOID: "energy ellipsoid",
@@ -69,6 +71,7 @@ class Actions(Protocol):
     """What the panel asks of its session (all non-blocking)."""
 
     def choose_preset(self, preset: Preset) -> None: ...
+    def choose_scene(self, scene: SceneSpec) -> None: ...
     def edit(self, change: Callable[[Parameters], Parameters]) -> None: ...
     def set_speed(self, speed: float) -> None: ...
     def toggle_pause(self) -> None: ...
@@ -123,7 +126,7 @@ class ControlPanel:
             self._folders["scene"] = folder
             self.preset = gui.add_dropdown(
                 "Preset",
-                [p.label for p in (*PRESETS, CUSTOM)],
+                [*(p.label for p in (*PRESETS, CUSTOM)), *(s.label for s in SCENES)],
                 initial_value=preset.label,
                 hint="Start from a classical case; editing a slider turns it into 'Custom'.",
             )
@@ -154,6 +157,9 @@ class ControlPanel:
         for p in (*PRESETS, CUSTOM):
             if p.label == handle.value:
                 self.actions.choose_preset(p)
+        scene = scene_by_label(handle.value)
+        if scene is not None:
+            self.actions.choose_scene(scene)
 
     # -- declaration ---------------------------------------------------------------------
     def declare(

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+import functools
 import logging
 import queue
 import threading
@@ -26,6 +27,7 @@ from poinsot.app.live.clock import SimClock
 from poinsot.app.live.ghost_controls import add_ghost_controls
 from poinsot.app.live.lecture import add_lecture_controls
 from poinsot.app.live.panel import ControlPanel
+from poinsot.app.live.uploads import UploadControls
 from poinsot.app.live.widgets import Retirement
 from poinsot.app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, Preset
@@ -150,6 +152,15 @@ class Session:
 
     def choose_preset(self, preset: Preset) -> None:
         self._post(lambda: self._apply_preset(preset))
+
+    @functools.cached_property
+    def uploads(self) -> UploadControls:
+        """The toss and mesh folders (made before the panel's first declaration)."""
+        return UploadControls(self)
+
+    def post(self, action: Callable[[], None]) -> None:
+        """Run ``action`` on the frame thread (from any thread; never blocks)."""
+        self._post(action)
 
     def edit(self, change: Callable[[Parameters], Parameters]) -> None:
         self._post(lambda: self._edit(change))
@@ -286,6 +297,8 @@ class Session:
         self.panel.show_status(message)
 
     def _apply_preset(self, preset: Preset) -> None:
+        # The menu's "Fitted toss" and "Body from a mesh": this session's own, if it has one.
+        preset = self.uploads.resolve(preset)
         self.preset = preset
         if preset is not CUSTOM:
             self._base = preset
