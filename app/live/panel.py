@@ -13,7 +13,7 @@ time, readouts and the plot of ω are in the floating "Motion" window
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any, Protocol, TypeVar
 
 import viser
@@ -28,7 +28,7 @@ from poinsot.app.parameters import (
     TRAIL_RANGE,
     Parameters,
 )
-from poinsot.app.presets import CUSTOM, PRESETS, Preset
+from poinsot.app.presets import MENU, Preset
 from poinsot.app.scenes import SCENES, scene_by_label
 from poinsot.app.scenes.spec import SceneSpec
 
@@ -111,6 +111,13 @@ _MIRRORED: dict[Group, str] = {
 }
 
 
+def slider_range(default: tuple[float, float], values: Iterable[float]) -> tuple[float, float]:
+    """A slider's range: ``default``, widened to hold ``values`` (a body of one's own can have
+    a moment below the usual range, or spin faster)."""
+    values = [float(v) for v in values]
+    return min(default[0], *values), max(default[1], *values)
+
+
 class ControlPanel:
     def __init__(
         self, gui: viser.GuiApi, actions: Actions, preset: Preset, retirement: Retirement
@@ -122,11 +129,13 @@ class ControlPanel:
         self._groups: dict[Group, list[Removable]] = {}
         self._folders: dict[str | Group, viser.GuiFolderHandle] = {}
         self._elements: frozenset[Element] = frozenset()
+        #: Builders of groups that other modules add (uploads: the toss and mesh folders).
+        self._extensions: dict[Group, Callable[[], list[Removable]]] = {}
         with gui.add_folder("Scene", order=_ORDER["scene"]) as folder:
             self._folders["scene"] = folder
             self.preset = gui.add_dropdown(
                 "Preset",
-                [*(p.label for p in (*PRESETS, CUSTOM)), *(s.label for s in SCENES)],
+                [*(p.label for p in MENU), *(s.label for s in SCENES)],
                 initial_value=preset.label,
                 hint="Start from a classical case; editing a slider turns it into 'Custom'.",
             )
@@ -154,7 +163,7 @@ class ControlPanel:
         return handle
 
     def _choose_preset(self, handle: viser.GuiDropdownHandle[str]) -> None:
-        for p in (*PRESETS, CUSTOM):
+        for p in MENU:
             if p.label == handle.value:
                 self.actions.choose_preset(p)
         scene = scene_by_label(handle.value)
@@ -190,6 +199,8 @@ class ControlPanel:
             Control.TRAIL: lambda: self._build_trail(trail),
             Control.VISIBILITY: lambda: self._build_visibility(elements, visible),
             Plot.OMEGA: lambda: [self.motion.add_plot()],
+            Plot.MEASURED: lambda: [self.motion.add_plot(measured=True)],
+            **self._extensions,
         }
         for key in sorted(wanted, key=lambda k: _ORDER.get(k, 25.0)):
             if key not in self._groups:
@@ -200,9 +211,13 @@ class ControlPanel:
     def groups(self) -> frozenset[Group]:
         return frozenset(self._groups)
 
+    def extend(self, group: Group, build: Callable[[], list[Removable]]) -> None:
+        """Let ``build`` create ``group`` (in folders of its own) when a preset declares it."""
+        self._extensions[group] = build
+
     def _remove_group(self, key: Group) -> None:
         self.widgets.forget(key)
-        if key is Plot.OMEGA:
+        if key in (Plot.OMEGA, Plot.MEASURED):
             self.motion.forget_plot()
         self.retirement.retire(self._groups.pop(key, []))
 
@@ -228,12 +243,13 @@ class ControlPanel:
     # -- groups --------------------------------------------------------------------------
     def _build_inertia(self, params: Parameters) -> list[Removable]:
         sliders = []
+        lo, hi = slider_range(INERTIA_RANGE, params.inertia)
         with self._folder(Control.INERTIA, "Body: principal moments"):
             for i in range(3):
                 slider = self.gui.add_slider(
                     f"I{'₁₂₃'[i]}",
-                    INERTIA_RANGE[0],
-                    INERTIA_RANGE[1],
+                    lo,
+                    hi,
                     0.01,
                     float(params.inertia[i]),
                     order=float(i),
@@ -299,8 +315,7 @@ class ControlPanel:
         with self._folder("motion", "Motion"):
             slider = self.gui.add_slider(
                 "|ω₀|",
-                OMEGA_NORM_RANGE[0],
-                OMEGA_NORM_RANGE[1],
+                *slider_range(OMEGA_NORM_RANGE, (params.omega_norm,)),
                 0.05,
                 float(params.omega_norm),
                 order=3.0,
@@ -384,13 +399,19 @@ class ControlPanel:
     def show_parameters(self, params: Parameters) -> None:
         """Mirror parameters into the sliders (and the D slider's range and marks)."""
         w = self.widgets
+        lo, hi = slider_range(INERTIA_RANGE, params.inertia)
         for slider, moment in zip(w.inertia, params.inertia, strict=False):
+            if (slider.min, slider.max) != (lo, hi):
+                slider.min, slider.max = lo, hi
             set_value(slider, float(moment))
         if w.energy is not None:
             w.energy.min, w.energy.max = params.D_range
             set_marks(w.energy, self._energy_marks(params))
             set_value(w.energy, float(params.D))
         if w.omega_norm is not None:
+            lo, hi = slider_range(OMEGA_NORM_RANGE, (params.omega_norm,))
+            if (w.omega_norm.min, w.omega_norm.max) != (lo, hi):
+                w.omega_norm.min, w.omega_norm.max = lo, hi
             set_value(w.omega_norm, float(params.omega_norm))
 
     def show_playback(self, speed: float, paused: bool, trail: int) -> None:
