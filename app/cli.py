@@ -22,6 +22,8 @@ from poinsot.app.exports.html import HTML_FPS
 from poinsot.app.exports.screenshot import parse_size, resolve_scene
 from poinsot.app.presets import PRESETS, Preset, preset_by_key
 from poinsot.app.scene.cameras import CAMERA_NAMES
+from poinsot.app.scenes import scene_by_name, scene_names
+from poinsot.app.scenes.spec import SceneSpec
 
 DESCRIPTION = "Poinsot: torque-free rigid-body motion, live in the browser and offline."
 
@@ -34,9 +36,16 @@ def _preset(key: str) -> Preset:
         raise argparse.ArgumentTypeError(exc.args[0]) from exc
 
 
-def _scene(name: str) -> Preset:
+def _scene(name: str) -> Preset | SceneSpec:
     try:
         return resolve_scene(name)
+    except KeyError as exc:
+        raise argparse.ArgumentTypeError(exc.args[0]) from exc
+
+
+def _scene_only(name: str) -> SceneSpec:
+    try:
+        return scene_by_name(name)
     except KeyError as exc:
         raise argparse.ArgumentTypeError(exc.args[0]) from exc
 
@@ -49,11 +58,12 @@ def _size(text: str) -> tuple[int, int]:
 
 
 # -- the commands ---------------------------------------------------------------------------
-def serve(host: str, port: int, preset: str) -> int:
-    """Serve until interrupted (Ctrl-C)."""
+def serve(host: str, port: int, preset: str, start_scene: SceneSpec | None) -> int:
+    """Serve until interrupted (Ctrl-C); each browser starts with ``start_scene`` if given,
+    else with ``preset``."""
     from poinsot.app.live.server import PoinsotApp
 
-    app = PoinsotApp(host, port, preset=preset_by_key(preset))
+    app = PoinsotApp(host, port, preset=preset_by_key(preset), scene=start_scene)
     print(f"Poinsot is running at {app.url}  (Ctrl-C to stop)", flush=True)
     try:
         while True:
@@ -76,7 +86,7 @@ def report(args: argparse.Namespace) -> int:
 
 def screenshot(
     out: pathlib.Path,
-    scene: Preset,
+    scene: Preset | SceneSpec,
     t: float | None,
     size: tuple[int, int],
     view: str,
@@ -91,7 +101,12 @@ def screenshot(
 
 
 def export_html(
-    out: pathlib.Path, preset: Preset, seconds: float, fps: float, view: str, light: bool
+    out: pathlib.Path,
+    preset: Preset | SceneSpec,
+    seconds: float,
+    fps: float,
+    view: str,
+    light: bool,
 ) -> int:
     """Write a standalone animated HTML page (see :mod:`poinsot.app.exports.html`)."""
     from poinsot.app.exports.html import export_html_command
@@ -114,11 +129,20 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         help="interface to listen on (0.0.0.0 lets students on the room's network connect)",
     )
     parser.add_argument("--port", type=int, default=8080, help="TCP port (0 = any free port)")
-    parser.add_argument(
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument(
         "--preset",
         default=PRESETS[0].key,
         choices=[p.key for p in PRESETS],
-        help="scene each new browser starts with",
+        help="preset each new browser starts with",
+    )
+    which.add_argument(
+        "--scene",
+        dest="start_scene",
+        type=_scene_only,
+        default=None,
+        metavar="{" + ",".join(scene_names()) + "}",
+        help="or the scene each new browser starts with",
     )
     parser.set_defaults(func=serve)
 
@@ -145,7 +169,9 @@ def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
         "--scene",
         type=_scene,
         metavar="NAME",
-        help="scene by preset key or label, e.g. 'Sphere (a cube)'",
+        help="a scene by name ("
+        + ", ".join(scene_names())
+        + "), or a preset by key or label, e.g. 'Sphere (a cube)'",
     )
     parser.add_argument(
         "--time",
@@ -180,8 +206,16 @@ def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
     keys = "{" + ",".join(p.key for p in PRESETS) + "}"
-    parser.add_argument(
-        "--preset", type=_preset, default=PRESETS[0].key, metavar=keys, help="scene to record"
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument(
+        "--preset", type=_preset, default=PRESETS[0].key, metavar=keys, help="preset to record"
+    )
+    which.add_argument(
+        "--scene",
+        dest="preset",
+        type=_scene,
+        metavar="NAME",
+        help="or a scene to record: " + ", ".join(scene_names()),
     )
     parser.add_argument("--seconds", type=float, default=20.0, help="clip length (wall seconds)")
     parser.add_argument("--fps", type=float, default=HTML_FPS, help="recorded frames per second")

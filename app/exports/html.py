@@ -19,6 +19,8 @@ from poinsot.app.parameters import Parameters
 from poinsot.app.presets import Preset
 from poinsot.app.scene.cameras import space_view
 from poinsot.app.scene.view import DEFAULT_VIEW, View
+from poinsot.app.scenes.spec import SceneSpec
+from poinsot.app.scenes.stage import SceneStage
 
 #: Frames per second of the recorded animation: smooth, and half the bytes of 60.
 HTML_FPS = 30.0
@@ -42,20 +44,54 @@ def animation_html(
 ) -> str:
     """A standalone HTML page that plays ``seconds`` of the motion (``speed`` simulation time
     units per second), looping, in any browser, from a file."""
+    _check_clip(seconds, fps)
+    with Stage(params, solid, elements, trail_points=trail_points, dark_mode=dark_mode) as stage:
+        return _record(stage, seconds, fps, speed, view, dark_mode, title)
+
+
+def _check_clip(seconds: float, fps: float) -> None:
     if not (math.isfinite(seconds) and 0 < seconds <= HTML_MAX_SECONDS):
         raise ValueError(f"the clip length must be in (0, {HTML_MAX_SECONDS:g}] seconds")
     if not (math.isfinite(fps) and 1 <= fps <= 60):
         raise ValueError("the frame rate must be between 1 and 60 per second")
-    with Stage(params, solid, elements, trail_points=trail_points, dark_mode=dark_mode) as stage:
-        stage.set_initial_camera(view)
-        serializer = stage.server.get_scene_serializer()  # snapshot: the scene at t = 0
-        frames = round(seconds * fps)
-        for i in range(1, frames + 1):
-            serializer.insert_sleep(1.0 / fps)
-            stage.advance(i / fps * speed)
-        html = serializer.as_html(dark_mode=dark_mode)
+
+
+def _record(
+    stage: Stage | SceneStage,
+    seconds: float,
+    fps: float,
+    speed: float,
+    view: View,
+    dark_mode: bool,
+    title: str,
+) -> str:
+    """Record ``seconds`` of a stage, frame by frame, as a page that plays from a file."""
+    stage.set_initial_camera(view)
+    serializer = stage.server.get_scene_serializer()  # snapshot: the scene at t = 0
+    frames = round(seconds * fps)
+    for i in range(1, frames + 1):
+        serializer.insert_sleep(1.0 / fps)
+        stage.advance(i / fps * speed)
+    html = serializer.as_html(dark_mode=dark_mode)
     safe_title = re.sub(r"[<>&\"]", "", title)
     return html.replace("<title>Viser</title>", f"<title>{safe_title}</title>", 1)
+
+
+def scene_html(
+    spec: SceneSpec,
+    seconds: float,
+    *,
+    fps: float = HTML_FPS,
+    view: View | None = None,
+    dark_mode: bool = True,
+) -> str:
+    """:func:`animation_html` of a scene (:mod:`poinsot.app.scenes`) at its own settings,
+    speed and camera (``view`` overrides the camera)."""
+    _check_clip(seconds, fps)
+    with SceneStage(spec, dark_mode=dark_mode) as stage:
+        camera = spec.view if view is None else view
+        title = f"Poinsot: {spec.label}"
+        return _record(stage, seconds, fps, spec.initial_speed(), camera, dark_mode, title)
 
 
 def preset_html(preset: Preset, seconds: float, **kwargs: Any) -> str:
@@ -70,7 +106,7 @@ def preset_html(preset: Preset, seconds: float, **kwargs: Any) -> str:
 
 def export_html_command(
     out: pathlib.Path,
-    preset: Preset,
+    preset: Preset | SceneSpec,
     *,
     seconds: float = 20.0,
     fps: float = HTML_FPS,
@@ -79,12 +115,17 @@ def export_html_command(
 ) -> int:
     """``poinsot export-html``: write the clip, print where and how big."""
     start = time.perf_counter()
-    html = preset_html(preset, seconds, fps=fps, view=space_view(view), dark_mode=not light)
+    if isinstance(preset, SceneSpec):  # a scene frames itself unless another view is asked
+        camera = None if view == "default" else space_view(view)
+        html = scene_html(preset, seconds, fps=fps, view=camera, dark_mode=not light)
+    else:
+        html = preset_html(preset, seconds, fps=fps, view=space_view(view), dark_mode=not light)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(html, encoding="utf-8")
     size = out.stat().st_size
     print(
         f"wrote {out} ({size / 1e6:.2f} MB, {seconds:g} s at {fps:g} fps, "
-        f"preset {preset.key}) in {time.perf_counter() - start:.1f} s"
+        f"{'scene' if isinstance(preset, SceneSpec) else 'preset'} {preset.key}) in "
+        f"{time.perf_counter() - start:.1f} s"
     )
     return 0

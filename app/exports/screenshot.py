@@ -40,6 +40,9 @@ from poinsot.app.presets import PRESETS, Preset, preset_by_key
 from poinsot.app.scene.cameras import space_view
 from poinsot.app.scene.frames import wxyz as to_wxyz
 from poinsot.app.scene.view import View
+from poinsot.app.scenes import scene_by_name
+from poinsot.app.scenes.spec import SceneSpec
+from poinsot.app.scenes.stage import SceneStage
 
 if TYPE_CHECKING:
     from playwright.sync_api import Browser, ViewportSize
@@ -246,7 +249,7 @@ class Shot:
     seconds: float
 
 
-def _wait_for_client(stage: Stage, timeout: float) -> viser.ClientHandle:
+def _wait_for_client(stage: Stage | SceneStage, timeout: float) -> viser.ClientHandle:
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         clients = stage.server.get_clients()
@@ -256,7 +259,7 @@ def _wait_for_client(stage: Stage, timeout: float) -> viser.ClientHandle:
     raise TimeoutError("the browser did not connect to the scene server")
 
 
-def _open(browser: Browser, stage: Stage, size: tuple[int, int]) -> viser.ClientHandle:
+def _open(browser: Browser, stage: Stage | SceneStage, size: tuple[int, int]) -> viser.ClientHandle:
     """Open ``stage`` in a window of WINDOW_HEIGHT CSS pixels with the picture's aspect."""
     width, height = size
     window: ViewportSize = {
@@ -303,7 +306,7 @@ class _Camera:
 
 
 def capture(
-    stage: Stage,
+    stage: Stage | SceneStage,
     view: View,
     size: tuple[int, int],
     *,
@@ -334,8 +337,13 @@ def capture(
 
 
 # -- the command ----------------------------------------------------------------------------
-def resolve_scene(name: str) -> Preset:
-    """A scene by preset key or label (case-insensitive)."""
+def resolve_scene(name: str) -> Preset | SceneSpec:
+    """A scene (:mod:`poinsot.app.scenes`) by name or label, or a preset by key or label
+    (case-insensitive)."""
+    try:
+        return scene_by_name(name)
+    except KeyError:
+        pass
     for preset in PRESETS:
         if name.lower() in (preset.key.lower(), preset.label.lower()):
             return preset
@@ -347,9 +355,23 @@ def default_time(period: float) -> float:
     return period if math.isfinite(period) and 0 < period <= 120 else 20.0
 
 
+def open_stage(scene: Preset | SceneSpec, dark_mode: bool) -> Stage | SceneStage:
+    """The stage that draws a preset or a scene (stop it when done)."""
+    if isinstance(scene, SceneSpec):
+        return SceneStage(scene, dark_mode=dark_mode)
+    return Stage.from_preset(scene, dark_mode=dark_mode)
+
+
+def picture_time(stage: Stage | SceneStage) -> float:
+    """The default time of a picture: the scene's own, or a preset's :func:`default_time`."""
+    if isinstance(stage, SceneStage):
+        return stage.spec.picture_time
+    return default_time(float(stage.body.period))
+
+
 def screenshot_command(
     out: pathlib.Path,
-    scene: Preset,
+    scene: Preset | SceneSpec,
     *,
     t: float | None = None,
     size: tuple[int, int] = (1920, 1080),
@@ -359,8 +381,9 @@ def screenshot_command(
 ) -> int:
     """``poinsot screenshot``: 0 on success, EXIT_NO_BROWSER without Chromium, 1 on failure.
 
-    ``t``: simulation time of the picture (None: one period of omega); ``view``: a camera of
-    :data:`~poinsot.app.scene.cameras.CAMERA_NAMES`; ``background``: "dark", "light" or
+    ``t``: simulation time of the picture (None: one period of omega, or a scene's own
+    time); ``view``: a camera of :data:`~poinsot.app.scene.cameras.CAMERA_NAMES` ("default"
+    is a scene's own framing); ``background``: "dark", "light" or
     "transparent"; ``fit``: frame the construction (else keep the view's field of view).
     """
     try:
@@ -369,10 +392,12 @@ def screenshot_command(
         print(f"poinsot screenshot: {exc}", file=sys.stderr)
         return EXIT_NO_BROWSER
     with sigterm_exits():
-        stage = Stage.from_preset(scene, dark_mode=background != "light")
+        stage = open_stage(scene, dark_mode=background != "light")
         try:
-            t = t if t is not None else default_time(float(stage.body.period))
+            t = t if t is not None else picture_time(stage)
             camera = space_view(view, stage.seek(t).wxyz)
+            if isinstance(scene, SceneSpec) and view == "default":
+                camera = scene.view
             stage.set_initial_camera(camera)
             ground = None if background == "transparent" else THEME_BACKGROUND[background == "dark"]
             shot = capture(stage, camera, size, chromium=chromium, background=ground, fit=fit)

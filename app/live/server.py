@@ -10,6 +10,7 @@ import viser
 from poinsot.app.live.budget import FrameBudget
 from poinsot.app.live.session import MAX_FPS, Session
 from poinsot.app.presets import DEFAULT_PRESET, Preset
+from poinsot.app.scenes.spec import SceneSpec
 
 
 class PoinsotApp:
@@ -21,10 +22,13 @@ class PoinsotApp:
         port: int = 8080,
         *,
         preset: Preset = DEFAULT_PRESET,
+        scene: SceneSpec | None = None,
         max_fps: float = MAX_FPS,
         verbose: bool = False,
     ) -> None:
+        """Each new browser starts with ``preset``, or with ``scene`` if one is given."""
         self.preset = preset
+        self.scene = scene
         self.max_fps = max_fps
         self._lock = threading.Lock()
         self._sessions: dict[int, Session] = {}
@@ -74,7 +78,9 @@ class PoinsotApp:
                 self._departed.discard(client.client_id)
                 self.discarded += 1
                 return
-        session = Session(client, self.preset, max_fps=self.max_fps, budget=self.budget)
+        session = Session(
+            client, self.preset, max_fps=self.max_fps, budget=self.budget, scene=self.scene
+        )
         with self._connected:
             if client.client_id in self._departed:
                 self._departed.discard(client.client_id)

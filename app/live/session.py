@@ -27,6 +27,7 @@ from poinsot.app.live.clock import SimClock
 from poinsot.app.live.ghost_controls import add_ghost_controls
 from poinsot.app.live.lecture import add_lecture_controls
 from poinsot.app.live.panel import ControlPanel
+from poinsot.app.live.showcase import LiveShowcase
 from poinsot.app.live.uploads import UploadControls
 from poinsot.app.live.widgets import Retirement
 from poinsot.app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters
@@ -34,6 +35,7 @@ from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, Preset
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.view import DEFAULT_VIEW, View, apply_theme
+from poinsot.app.scenes.spec import SceneSpec, Value
 from poinsot.physics import FreeRigidBody, box_dimensions
 
 log = logging.getLogger(__name__)
@@ -85,8 +87,10 @@ class Session:
         max_fps: float = MAX_FPS,
         view: View = DEFAULT_VIEW,
         budget: FrameBudget | None = None,
+        scene: SceneSpec | None = None,
     ) -> None:
-        """``budget``: the server's shared frame-rate governor (one per session if None)."""
+        """``budget``: the server's shared frame-rate governor (one per session if None);
+        ``scene``: start with this scene (:mod:`poinsot.app.scenes`) instead of ``preset``."""
         self.client = client
         self.max_fps = float(max_fps)
         self.budget = budget if budget is not None else FrameBudget(max_fps=max_fps)
@@ -108,21 +112,33 @@ class Session:
         self._generation = 0  # bumped after each rebuild (tests wait on it)
         self._thread: threading.Thread | None = None
         self._last_plot = self._last_time = 0.0  # monotonic times of the last refreshes
+        #: The scene being shown, if one is chosen instead of a preset (frame thread).
+        self.showcase: LiveShowcase | None = None
+        self.speed_range = SPEED_RANGE
 
         apply_theme(client)
         view.apply(client.camera)
         self.scene = PoinsotScene(
-            client.scene, preset.elements, preset.trail_points, atomic=client.atomic
+            client.scene,
+            preset.elements if scene is None else frozenset(),
+            preset.trail_points,
+            atomic=client.atomic,
         )
         #: Widgets removed from the panel, deleted a moment later (frame thread).
         self.retirement = Retirement()
-        self.panel = ControlPanel(client.gui, self, preset, self.retirement)
-        self._apply_preset(preset)
+        self.panel = ControlPanel(
+            client.gui, self, preset if scene is None else scene.identity(), self.retirement
+        )
+        if scene is None:
+            self._apply_preset(preset)
+        else:
+            self._apply_scene(scene)
         self._rebuild()
         # Exports, camera views, theme and hotkeys mount on the session's panel.
         self.lecture = add_lecture_controls(self)
         # The numerical ghost: its controls now, the ghost itself only when switched on.
         self.ghost = add_ghost_controls(self)
+        self._fit_ghost()
 
     # -- lifecycle -----------------------------------------------------------------------
     def start(self) -> Session:
@@ -162,11 +178,30 @@ class Session:
         """Run ``action`` on the frame thread (from any thread; never blocks)."""
         self._post(action)
 
+    def choose_scene(self, scene: SceneSpec) -> None:
+        self._post(lambda: self._apply_scene(scene))
+
+    def configure_scene(self, key: str, value: Value) -> None:
+        """A control of the current scene moved."""
+
+        def action() -> None:
+            if self.showcase is not None and self.showcase.configure(key, value):
+                self._dirty = True
+
+        self._post(action)
+
+    def set_part_visible(self, part: str, visible: bool) -> None:
+        def action() -> None:
+            if self.showcase is not None:
+                self.showcase.set_visible(part, visible)
+
+        self._post(action)
+
     def edit(self, change: Callable[[Parameters], Parameters]) -> None:
         self._post(lambda: self._edit(change))
 
     def set_speed(self, speed: float) -> None:
-        speed = min(max(float(speed), SPEED_RANGE[0]), SPEED_RANGE[1])
+        speed = min(max(float(speed), self.speed_range[0]), self.speed_range[1])
 
         def action() -> None:
             self.clock.speed = speed
@@ -255,6 +290,8 @@ class Session:
             self._last_time = now
             motion.show_time(self.frame.t if self.frame is not None else 0.0, self.clock.paused)
             self.retirement.collect(now)
+        if self.showcase is not None and self.frame is not None:
+            self.showcase.refresh(now, self.frame.t)  # its readouts and plots, at their rates
 
     def _drain(self) -> None:
         if self._actions.empty():  # the usual frame: no exception raised and caught
@@ -270,10 +307,12 @@ class Session:
                 self._report(exc)
 
     def _advance(self) -> None:
-        if self.body is None:
+        showcase = self.showcase
+        if (self.body is None) if showcase is None else not showcase.loaded:
             return
         start = time.perf_counter()
-        self.frame = self.scene.advance(self.clock.now())
+        t = self.clock.now()
+        self.frame = self.scene.advance(t) if showcase is None else showcase.advance(t)
         self.lecture.on_frame(self.frame)
         self.ghost.on_frame(self.frame)
         self.stats.frame_seconds.append(time.perf_counter() - start)
@@ -299,6 +338,7 @@ class Session:
     def _apply_preset(self, preset: Preset) -> None:
         # The menu's "Fitted toss" and "Body from a mesh": this session's own, if it has one.
         preset = self.uploads.resolve(preset)
+        self._leave_scene()
         self.preset = preset
         if preset is not CUSTOM:
             self._base = preset
@@ -319,6 +359,50 @@ class Session:
         )
         self.panel.show_preset(preset)
         self._show_playback()
+
+    def _apply_scene(self, scene: SceneSpec) -> None:
+        """Show ``scene``: the construction's elements it declares, the panel's groups it shares
+        (speed, playback, trail, show/hide), and its own controls, parts, readouts and plots."""
+        self._leave_scene()
+        self.preset = scene.identity()
+        self.speed_range = scene.speed_range
+        self.clock.speed = scene.initial_speed()
+        self.scene.trail_points = scene.trail_points
+        self.showcase = LiveShowcase(
+            scene, self.client, self.scene, self.panel.motion, self, self.retirement
+        )
+        self.panel.declare(
+            scene.shared,
+            frozenset(),
+            scene.elements,
+            self._desired,
+            self.clock.speed,
+            self.scene.trail_points,
+            self.scene.is_visible,
+        )
+        self.panel.show_preset(self.preset)
+        self._show_playback()
+        scene.view.apply(self.client.camera)
+        self._dirty = True
+
+    def _leave_scene(self) -> None:
+        """Remove the current scene (if any); the next preset rebuilds its body."""
+        if self.showcase is not None:
+            self.showcase.remove()
+            self.showcase = None
+            self.speed_range = SPEED_RANGE
+            self.body = None
+            self._dirty = True
+            DEFAULT_VIEW.apply(self.client.camera)
+
+    def _fit_ghost(self) -> None:
+        """The numerical ghost races an exact torque-free body: without one (a scene that
+        poses its own body) its controls are hidden and it is switched off."""
+        ghost = getattr(self, "ghost", None)  # mounted after the first rebuild
+        if ghost is not None:
+            if self.body is None:
+                ghost.configure(enabled=False)
+            ghost.folder.visible = self.body is not None
 
     def _edit(self, change: Callable[[Parameters], Parameters]) -> None:
         new = change(self._desired)
@@ -359,19 +443,31 @@ class Session:
             desired = self._desired
             self._dirty = False
             try:
-                body = desired.build()
-                self.clock.reset(0.0)
-                frame = self.scene.load(body, self._solid(desired), frame_time=self.frame_time)
+                if self.showcase is not None:
+                    self._load_scene(self.showcase)
+                else:
+                    body = desired.build()
+                    self.clock.reset(0.0)
+                    frame = self.scene.load(body, self._solid(desired), frame_time=self.frame_time)
+                    self._show_body(body, desired, frame)
             except ValueError as exc:
                 reason = str(exc)
                 self._set_status(f"{reason[:1].upper()}{reason[1:]}. Showing the last valid body.")
-            else:
-                self._show_body(body, desired, frame)
+            self._fit_ghost()
             self.stats.rebuild_seconds.append(time.perf_counter() - start)
             self.stats.rebuilds += 1
         with self._applied:
             self._generation += 1
             self._applied.notify_all()
+
+    def _load_scene(self, showcase: LiveShowcase) -> None:
+        """Load the scene's desired settings at t = 0 (ValueError: the last scene is kept)."""
+        self.clock.reset(0.0)
+        self.frame = showcase.load(self.frame_time)
+        self.body = showcase.body
+        self.panel.motion.clear_plot()
+        self._set_status("")
+        self.client.flush()
 
     def _show_body(self, body: FreeRigidBody, params: Parameters, frame: Frame) -> None:
         """The new body is on screen: mirror it into the panel and the "Motion" window."""

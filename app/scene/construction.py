@@ -184,6 +184,15 @@ class PoinsotScene:
             self._frame = None
             return self._draw(k, k, restart=True)
 
+    def unload(self) -> None:
+        """Forget the body (a scene that poses its own body draws no construction): the traces
+        are emptied and :meth:`advance` needs a new :meth:`load`."""
+        for trail in self._trails.values():
+            trail.clear()
+        self._pending.clear()
+        self._body = self._geometry = self._sampler = self._batch = None
+        self._k_last, self._frame = None, None
+
     def set_frame_time(self, frame_time: float) -> None:
         """The clock's speed changed: re-grid the motion from the time now shown."""
         if self._body is None or self._geometry is None or self._frame is None:

@@ -1,0 +1,49 @@
+"""Colours of the scenes' own parts, beside :mod:`poinsot.app.scene.palette` (whose colours
+they reuse where a part is the same thing: the polhode's pink, the ellipsoid's amber).
+
+The polhode families take the hue of the axis they circle (warm around the minor axis 1, blue
+around the major axis 3), the separatrix is white: a family reads at a glance on a projector.
+"""
+
+from __future__ import annotations
+
+from poinsot.app.scene import palette
+
+RGB = tuple[int, int, int]
+
+MINOR_FAMILY: RGB = (255, 140, 90)
+MAJOR_FAMILY: RGB = (110, 190, 255)
+SEPARATRIX: RGB = (245, 245, 245)
+#: The polhode of the current D: the app's polhode pink.
+CURRENT: RGB = palette.POLHODE
+#: Landau's momentum sphere |m| = G (translucent) and his energy ellipsoid (the amber).
+SPHERE: RGB = (150, 125, 255)
+SPHERE_OPACITY = 0.22
+ELLIPSOID: RGB = palette.ELLIPSOID
+ELLIPSOID_OPACITY = 0.3
+#: The moving point m = I ω on Landau's picture, and its trace.
+MOMENTUM: RGB = (255, 255, 255)
+MOMENTUM_TRACE: RGB = palette.HERPOLHODE
+#: Cones of the symmetric top: the body cone (rides with the body), the space cone (fixed).
+BODY_CONE: RGB = (255, 120, 200)
+SPACE_CONE: RGB = (90, 230, 160)
+CONE_OPACITY = 0.25
+#: The gyroscope: its symmetry axis, the torque, the drift of the axis and the axis's path.
+SYMMETRY_AXIS: RGB = palette.AXES[2]
+TORQUE: RGB = (255, 90, 60)
+DRIFT: RGB = (120, 255, 120)
+AXIS_PATH: RGB = (255, 210, 60)
+OMEGA: RGB = palette.OMEGA
+L: RGB = palette.ANGULAR_MOMENTUM
+#: Solid bodies drawn from their own meshes.
+SOLID: RGB = palette.SOLID
+
+#: Plot series (uPlot strokes).
+PLOT_MEASURED = "#ff40a0"
+PLOT_THEORY = "#ffe64a"
+PLOT_LEVEL = "#9aa4ae"
+PLOT_SECOND = "#00e5ff"
+
+
+def hex_color(rgb: RGB) -> str:
+    return "#{:02x}{:02x}{:02x}".format(*rgb)

@@ -1,0 +1,298 @@
+"""Scene "gyroscope-torque": a symmetric body under a constant torque fixed in the body
+[FM06 §7.11, Eqs. 7.85-7.98; HLW06 §IV.7].
+
+What it shows: the presets' homogeneous disc (I₁ = I₂ = J, I₃ = J₃) spinning about its axis
+while a torque of constant size M acts along its own axis x₂ (the red arrow, turning with the
+body). Euler's equations with the torque give ω(t) in closed form: ω₃ stays constant and
+(ω₁ − ω₁*, ω₂) turns uniformly at ν = ((J₃ − J)/J) ω₃ about the nutation centre
+ω₁* = −M/((J₃ − J) ω₃) [FM06 Eqs. 7.88-7.95]. The attitude has no closed form: it is integrated
+from that ω(t) by the fourth-order Magnus method, with an error estimate from a run with half
+the steps (Richardson). On average the axis moves towards the torque at the rate
+M/((J₃ − J) ω₃) [FM06 Eq. 7.98], the green arrow at the axis's tip; the yellow trace is the
+path of the axis's tip in space. L is not conserved here, so there is no invariable plane.
+
+Readouts: the drift rate against the mean velocity of the axis measured from the integrated
+attitude (and the drift across the torque, 0 in theory); the nutation centre against ω
+recovered from the integrated attitude (ω = 2 Im(q* q̇), fourth-order differences of the
+quaternions drawn), and the attitude's error estimate at the time shown. The plot: log₁₀ of the
+error estimate and of the mismatch between that recovered ω and the closed-form ω.
+
+Physics: :class:`poinsot.physics.gyroscope.Gyroscope` (``omega``, ``attitude``,
+``measure_drift``), :mod:`poinsot.physics.rotations` (products of the drawn quaternions).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+
+import numpy as np
+
+from poinsot.app.elements import Control, Solid
+from poinsot.app.presets import preset_by_key
+from poinsot.app.scene import meshes
+from poinsot.app.scene.batch import Frame
+from poinsot.app.scene.frames import wxyz_from_xyzw
+from poinsot.app.scene.geometry import Geometry
+from poinsot.app.scenes import colors
+from poinsot.app.scenes.drawing import THIN_ARROW, Parts, arrow_points
+from poinsot.app.scenes.spec import (
+    Canvas,
+    Model,
+    Part,
+    PlotSpec,
+    Readout,
+    SceneSpec,
+    Settings,
+    Slider,
+    number,
+    relative,
+)
+from poinsot.app.scenes.tabulated import Player, Table
+from poinsot.physics import FreeRigidBody, rotations
+from poinsot.physics.gyroscope import AttitudeRun, DriftMeasurement, Gyroscope
+
+#: The body: the presets' homogeneous disc (its moments checked against trimesh by
+#: tests/app/test_parts.py); J transverse, J₃ axial.
+DISC = preset_by_key("oblate")
+J, _, J3 = DISC.inertia
+#: Rows of the table per time unit, and its span: whole nutation periods, at least MIN_SPAN.
+ROWS_PER_TIME = 120
+NUTATIONS = 8
+MIN_SPAN, MAX_SPAN = 30.0, 120.0
+#: Error plot samples, and the floor of its log scale (rounding).
+PLOT_SAMPLES = 600
+ERROR_FLOOR = 1e-16
+#: Display sizes: the disc's radius, the half-length of the drawn axis, the ω arrow's longest
+#: length, and the time over which the drift arrow shows the axis's mean displacement.
+DISC_RADIUS = 0.75
+AXIS_LENGTH = 1.15
+OMEGA_LENGTH = 1.0
+DRIFT_TIME = 1.0
+ROOT = "/space"
+DISC_NODE = f"{ROOT}/body/disc"
+AXIS_NODE = f"{ROOT}/body/symmetry_axis"
+TORQUE_NODE = f"{ROOT}/body/torque"
+DRIFT_NODE = f"{ROOT}/body/drift"
+PATH_NODE = f"{ROOT}/axis_path"
+OMEGA_NODE = f"{ROOT}/gyro_omega"
+
+
+def omega_from_attitude(quaternions: np.ndarray, dt: float) -> np.ndarray:
+    """Body-frame ω (N - 4, 3) read off attitudes (N, 4) (scalar-last, continuous in sign)
+    sampled every ``dt``, at the rows 2 … N - 3: ``ω = 2 Im(q* ⊗ q̇)`` with q̇ from
+    fourth-order central differences."""
+    q = np.asarray(quaternions, dtype=float)
+    dq = (q[:-4] - 8.0 * q[1:-3] + 8.0 * q[3:-1] - q[4:]) / (12.0 * dt)
+    conj = q[2:-2] * np.array([-1.0, -1.0, -1.0, 1.0])
+    return 2.0 * rotations.multiply(conj, dq)[:, :3]
+
+
+def circle_center(points: np.ndarray) -> tuple[float, float]:
+    """The centre of the circle through points (N, 2), by linear least squares on
+    ``x² + y² + a x + b y + c = 0`` (exact for points on a circle, whatever arc they cover)."""
+    x, y = points[:, 0], points[:, 1]
+    system = np.stack([x, y, np.ones_like(x)], axis=1)
+    (a, b, _), *_ = np.linalg.lstsq(system, -(x * x + y * y), rcond=None)
+    return -0.5 * float(a), -0.5 * float(b)
+
+
+@dataclasses.dataclass(frozen=True)
+class GyroModel:
+    gyro: Gyroscope
+    times: np.ndarray  # (N,) the table's grid
+    run: AttitudeRun
+    omega: np.ndarray  # (N, 3) closed form
+    mismatch: np.ndarray  # (N,) |ω from the attitude - ω| / |ω| (the two end rows repeated)
+    drift: DriftMeasurement
+
+    @property
+    def body(self) -> FreeRigidBody | None:
+        return None  # not torque-free: the scene poses the body itself
+
+    @property
+    def solid(self) -> Solid | None:
+        return None
+
+    @property
+    def span(self) -> float:
+        return len(self.times) * float(self.times[1] - self.times[0])
+
+    def row(self, t: float) -> int:
+        return min(len(self.times) - 1, int(np.searchsorted(self.times, t % self.span)))
+
+    def readouts(self, t: float) -> tuple[Readout, ...]:
+        g = self.gyro
+        return (
+            *self.rows,
+            Readout(
+                "attitude error estimate now",
+                "—",
+                f"{self.run.error_estimate[self.row(t)]:.1e} rad",
+                f"Magnus-4, {self.run.steps} steps against half as many (Richardson)",
+            ),
+            Readout("nutation period 2π/|ν|", number(g.nutation_period), "—"),
+        )
+
+    @functools.cached_property
+    def rows(self) -> tuple[Readout, ...]:
+        g, d = self.gyro, self.drift
+        recovered_center = circle_center(self.recovered()[:, :2])[0]
+        return (
+            Readout(
+                "drift rate M/((J₃−J)ω₃)",
+                number(g.drift_rate, 9),
+                relative(d.along_torque, g.drift_rate, 9),
+                f"measured: mean velocity of the axis over {d.periods} nutation periods",
+            ),
+            Readout("drift across the torque", "0", f"{d.across:.1e}"),
+            Readout(
+                "nutation centre ω₁* = −M/((J₃−J)ω₃)",
+                number(g.nutation_center, 9),
+                relative(recovered_center, g.nutation_center, 9),
+                "measured: centre of the circle (ω₁, ω₂) recovered from the integrated attitude",
+            ),
+            Readout(
+                "ω from the attitude vs closed form",
+                "0",
+                f"{float(self.mismatch.max()):.1e} rel.",
+            ),
+        )
+
+    def recovered(self) -> np.ndarray:
+        return omega_from_attitude(self.run.quaternions, float(self.times[1] - self.times[0]))
+
+    def plot(self, key: str, t: float) -> tuple[np.ndarray, ...]:
+        stride = max(1, len(self.times) // PLOT_SAMPLES)
+        n = max(2, self.row(t) // stride + 1)
+        times = self.times[::stride][:n]
+        error = np.log10(np.maximum(self.run.error_estimate[::stride][:n], ERROR_FLOOR))
+        gap = np.log10(np.maximum(self.mismatch[::stride][:n], ERROR_FLOOR))
+        return times, error, gap
+
+
+def build(settings: Settings) -> GyroModel:
+    torque, spin = float(settings["M"]), float(settings["spin"])
+    gyro = Gyroscope(J, J3, torque, (0.0, 0.0, spin))
+    span = min(max(NUTATIONS * gyro.nutation_period, MIN_SPAN), MAX_SPAN)
+    times = np.arange(round(span * ROWS_PER_TIME)) / ROWS_PER_TIME
+    run = gyro.attitude(times)
+    omega = gyro.omega(times)
+    recovered = omega_from_attitude(run.quaternions, 1.0 / ROWS_PER_TIME)
+    inner = omega[2:-2]
+    gap = np.linalg.norm(recovered - inner, axis=1) / np.linalg.norm(inner, axis=1)
+    mismatch = np.pad(gap, 2, mode="edge")
+    drift = gyro.measure_drift(periods=4)
+    return GyroModel(gyro, times, run, omega, mismatch, drift)
+
+
+class GyroDrawing:
+    """The disc, its axis, the torque and drift arrows (body frame), ω and the axis's path."""
+
+    def __init__(self, canvas: Canvas) -> None:
+        self.canvas = canvas
+        parts = self.parts = Parts(canvas.api)
+        mesh = meshes.solid_mesh(DISC.solid) if DISC.solid is not None else None
+        assert mesh is not None
+        vertices = np.asarray(mesh.vertices) * (DISC_RADIUS / float(np.max(mesh.extents) / 2.0))
+        parts.surface("gyroscope", DISC_NODE, (vertices, np.asarray(mesh.faces)), colors.SOLID)
+        axis = parts.lines("axis", AXIS_NODE, colors.SYMMETRY_AXIS, 3.0)
+        axis.points = np.array([[[0, 0, -AXIS_LENGTH], [0, 0, AXIS_LENGTH]]], np.float32)
+        self.torque = parts.arrow("torque", TORQUE_NODE, colors.TORQUE, THIN_ARROW)
+        self.drift = parts.arrow("drift", DRIFT_NODE, colors.DRIFT, THIN_ARROW)
+        self.omega = parts.arrow("omega", OMEGA_NODE, colors.OMEGA, THIN_ARROW)
+        self.path = parts.trail("path", PATH_NODE, colors.AXIS_PATH, 3.0, 2400)
+        self.player: Player | None = None
+
+    def fit(self, model: Model, geometry: Geometry | None) -> None:
+        assert isinstance(model, GyroModel)
+        g = model.gyro
+        quats = model.run.quaternions
+        tip = rotations.rotate(quats, np.array([0.0, 0.0, AXIS_LENGTH]))
+        omega_space = rotations.rotate(quats, model.omega)
+        reach = float(np.max(np.linalg.norm(model.omega, axis=1)))
+        arrows = np.zeros((len(quats), 1, 2, 3), np.float32)
+        arrows[:, 0, 1] = omega_space * (OMEGA_LENGTH / reach)
+        table = Table(
+            1.0 / ROWS_PER_TIME,
+            wxyz_from_xyzw(quats),
+            model.omega,
+            {"path": tip.astype(np.float32)},
+            {"omega": arrows},
+        )
+        torque = 0.25 + 0.5 * min(1.0, abs(g.torque))
+        self.torque.points = arrow_points((0, 0, 0), (0, math.copysign(torque, g.torque), 0))
+        shift = g.drift_rate * DRIFT_TIME * AXIS_LENGTH
+        self.drift.points = arrow_points((0, 0, AXIS_LENGTH), (0, shift, AXIS_LENGTH))
+        self.player = Player(table, {"path": self.path})
+
+    def advance(self, t: float, frame: Frame | None) -> Frame:
+        if self.player is None:
+            raise RuntimeError("fit() a model before advance()")
+        table = self.player.table
+        row, samples = self.player.advance(t)
+        self.canvas.body.wxyz = table.wxyz[row]
+        self.omega.points = table.arrows["omega"][row]
+        cycle, _ = table.locate(t)
+        return table.frame(
+            cycle * table.span + row * table.dt, row, table.points["path"][row], samples
+        )
+
+    def set_visible(self, part: str, visible: bool) -> None:
+        self.parts.set_visible(part, visible)
+
+    def remove(self) -> None:
+        self.parts.remove()
+
+
+SPEC = SceneSpec(
+    name="gyroscope-torque",
+    label="Scene: gyroscope with a body-fixed torque",
+    source=(
+        "[FM06 §7.11, Eqs. 7.85-7.98]: J ω₁' = (J − J₃) ω₂ω₃, J ω₂' = (J₃ − J) ω₃ω₁ + M, "
+        "ω₃ constant; ω in closed form, the attitude by Magnus-4 [HLW06 §IV.7]; the axis "
+        "drifts towards the torque at M/((J₃ − J) ω₃) (tendency to parallelism)."
+    ),
+    body="the presets' homogeneous disc (r 1, thickness 0.25), J = 1, J₃ = 1.9592",
+    motion="Gyroscope(J, J₃, M, (0, 0, ω₃)): omega (closed form), attitude (Magnus-4), "
+    "measure_drift",
+    elements=frozenset(),
+    parts=(
+        Part("gyroscope", "the disc", (DISC_NODE,), surface=colors.SOLID),
+        Part("axis", "symmetry axis e₃", (AXIS_NODE,), (colors.SYMMETRY_AXIS,)),
+        Part("torque", "torque M (along x₂)", (TORQUE_NODE,), surface=colors.TORQUE),
+        Part("drift", "mean drift of the axis", (DRIFT_NODE,), surface=colors.DRIFT),
+        Part("omega", "ω", (OMEGA_NODE,), surface=colors.OMEGA),
+        Part("path", "path of the axis", (PATH_NODE,), (colors.AXIS_PATH,), trails=(PATH_NODE,)),
+    ),
+    controls=(
+        Slider("M", "torque M", -1.0, 1.0, 0.05, 0.5, hint="Along the body's own x₂."),
+        Slider("spin", "spin ω₃", 0.5, 4.0, 0.05, 1.5, hint="About the symmetry axis."),
+    ),
+    shared=frozenset({Control.SPEED, Control.PLAYBACK}),
+    readouts=(
+        "drift rate M/((J₃−J)ω₃)",
+        "drift across the torque",
+        "nutation centre ω₁* = −M/((J₃−J)ω₃)",
+        "ω from the attitude vs closed form",
+        "attitude error estimate now",
+        "nutation period 2π/|ν|",
+    ),
+    plots=(
+        PlotSpec(
+            "errors",
+            "the integrated attitude (log scale)",
+            "t",
+            "log₁₀ error",
+            (
+                ("estimate (rad)", colors.PLOT_MEASURED),
+                ("ω from attitude (rel.)", colors.PLOT_SECOND),
+            ),
+        ),
+    ),
+    build=build,
+    draw=GyroDrawing,
+    speed=1.0,
+    picture_time=12.0,
+)

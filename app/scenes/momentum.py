@@ -1,0 +1,151 @@
+"""Landau's picture in momentum space [LL76 §37, Fig. 51], as a group of nodes beside the
+construction, and the polhode family coloured by kind.
+
+In the body frame the angular momentum ``m = I ω`` lies on the sphere ``|m| = G`` (fixed while
+no torque acts) and on the energy ellipsoid ``Σ mᵢ²/Iᵢ = 2T`` (semi-axes ``sqrt(2T Iᵢ)``); the
+curve where the two meet is the polhode, mapped by ``I``. The group shows the sphere, the
+ellipsoid, their intersection (or the whole family), the body axes and the moving point
+``m(t)``, scaled so that the sphere has radius :data:`SPHERE_RADIUS` (display units). Every
+number comes from :mod:`poinsot.physics.family`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from poinsot.app.scene import palette
+from poinsot.app.scene.geometry import triple
+from poinsot.app.scenes import colors
+from poinsot.app.scenes.drawing import Parts, many_segments, unit_sphere
+from poinsot.physics import Regime
+from poinsot.physics.family import PolhodeCurve
+
+#: Radius of the momentum sphere on screen [display units].
+SPHERE_RADIUS = 0.8
+#: The body axes reach this far past the sphere.
+AXIS_REACH = 1.25
+#: Widths of the curves [screen px].
+FAMILY_WIDTH_PX = 2.0
+CURRENT_WIDTH_PX = 4.5
+#: Family kinds, their node suffix and colour.
+KINDS: dict[str, tuple[tuple[Regime, ...], tuple[int, int, int]]] = {
+    "minor": ((Regime.MINOR_AXIS,), colors.MINOR_FAMILY),
+    "major": ((Regime.MAJOR_AXIS,), colors.MAJOR_FAMILY),
+    "separatrix": ((Regime.SEPARATRIX,), colors.SEPARATRIX),
+}
+
+
+def family_segments(
+    curves: Iterable[PolhodeCurve], scale: float, momentum: bool = False
+) -> dict[str, np.ndarray]:
+    """The curves of a family, by kind ("minor", "major", "separatrix"), as line segments in
+    display units (ω, or ``m = I ω`` if ``momentum``, times ``scale``). A permanent rotation
+    (a point) draws nothing."""
+    by_kind: dict[str, list[tuple[np.ndarray, bool]]] = {kind: [] for kind in KINDS}
+    for curve in curves:
+        points = curve.momentum if momentum else curve.omega
+        for kind, (regimes, _) in KINDS.items():
+            if curve.regime in regimes and len(points) > 1:
+                by_kind[kind].append((points * scale, curve.closed))
+    return {kind: many_segments(parts) for kind, parts in by_kind.items()}
+
+
+def current_segments(curves: Iterable[PolhodeCurve], scale: float, momentum: bool) -> np.ndarray:
+    """All curves of one D in one line-segments array (display units)."""
+    return many_segments(
+        ((c.momentum if momentum else c.omega) * scale, c.closed)
+        for c in curves
+        if len(c.omega) > 1
+    )
+
+
+def momentum_nodes(root: str, *, family: bool, current: bool, trace: bool) -> tuple[str, ...]:
+    """The node names of a :class:`MomentumPicture` under ``root`` (its group)."""
+    names = [root, f"{root}/sphere", f"{root}/ellipsoid", f"{root}/m", f"{root}/label"]
+    names += [f"{root}/axis{i}" for i in (1, 2, 3)]
+    if family:
+        names += [f"{root}/{kind}" for kind in KINDS]
+    if current:
+        names.append(f"{root}/polhode")
+    if trace:
+        names.append(f"{root}/trace")
+    return tuple(names)
+
+
+class MomentumPicture:
+    """The nodes of Landau's picture under the group ``root``, posed at ``offset`` in space."""
+
+    def __init__(
+        self,
+        parts: Parts,
+        part: str,
+        root: str,
+        offset: ArrayLike,
+        *,
+        title: str,
+        family: bool = False,
+        current: bool = False,
+        trace_points: int = 0,
+    ) -> None:
+        self.root = root
+        parts.frame(part, root, offset)
+        sphere = unit_sphere()
+        self.sphere = parts.surface(
+            part, f"{root}/sphere", sphere, colors.SPHERE, colors.SPHERE_OPACITY
+        )
+        self.ellipsoid = parts.surface(
+            part, f"{root}/ellipsoid", sphere, colors.ELLIPSOID, colors.ELLIPSOID_OPACITY
+        )
+        self.axes = [
+            parts.lines(part, f"{root}/axis{i + 1}", palette.AXES[i], palette.AXIS_WIDTH_PX)
+            for i in range(3)
+        ]
+        self.family = {
+            kind: parts.lines(part, f"{root}/{kind}", color, FAMILY_WIDTH_PX)
+            for kind, (_, color) in KINDS.items()
+            if family
+        }
+        self.current = (
+            parts.lines(part, f"{root}/polhode", colors.CURRENT, CURRENT_WIDTH_PX)
+            if current
+            else None
+        )
+        self.trace = (
+            parts.trail(part, f"{root}/trace", colors.MOMENTUM_TRACE, 3.0, trace_points)
+            if trace_points
+            else None
+        )
+        self.marker = parts.marker(part, f"{root}/m", colors.MOMENTUM)
+        self.label = parts.label(
+            part, f"{root}/label", title, (-SPHERE_RADIUS, 0.0, 1.35 * SPHERE_RADIUS)
+        )
+        self.scale = 1.0
+
+    def fit(self, G: float, semi_axes: ArrayLike, curves: list[PolhodeCurve]) -> None:
+        """Sphere ``|m| = G``, the ellipsoid's semi-axes (physical), and the curves: the family
+        (coloured by kind) or the current D's curves, whichever this picture draws."""
+        scale = SPHERE_RADIUS / float(G)
+        reach = AXIS_REACH * max(SPHERE_RADIUS, scale * float(np.max(semi_axes)))
+        self.scale = scale
+        self.sphere.scale = (SPHERE_RADIUS,) * 3
+        self.ellipsoid.scale = triple(np.asarray(semi_axes, dtype=float) * scale)
+        for i, line in enumerate(self.axes):
+            end = np.zeros(3)
+            end[i] = reach
+            line.points = np.array([[-end, end]], dtype=np.float32)
+        if self.family:
+            for kind, segs in family_segments(curves, scale, momentum=True).items():
+                self.family[kind].points = segs
+        if self.current is not None:
+            self.current.points = current_segments(curves, scale, momentum=True)
+
+    def show_ellipsoid(self, semi_axes: ArrayLike) -> None:
+        """A new energy ellipsoid (physical semi-axes): one scale message."""
+        self.ellipsoid.scale = triple(np.asarray(semi_axes, dtype=float) * self.scale)
+
+    def show_m(self, m: ArrayLike) -> None:
+        """The point ``m`` (physical, body frame): one position message."""
+        self.marker.position = triple(np.asarray(m, dtype=float) * self.scale)
