@@ -1,7 +1,7 @@
 """Command line: ``poinsot [serve] [--host H] [--port P] [--preset NAME]`` and offline commands.
 
-``poinsot`` serves the live app; ``report``, ``screenshot``, ``export-html`` and ``benchmark``
-are the offline commands.
+``poinsot`` serves the live app; ``report``, ``screenshot``, ``export-html``, ``benchmark`` and
+``fit`` (the exact free motion fitted to a gyroscope recording) are the offline commands.
 
 Every option of every command is declared here (:func:`build_parser`). Each subcommand sets
 ``func``, its implementation, which takes its options as plain typed keyword arguments named
@@ -14,9 +14,12 @@ from __future__ import annotations
 
 import argparse
 import inspect
+import math
 import pathlib
+import sys
 import time
 from collections.abc import Callable, Sequence
+from typing import NoReturn
 
 from poinsot.app.exports.html import HTML_FPS
 from poinsot.app.exports.screenshot import parse_size, resolve_scene
@@ -26,6 +29,13 @@ from poinsot.app.scenes import scene_by_name, scene_names
 from poinsot.app.scenes.spec import SceneSpec
 
 DESCRIPTION = "Poinsot: torque-free rigid-body motion, live in the browser and offline."
+
+
+class CommandParser(argparse.ArgumentParser):
+    """A subcommand's parser: a bad option is one line on stderr (exit status 2)."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 # -- converters (text -> value; a readable error for argparse) ------------------------------
@@ -48,6 +58,17 @@ def _scene_only(name: str) -> SceneSpec:
         return scene_by_name(name)
     except KeyError as exc:
         raise argparse.ArgumentTypeError(exc.args[0]) from exc
+
+
+def _seconds(text: str) -> float:
+    """A time in seconds: a finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds")
+    return value
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -112,6 +133,37 @@ def export_html(
     from poinsot.app.exports.html import export_html_command
 
     return export_html_command(out, preset, seconds=seconds, fps=fps, view=view, light=light)
+
+
+def fit(
+    path: pathlib.Path,
+    start: float | None,
+    end: float | None,
+    json_out: pathlib.Path | None,
+    plot_out: pathlib.Path | None,
+    degrees: bool,
+    fit_rotation: bool,
+    fit_bias: bool,
+) -> int:
+    """Fit the exact free motion to each toss of a recording (see :mod:`poinsot.app.fitting`)."""
+    from poinsot.app.fitting import run_fit
+
+    if start is not None and end is not None and not start < end:
+        print(
+            f"poinsot fit: the start ({start:g} s) must come before the end ({end:g} s)",
+            file=sys.stderr,
+        )
+        return 2
+    return run_fit(
+        path,
+        start=start,
+        end=end,
+        json_out=json_out,
+        plot_out=plot_out,
+        degrees=degrees,
+        fit_rotation=fit_rotation,
+        fit_bias=fit_bias,
+    )
 
 
 def benchmark(clients: list[int], seconds: float, redraws: int) -> int:
@@ -237,6 +289,44 @@ def _add_benchmark_arguments(parser: argparse.ArgumentParser) -> None:
     parser.set_defaults(func=benchmark)
 
 
+def _add_fit_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "path",
+        type=pathlib.Path,
+        metavar="PATH",
+        help="a phyphox export (folder or .zip) or a CSV of t, ωx, ωy, ωz",
+    )
+    parser.add_argument(
+        "--start", type=_seconds, metavar="S", help="fit only from this time [s] (one stretch)"
+    )
+    parser.add_argument(
+        "--end", type=_seconds, metavar="E", help="fit only up to this time [s] (one stretch)"
+    )
+    parser.add_argument(
+        "--json", dest="json_out", type=pathlib.Path, metavar="OUT", help="write the fits as JSON"
+    )
+    parser.add_argument(
+        "--plot",
+        dest="plot_out",
+        type=pathlib.Path,
+        metavar="OUT.png",
+        help="plot the measured ω against the fits (needs matplotlib)",
+    )
+    parser.add_argument(
+        "--deg", dest="degrees", action="store_true", help="the plain CSV is in deg/s"
+    )
+    parser.add_argument(
+        "--rotation",
+        dest="fit_rotation",
+        action="store_true",
+        help="also fit a small rotation between the sensor's and the principal axes",
+    )
+    parser.add_argument(
+        "--bias", dest="fit_bias", action="store_true", help="also fit a constant gyroscope bias"
+    )
+    parser.set_defaults(func=fit)
+
+
 #: Subcommand -> (help, how its options are declared).
 _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] = {
     "serve": ("serve the interactive scene (the default)", _add_serve_arguments),
@@ -253,13 +343,17 @@ _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] =
         "server time per client-frame, bytes per frame and slider-to-redraw time",
         _add_benchmark_arguments,
     ),
+    "fit": (
+        "fit the exact free motion to the tosses of a gyroscope recording (phyphox or CSV)",
+        _add_fit_arguments,
+    ),
 }
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="poinsot", description=DESCRIPTION)
     _add_serve_arguments(parser)  # `poinsot --host ...` is `poinsot serve --host ...`
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=CommandParser)
     for name, (help_text, add_arguments) in _SUBCOMMANDS.items():
         add_arguments(sub.add_parser(name, help=help_text))
     return parser
