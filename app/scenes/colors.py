@@ -21,13 +21,13 @@ SPHERE: RGB = (150, 125, 255)
 SPHERE_OPACITY = 0.22
 ELLIPSOID: RGB = palette.ELLIPSOID
 ELLIPSOID_OPACITY = 0.3
-#: The moving point m = I ω on Landau's picture, and its trace.
+#: The moving point m = I ω on Landau's picture, and its trace (a polhode: the polhode pink).
 MOMENTUM: RGB = (255, 255, 255)
-MOMENTUM_TRACE: RGB = palette.HERPOLHODE
+MOMENTUM_TRACE: RGB = palette.POLHODE
 #: Cones of the symmetric top: the body cone (rides with the body), the space cone (fixed).
 BODY_CONE: RGB = (255, 120, 200)
 SPACE_CONE: RGB = (90, 230, 160)
-CONE_OPACITY = 0.25
+CONE_OPACITY = 0.33
 #: The gyroscope: its symmetry axis, the torque, the drift of the axis and the axis's path.
 SYMMETRY_AXIS: RGB = palette.AXES[2]
 TORQUE: RGB = (255, 90, 60)

@@ -146,9 +146,13 @@ class Parts:
         return handle
 
     def frame(
-        self, part: str, name: str, position: ArrayLike = (0.0, 0.0, 0.0)
+        self,
+        part: str,
+        name: str,
+        position: ArrayLike = (0.0, 0.0, 0.0),
+        wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0),
     ) -> viser.FrameHandle:
-        handle = self.api.add_frame(name, show_axes=False, position=triple(position))
+        handle = self.api.add_frame(name, show_axes=False, position=triple(position), wxyz=wxyz)
         self.keep(part, handle)
         return handle
 

@@ -9,10 +9,11 @@ spin about the major axis, end over end [BG58]. The stated law here is
 dT/dt = −κ(2T − |L|²/I₃): 2T decays exponentially to its minimum |L|²/I₃ at this |L|.
 
 Left, the satellite in space (L fixed and vertical, ω moving); right, the body-frame momentum
-sphere |m| = |L| with the polhode family on it (coloured by kind) and the shrinking energy
-ellipsoid Σ mᵢ²/Iᵢ = 2T(t): the point m(t) sweeps across the family, from the curves around
-the minor axis, over the separatrix, onto those around the major axis. A plot shows D(t), the
-law against the motion, with I₂ marked.
+sphere |m| = |L| with the polhode family on it (coloured by kind): the point m(t) and its trace
+sweep across the family, from the curves around the minor axis, over the separatrix, onto
+those around the major axis (the energy ellipsoid Σ mᵢ²/Iᵢ = 2T(t) that cuts the sphere along
+the current curve shrinks meanwhile; it is left out: at the start it dwarfs the sphere). A
+plot shows D(t), the law against the motion, with I₂ marked.
 
 Readouts: the separatrix crossing t* of the law against the first time the motion's D reaches
 I₂; |L| kept and L fixed in space (measured on the motion shown); D and the family now; the
@@ -63,7 +64,7 @@ CYLINDER = (2.0, 0.12)  # length, radius
 ANTENNA = (0.8, 0.02)  # length of each, radius
 #: The initial spin [rad/time] and its small tilt from the long axis [rad].
 SPIN = 3.0
-TILT = math.radians(2.0)
+TILT = math.radians(0.5)
 #: The dissipation rates offered [1/time], and how long after t* the motion runs: a few 1/κ.
 KAPPAS = ("0.05", "0.1", "0.2", "0.5")
 AFTER_CROSSING = 2.5
@@ -73,8 +74,10 @@ PLOT_SAMPLES = 500
 #: Display: the satellite's length, the ω arrow's longest length, the L arrow, the sphere's place.
 SATELLITE_LENGTH = 1.6
 OMEGA_LENGTH = 1.0
+OMEGA_MIN = 0.35
 L_LENGTH = 1.3
 MOMENTUM_OFFSET = (2.9, 0.0, 0.1)
+MOMENTUM_TURN = math.radians(-40.0)
 ROOT = "/space"
 SATELLITE_NODE = f"{ROOT}/body/satellite"
 OMEGA_NODE = f"{ROOT}/satellite_omega"
@@ -200,8 +203,8 @@ def build(settings: Settings) -> SinkModel:
 
 
 class SatelliteDrawing:
-    """The satellite, ω and L in space; the momentum sphere with the family, the shrinking
-    ellipsoid and the trace of m(t) beside it."""
+    """The satellite, ω and L in space; the momentum sphere with the family and the trace of
+    m(t) beside it."""
 
     def __init__(self, canvas: Canvas) -> None:
         self.canvas = canvas
@@ -219,9 +222,11 @@ class SatelliteDrawing:
             "momentum",
             MOMENTUM_ROOT,
             MOMENTUM_OFFSET,
-            title="body frame: |m| = |L|,  Σ mᵢ²/Iᵢ = 2T(t)",
+            title="body frame: m(t) on the sphere |m| = |L|",
             family=True,
             trace_points=4000,
+            ellipsoid=False,
+            turn=MOMENTUM_TURN,
         )
         self.player: Player | None = None
 
@@ -229,20 +234,20 @@ class SatelliteDrawing:
         assert isinstance(model, SinkModel)
         sink, picture = model.sink, self.picture
         J = sink.inertia
-        two_T = np.sum(J * model.omega * model.omega, axis=1)
-        picture.fit(sink.G, np.sqrt(two_T[0] * J), model.family)
-        reach = float(np.max(np.linalg.norm(model.omega, axis=1)))
+        picture.fit(sink.G, model.family)
+        # ω slows down tenfold from the spin to the flat spin: the arrow keeps a visible length
+        # (OMEGA_MIN of the longest) and grows with |ω|.
+        speed = np.linalg.norm(model.omega, axis=1)
+        length = OMEGA_LENGTH * (OMEGA_MIN + (1.0 - OMEGA_MIN) * speed / float(speed.max()))
         arrows = np.zeros((len(model.times), 1, 2, 3), np.float32)
-        arrows[:, 0, 1] = rotations.rotate(model.quaternions, model.omega) * (OMEGA_LENGTH / reach)
+        space = rotations.rotate(model.quaternions, model.omega)
+        arrows[:, 0, 1] = space * (length / speed)[:, None]
         scale = SPHERE_RADIUS / sink.G
         table = Table(
             1.0 / ROWS_PER_TIME,
             wxyz_from_xyzw(model.quaternions),
             model.omega,
-            {
-                "trace": (model.omega * J * scale).astype(np.float32),
-                "ellipsoid": np.sqrt(two_T[:, None] * J) * scale,
-            },
+            {"trace": (model.omega * J * scale).astype(np.float32)},
             {"omega": arrows},
         )
         self.player = Player(table, {"trace": picture.trace} if picture.trace else {})
@@ -255,7 +260,6 @@ class SatelliteDrawing:
         self.canvas.body.wxyz = table.wxyz[row]
         self.omega.points = table.arrows["omega"][row]
         picture.marker.position = triple(table.points["trace"][row])
-        picture.ellipsoid.scale = triple(table.points["ellipsoid"][row])
         cycle, _ = table.locate(t)
         time = cycle * table.span + row * table.dt
         return table.frame(time, row, table.points["trace"][row], samples)
@@ -278,17 +282,17 @@ SPEC = SceneSpec(
     ),
     body="a cylinder 2 long, radius 0.12, with two whip antennas 0.8 long (Explorer 1 "
     "simplified), moments by trimesh, normalised to I₃ = 1",
-    motion="EnergySink(I, ω₀ = 3 at 2° from e₁, κ, t* + 2.5/κ): exact in short windows; "
+    motion="EnergySink(I, ω₀ = 3 at 0.5° from e₁, κ, t* + 2.5/κ): exact in short windows; "
     "polhode_family on the sphere |m| = G",
     elements=frozenset(),
     parts=(
         Part("satellite", "the satellite", (SATELLITE_NODE,), surface=colors.SOLID),
-        Part("omega", "ω", (OMEGA_NODE,), surface=colors.OMEGA),
+        Part("omega", "ω (its direction)", (OMEGA_NODE,), surface=colors.OMEGA),
         Part("L", "L (fixed)", (L_NODE,), surface=colors.L),
         Part(
             "momentum",
             "momentum sphere and family",
-            momentum_nodes(MOMENTUM_ROOT, family=True, current=False, trace=True),
+            momentum_nodes(MOMENTUM_ROOT, family=True, current=False, trace=True, ellipsoid=False),
             (colors.MINOR_FAMILY, colors.MAJOR_FAMILY, colors.SEPARATRIX, colors.MOMENTUM_TRACE),
             trails=(f"{MOMENTUM_ROOT}/trace",),
             surface=colors.SPHERE,
@@ -330,5 +334,5 @@ SPEC = SceneSpec(
     draw=SatelliteDrawing,
     view=View(position=(2.6, -6.0, 2.4), look_at=(1.45, 0.0, 0.1)),
     speed=2.0,
-    picture_time=60.0,
+    picture_time=48.0,
 )

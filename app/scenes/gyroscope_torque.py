@@ -35,6 +35,7 @@ from poinsot.app.scene import meshes
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.frames import wxyz_from_xyzw
 from poinsot.app.scene.geometry import Geometry
+from poinsot.app.scene.view import View
 from poinsot.app.scenes import colors
 from poinsot.app.scenes.drawing import THIN_ARROW, Parts, arrow_points
 from poinsot.app.scenes.spec import (
@@ -200,7 +201,9 @@ class GyroDrawing:
         axis = parts.lines("axis", AXIS_NODE, colors.SYMMETRY_AXIS, 3.0)
         axis.points = np.array([[[0, 0, -AXIS_LENGTH], [0, 0, AXIS_LENGTH]]], np.float32)
         self.torque = parts.arrow("torque", TORQUE_NODE, colors.TORQUE, THIN_ARROW)
+        self.torque_label = parts.label("torque", f"{TORQUE_NODE}_label", "M", (0, 1, 0))
         self.drift = parts.arrow("drift", DRIFT_NODE, colors.DRIFT, THIN_ARROW)
+        self.drift_label = parts.label("drift", f"{DRIFT_NODE}_label", "drift", (0, 0, 1))
         self.omega = parts.arrow("omega", OMEGA_NODE, colors.OMEGA, THIN_ARROW)
         self.path = parts.trail("path", PATH_NODE, colors.AXIS_PATH, 3.0, 2400)
         self.player: Player | None = None
@@ -221,10 +224,15 @@ class GyroDrawing:
             {"path": tip.astype(np.float32)},
             {"omega": arrows},
         )
-        torque = 0.25 + 0.5 * min(1.0, abs(g.torque))
-        self.torque.points = arrow_points((0, 0, 0), (0, math.copysign(torque, g.torque), 0))
+        # The torque from the disc's rim outwards along ±x₂ (longer for a larger |M|), the drift
+        # from the axis's tip: the mean displacement of the tip in DRIFT_TIME.
+        side = math.copysign(1.0, g.torque)
+        reach = DISC_RADIUS + 0.15 + 0.45 * min(1.0, abs(g.torque))
+        self.torque.points = arrow_points((0, side * DISC_RADIUS, 0), (0, side * reach, 0))
+        self.torque_label.position = (0.0, side * reach, 0.05)
         shift = g.drift_rate * DRIFT_TIME * AXIS_LENGTH
         self.drift.points = arrow_points((0, 0, AXIS_LENGTH), (0, shift, AXIS_LENGTH))
+        self.drift_label.position = (0.0, shift, AXIS_LENGTH + 0.05)
         self.player = Player(table, {"path": self.path})
 
     def advance(self, t: float, frame: Frame | None) -> Frame:
@@ -261,8 +269,18 @@ SPEC = SceneSpec(
     parts=(
         Part("gyroscope", "the disc", (DISC_NODE,), surface=colors.SOLID),
         Part("axis", "symmetry axis e₃", (AXIS_NODE,), (colors.SYMMETRY_AXIS,)),
-        Part("torque", "torque M (along x₂)", (TORQUE_NODE,), surface=colors.TORQUE),
-        Part("drift", "mean drift of the axis", (DRIFT_NODE,), surface=colors.DRIFT),
+        Part(
+            "torque",
+            "torque M (along x₂)",
+            (TORQUE_NODE, f"{TORQUE_NODE}_label"),
+            surface=colors.TORQUE,
+        ),
+        Part(
+            "drift",
+            "mean drift of the axis",
+            (DRIFT_NODE, f"{DRIFT_NODE}_label"),
+            surface=colors.DRIFT,
+        ),
         Part("omega", "ω", (OMEGA_NODE,), surface=colors.OMEGA),
         Part("path", "path of the axis", (PATH_NODE,), (colors.AXIS_PATH,), trails=(PATH_NODE,)),
     ),
@@ -293,6 +311,7 @@ SPEC = SceneSpec(
     ),
     build=build,
     draw=GyroDrawing,
+    view=View(position=(2.3, -2.9, 2.5), look_at=(0.0, 0.0, 0.45)),
     speed=1.0,
     picture_time=12.0,
 )

@@ -5,12 +5,13 @@ In the body frame the angular momentum ``m = I ω`` lies on the sphere ``|m| = G
 no torque acts) and on the energy ellipsoid ``Σ mᵢ²/Iᵢ = 2T`` (semi-axes ``sqrt(2T Iᵢ)``); the
 curve where the two meet is the polhode, mapped by ``I``. The group shows the sphere, the
 ellipsoid, their intersection (or the whole family), the body axes and the moving point
-``m(t)``, scaled so that the sphere has radius :data:`SPHERE_RADIUS` (display units). Every
-number comes from :mod:`poinsot.physics.family`.
+``m(t)``, scaled so that the sphere has a given radius (display units). Every number comes
+from :mod:`poinsot.physics.family`.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 
 import numpy as np
@@ -23,12 +24,13 @@ from poinsot.app.scenes.drawing import Parts, many_segments, unit_sphere
 from poinsot.physics import Regime
 from poinsot.physics.family import PolhodeCurve
 
-#: Radius of the momentum sphere on screen [display units].
+#: Radius of the momentum sphere on screen [display units], unless a scene says otherwise.
 SPHERE_RADIUS = 0.8
 #: The body axes reach this far past the sphere.
 AXIS_REACH = 1.25
-#: Widths of the curves [screen px].
+#: Widths of the curves [screen px] (the separatrix a little wider: it splits the families).
 FAMILY_WIDTH_PX = 2.0
+SEPARATRIX_WIDTH_PX = 3.0
 CURRENT_WIDTH_PX = 4.5
 #: Family kinds, their node suffix and colour.
 KINDS: dict[str, tuple[tuple[Regime, ...], tuple[int, int, int]]] = {
@@ -36,6 +38,11 @@ KINDS: dict[str, tuple[tuple[Regime, ...], tuple[int, int, int]]] = {
     "major": ((Regime.MAJOR_AXIS,), colors.MAJOR_FAMILY),
     "separatrix": ((Regime.SEPARATRIX,), colors.SEPARATRIX),
 }
+
+
+def family_width(kind: str) -> float:
+    """The line width of a family kind [screen px]."""
+    return SEPARATRIX_WIDTH_PX if kind == "separatrix" else FAMILY_WIDTH_PX
 
 
 def family_segments(
@@ -62,10 +69,14 @@ def current_segments(curves: Iterable[PolhodeCurve], scale: float, momentum: boo
     )
 
 
-def momentum_nodes(root: str, *, family: bool, current: bool, trace: bool) -> tuple[str, ...]:
+def momentum_nodes(
+    root: str, *, family: bool, current: bool, trace: bool, ellipsoid: bool = True
+) -> tuple[str, ...]:
     """The node names of a :class:`MomentumPicture` under ``root`` (its group)."""
-    names = [root, f"{root}/sphere", f"{root}/ellipsoid", f"{root}/m", f"{root}/label"]
+    names = [root, f"{root}/sphere", f"{root}/m", f"{root}/label"]
     names += [f"{root}/axis{i}" for i in (1, 2, 3)]
+    if ellipsoid:
+        names.append(f"{root}/ellipsoid")
     if family:
         names += [f"{root}/{kind}" for kind in KINDS]
     if current:
@@ -89,22 +100,33 @@ class MomentumPicture:
         family: bool = False,
         current: bool = False,
         trace_points: int = 0,
+        ellipsoid: bool = True,
+        radius: float = SPHERE_RADIUS,
+        turn: float = 0.0,
     ) -> None:
+        """``turn``: the group is turned by this angle [rad] about the vertical, to show the
+        curves around the first axis less edge-on."""
         self.root = root
-        parts.frame(part, root, offset)
+        self.radius = float(radius)
+        half = 0.5 * float(turn)
+        parts.frame(part, root, offset, (math.cos(half), 0.0, 0.0, math.sin(half)))
         sphere = unit_sphere()
         self.sphere = parts.surface(
             part, f"{root}/sphere", sphere, colors.SPHERE, colors.SPHERE_OPACITY
         )
-        self.ellipsoid = parts.surface(
-            part, f"{root}/ellipsoid", sphere, colors.ELLIPSOID, colors.ELLIPSOID_OPACITY
+        self.ellipsoid = (
+            parts.surface(
+                part, f"{root}/ellipsoid", sphere, colors.ELLIPSOID, colors.ELLIPSOID_OPACITY
+            )
+            if ellipsoid
+            else None
         )
         self.axes = [
             parts.lines(part, f"{root}/axis{i + 1}", palette.AXES[i], palette.AXIS_WIDTH_PX)
             for i in range(3)
         ]
         self.family = {
-            kind: parts.lines(part, f"{root}/{kind}", color, FAMILY_WIDTH_PX)
+            kind: parts.lines(part, f"{root}/{kind}", color, family_width(kind))
             for kind, (_, color) in KINDS.items()
             if family
         }
@@ -120,18 +142,23 @@ class MomentumPicture:
         )
         self.marker = parts.marker(part, f"{root}/m", colors.MOMENTUM)
         self.label = parts.label(
-            part, f"{root}/label", title, (-SPHERE_RADIUS, 0.0, 1.35 * SPHERE_RADIUS)
+            part, f"{root}/label", title, (-self.radius, 0.0, 1.35 * self.radius)
         )
         self.scale = 1.0
 
-    def fit(self, G: float, semi_axes: ArrayLike, curves: list[PolhodeCurve]) -> None:
-        """Sphere ``|m| = G``, the ellipsoid's semi-axes (physical), and the curves: the family
-        (coloured by kind) or the current D's curves, whichever this picture draws."""
-        scale = SPHERE_RADIUS / float(G)
-        reach = AXIS_REACH * max(SPHERE_RADIUS, scale * float(np.max(semi_axes)))
+    def fit(self, G: float, curves: list[PolhodeCurve], semi_axes: ArrayLike | None = None) -> None:
+        """Sphere ``|m| = G``, the curves (the family coloured by kind, or the current D's
+        curves, whichever this picture draws) and the ellipsoid's semi-axes (physical; if it
+        draws one)."""
+        scale = self.radius / float(G)
+        extent = self.radius
+        if self.ellipsoid is not None and semi_axes is not None:
+            semi = np.asarray(semi_axes, dtype=float) * scale
+            self.ellipsoid.scale = triple(semi)
+            extent = max(extent, float(np.max(semi)))
+        reach = AXIS_REACH * extent
         self.scale = scale
-        self.sphere.scale = (SPHERE_RADIUS,) * 3
-        self.ellipsoid.scale = triple(np.asarray(semi_axes, dtype=float) * scale)
+        self.sphere.scale = (self.radius,) * 3
         for i, line in enumerate(self.axes):
             end = np.zeros(3)
             end[i] = reach
@@ -141,10 +168,6 @@ class MomentumPicture:
                 self.family[kind].points = segs
         if self.current is not None:
             self.current.points = current_segments(curves, scale, momentum=True)
-
-    def show_ellipsoid(self, semi_axes: ArrayLike) -> None:
-        """A new energy ellipsoid (physical semi-axes): one scale message."""
-        self.ellipsoid.scale = triple(np.asarray(semi_axes, dtype=float) * self.scale)
 
     def show_m(self, m: ArrayLike) -> None:
         """The point ``m`` (physical, body frame): one position message."""

@@ -35,11 +35,11 @@ from poinsot.app.scenes import colors
 from poinsot.app.scenes.drawing import Parts
 from poinsot.app.scenes.momentum import (
     CURRENT_WIDTH_PX,
-    FAMILY_WIDTH_PX,
     KINDS,
     MomentumPicture,
     current_segments,
     family_segments,
+    family_width,
     momentum_nodes,
 )
 from poinsot.app.scenes.spec import (
@@ -76,7 +76,8 @@ PER_FAMILY = 4
 #: The D slider's step; a value within half a step of I₂ is the separatrix itself.
 D_STEP = 0.005
 #: Landau's picture stands this far to the side (space x, display units).
-LANDAU_OFFSET = (3.3, 0.0, 0.15)
+LANDAU_OFFSET = (2.75, 0.0, 0.1)
+LANDAU_RADIUS = 0.62
 ROOT = "/space"
 FAMILY_ROOT = f"{ROOT}/body/family"
 CURRENT_NODE = f"{ROOT}/body/current_polhode"
@@ -190,7 +191,7 @@ class FamilyDrawing:
         self.parts = Parts(canvas.api)
         self.parts.frame("family", FAMILY_ROOT)
         self.family = {
-            kind: self.parts.lines("family", f"{FAMILY_ROOT}/{kind}", color, FAMILY_WIDTH_PX)
+            kind: self.parts.lines("family", f"{FAMILY_ROOT}/{kind}", color, family_width(kind))
             for kind, (_, color) in KINDS.items()
         }
         self.current = self.parts.lines("current", CURRENT_NODE, colors.CURRENT, CURRENT_WIDTH_PX)
@@ -201,6 +202,7 @@ class FamilyDrawing:
             LANDAU_OFFSET,
             title="Landau: |L| = G  ∩  Σ Lᵢ²/Iᵢ = 2T",
             current=True,
+            radius=LANDAU_RADIUS,
         )
         self.model: FamilyModel | None = None
 
@@ -215,7 +217,7 @@ class FamilyDrawing:
             self.family[kind].points = segs
         self.current.points = current
         view = model.landau
-        self.landau.fit(view.sphere_radius, view.ellipsoid_semi_axes, view.curves)
+        self.landau.fit(view.sphere_radius, view.curves, view.ellipsoid_semi_axes)
         self.model = model
 
     def advance(self, t: float, frame: Frame | None) -> Frame:
@@ -295,7 +297,7 @@ SPEC = SceneSpec(
     plots=(),
     build=build,
     draw=FamilyDrawing,
-    view=View(position=(3.2, -6.2, 2.6), look_at=(1.65, 0.0, 0.05)),
+    view=View(position=(2.6, -5.4, 2.6), look_at=(1.35, 0.0, 0.3)),
     speed=1.0,
     trail_points=1600,
     picture_time=6.0,

@@ -57,8 +57,9 @@ from poinsot.physics.symmetric import (
 SHAPES = {"oblate (a disc)": preset_by_key("oblate"), "prolate (a rod)": preset_by_key("prolate")}
 #: |ω₀| [rad/time].
 SPIN = 1.2
-#: Generators of the drawn cones.
+#: Sections of the drawn cones, and the generators drawn as lines.
 CONE_SECTIONS = 96
+GENERATORS = 12
 #: The rates are measured over this many precession periods.
 MEASURE_TURNS = 3.0
 #: Samples of the motion used to read the cones' angles.
@@ -178,7 +179,9 @@ class ConesDrawing:
             vertices, faces = cone_mesh(rim)
             surface.vertices = vertices.astype(np.float32)
             surface.faces = faces.astype(np.uint32)
-            line.points = segments(rim, closed=True)
+            generators = np.zeros((GENERATORS, 2, 3), np.float32)
+            generators[:, 1] = rim[:: CONE_SECTIONS // GENERATORS]
+            line.points = np.concatenate([segments(rim, closed=True), generators])
 
     def advance(self, t: float, frame: Frame | None) -> Frame:
         if frame is None:
