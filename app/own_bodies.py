@@ -65,6 +65,8 @@ class FittedToss:
         tau: (n,) times of the kept samples since the segment's first [s].
         measured: (n, 3) the measured ω at ``tau`` [rad/s], sensor axes.
         exact: (n, 3) the fitted exact solution at ``tau`` [rad/s].
+        bound: no component of ω, measured or exact, exceeds it [rad/s]: the energy
+            ellipsoid's largest semi-axis (I_k ω_k² <= 2T), or a noisy sample beyond it.
     """
 
     name: str
@@ -74,6 +76,7 @@ class FittedToss:
     tau: NDArray[np.float64]
     measured: NDArray[np.float64]
     exact: NDArray[np.float64]
+    bound: float
 
     @property
     def fit(self) -> AngularVelocityFit:
@@ -155,9 +158,12 @@ def _toss(name: str, index: int, count: int, result: SegmentFit) -> FittedToss:
     exact = np.asarray(fit.predict(t), dtype=np.float64)
     measured = np.asarray(segment.omega[::stride], dtype=np.float64)
     tau = np.asarray(t - fit.t0, dtype=np.float64)
-    if not (np.all(np.isfinite(exact)) and np.all(np.isfinite(measured))):
+    bound = max(float(np.max(fit.body.semi_axes)), float(np.max(np.abs(measured))))
+    if not (np.all(np.isfinite(exact)) and np.all(np.isfinite(measured))) or not (
+        math.isfinite(bound) and bound > 0.0
+    ):
         raise ValueError(f"{name}: the fitted motion is not finite; nothing is shown")
-    return FittedToss(name, index, count, result, tau, measured, exact)
+    return FittedToss(name, index, count, result, tau, measured, exact, bound)
 
 
 def toss_preset(toss: FittedToss) -> Preset:

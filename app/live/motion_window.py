@@ -15,7 +15,7 @@ import viser
 import viser.uplot
 
 from poinsot.app.live import readouts
-from poinsot.app.live.overlay import Measured, measured_series, merge
+from poinsot.app.live.overlay import LEGEND, Measured, measured_series, merge
 from poinsot.app.scene import palette
 
 #: Number of plot samples kept (one per plot refresh, 10 per second: the last 30 s).
@@ -39,7 +39,7 @@ class MotionWindow:
         self._t: list[float] = []
         self._omega: list[np.ndarray] = []
         #: An uploaded toss's samples, drawn when the plot was added with ``measured=True``.
-        self.measured: Measured | None = None
+        self.measured = Measured(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))
         self._with_measured = False
 
     # -- the plot's lifecycle (the panel declares and retires it) ---------------------------
@@ -60,13 +60,26 @@ class MotionWindow:
                 data=(np.array([0.0, 1.0]), *[zeros] * (len(series) - 1)),
                 series=tuple(series),
                 title=title,
-                scales=palette.plot_scales(),
+                scales=self.measured.scales() if measured else palette.plot_scales(),
                 axes=palette.plot_axes(),
+                legend=LEGEND if measured else None,
                 aspect=1.7,
                 order=2.0,
             )
         self.clear_plot()
         return self.plot
+
+    def show_measured(self, measured: Measured) -> None:
+        """The samples of an uploaded toss, drawn by a plot added with ``measured=True``."""
+        self.measured = measured
+        if self.plot is not None and self._with_measured:
+            self.plot.scales = measured.scales()
+
+    def restore_plot(self, plot: viser.GuiUplotHandle) -> None:
+        """The plot of ω, put away by the panel, is shown again: record into it afresh."""
+        self.plot = plot
+        self._with_measured = False
+        self.clear_plot()
 
     def forget_plot(self) -> None:
         """The plot was removed (by the panel): stop recording."""
@@ -102,10 +115,9 @@ class MotionWindow:
         if self.plot is None or len(self._t) < 2:
             return False
         w = np.asarray(self._omega)
-        data = (np.asarray(self._t), w[:, 0].copy(), w[:, 1].copy(), w[:, 2].copy())
+        data: tuple[np.ndarray, ...] = (np.asarray(self._t), *(w[:, i].copy() for i in range(3)))
         if self._with_measured:
-            empty = Measured(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))
-            data = merge(data[0], w, self.measured or empty)
+            data = merge(data[0], w, self.measured)
         if all(np.all(np.isfinite(a)) for a in data[:4]):  # measured NaN: no sample there
             self.plot.data = data
             return True

@@ -8,10 +8,11 @@ samples of the exact solution and the recording's samples are merged in time ord
   when the toss was fitted) and the measured columns the measurement;
 - at a live sample (the motion as it plays, which goes on past the end of the recording) the
   exact columns hold the live value and the measured columns hold NaN: no measurement at
-  that time. The measured series are drawn as dots only, and uPlot draws no dot for NaN and
-  leaves it out of the axis range, so NaN is exactly "no sample" here. It is the one marker a
-  float column can carry (viser sends the plot's columns as float64); it never appears in
-  the exact columns nor in the 3D scene.
+  that time. NaN is the one marker a float column can carry (viser sends the plot's columns
+  as float64); uPlot draws no dot for it (the measured series are dots only, so no line
+  bridges a gap), but its automatic range would turn NaN too, so this plot's ω axis is
+  fixed to ``± bound``, which no component of ω exceeds, and its legend shows no values
+  under the cursor. NaN never appears in the exact columns nor in the 3D scene.
 
 Recording samples are shown from the live window's first time on, so the two stay one picture
 as the window scrolls.
@@ -29,17 +30,21 @@ from poinsot.app.scene import palette
 
 #: Size of a measured dot [CSS px].
 DOT_SIZE = 4.0
+#: The ω axis reaches this much past the largest component.
+MARGIN = 1.08
 
 
 @dataclasses.dataclass(frozen=True)
 class Measured:
     """A recording's samples on the session's clock: ``tau`` (n,) [s] from the fitted motion's
-    start, ``omega`` (n, 3) measured and ``exact`` (n, 3) the fitted solution there; all
-    finite (checked)."""
+    start, ``omega`` (n, 3) measured and ``exact`` (n, 3) the fitted solution there, and
+    ``bound`` [rad/s], which no component of ω (measured or exact, now or later) exceeds;
+    all finite (checked)."""
 
     tau: NDArray[np.float64]
     omega: NDArray[np.float64]
     exact: NDArray[np.float64]
+    bound: float = 1.0
 
     def __post_init__(self) -> None:
         n = self.tau.shape[0]
@@ -48,6 +53,20 @@ class Measured:
         for array in (self.tau, self.omega, self.exact):
             if not np.all(np.isfinite(array)):
                 raise ValueError("measured samples must be finite")
+        if not (np.isfinite(self.bound) and self.bound > 0.0):
+            raise ValueError("the bound on ω must be positive and finite")
+
+    def scales(self) -> dict[str, viser.uplot.Scale]:
+        """Time follows the data; the ω axis is fixed to ± the bound (see the module)."""
+        top = MARGIN * float(self.bound)
+        return {
+            "x": viser.uplot.Scale(time=False, auto=True),
+            "y": viser.uplot.Scale(auto=False, range=(-top, top)),
+        }
+
+
+#: A measured plot's legend: the series' names, no values under the cursor (NaN there).
+LEGEND = viser.uplot.Legend(show=True, live=False)
 
 
 def measured_series() -> list[viser.uplot.Series]:

@@ -13,6 +13,7 @@ time, readouts and the plot of ω are in the floating "Motion" window
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Iterable
 from typing import Any, Protocol, TypeVar
 
@@ -113,9 +114,11 @@ _MIRRORED: dict[Group, str] = {
 
 def slider_range(default: tuple[float, float], values: Iterable[float]) -> tuple[float, float]:
     """A slider's range: ``default``, widened to hold ``values`` (a body of one's own can have
-    a moment below the usual range, or spin faster)."""
+    a moment below the usual range, or spin faster), to round ends (hundredths below, tenths
+    above)."""
     values = [float(v) for v in values]
-    return min(default[0], *values), max(default[1], *values)
+    lo = min(default[0], *(math.floor(100.0 * v) / 100.0 if v >= 0.01 else v for v in values))
+    return lo, max(default[1], *(math.ceil(10.0 * v) / 10.0 for v in values))
 
 
 class ControlPanel:

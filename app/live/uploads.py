@@ -268,7 +268,8 @@ class UploadControls:
         if kind == "toss":
             toss: FittedToss = result
             self.toss, self.toss_preset = toss, preset
-            self.host.panel.motion.measured = Measured(toss.tau, toss.measured, toss.exact)
+            motion = self.host.panel.motion
+            motion.show_measured(Measured(toss.tau, toss.measured, toss.exact, toss.bound))
             self.toss_lines.show(status="", readout=own_bodies.toss_markdown(toss))
         else:
             body: MeshBody = result

@@ -164,6 +164,11 @@ def test_the_plot_draws_the_measured_omega_over_the_exact_one(toss_page, probe):
     np.testing.assert_allclose(x[seen], toss.tau)
     np.testing.assert_allclose(measured[seen], toss.measured)
     assert np.sqrt(np.mean((measured[seen] - exact[seen]) ** 2)) < 0.05  # the noise: 0.02
+    # uPlot cannot range an axis over NaN: the ω axis is fixed, and holds every value
+    y = plot.props["scales"]["y"]
+    assert y["auto"] is False and y["range"][0] == -y["range"][1]
+    assert np.max(np.abs(exact)) < y["range"][1] and np.max(np.abs(measured[seen])) < y["range"][1]
+    assert y["range"][1] < 2.0 * np.linalg.norm(session.params.omega0)  # and is not far off
     # the exact solution goes on past the recording
     session.set_speed(4.0)
     assert probe.wait_for(lambda p: float(the_plot(p).props["data"][0][-1]) > toss.tau[-1], 20)
