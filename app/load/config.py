@@ -13,8 +13,6 @@ from poinsot.app.load.figures import Figure
 SPARE_LIFETIME = 600.0
 #: Pause after the clients connected, before anything is measured (the connection burst).
 WARMUP_SECONDS = 5.0
-#: The others' frame rate is measured for this long before a stall or a flood.
-BEFORE_SECONDS = 15.0
 MB = 1e6
 
 #: Progress lines (to stderr in the command).

@@ -80,10 +80,6 @@ class Window:
     latencies: list[float]  # slider-to-redraw [s]; lost redraws are not in here
     lost_redraws: int
     silent: int  # clients not stalled that received nothing lately
-    cpu_seconds: float  # CPU time of the client process during the window
-
-    def fps_of_running(self) -> list[float]:
-        return [f for f, s in zip(self.fps, self.stalled, strict=True) if not s]
 
 
 def _slide(probe: Probe, client: _Client) -> float | None:
@@ -111,7 +107,6 @@ def _window(
     probes: list[Probe], clients: list[_Client], seconds: float, slider_period: float
 ) -> Window:
     poses0 = [c.poses for c in clients]
-    cpu0 = time.process_time()
     start = time.perf_counter()
     end = start + seconds
     latencies: list[float] = []
@@ -140,7 +135,6 @@ def _window(
         latencies=latencies,
         lost_redraws=lost,
         silent=sum(1 for c in clients if not c.stalled and now - c.last_pose > SILENT_SECONDS),
-        cpu_seconds=time.process_time() - cpu0,
     )
 
 

@@ -4,12 +4,14 @@ A :class:`~poinsot.app.load.raw.RawClient` opens a websocket, sends its camera (
 client with a session of its own, and keeps reading what it is sent), and on ``go`` writes
 viewer-camera messages, what a browser sends while the user orbits, at ``rate`` messages a
 second for ``seconds``: bursts of pre-built frames every 10 ms, so the flooder's own cost stays
-small next to the server's. If the server stops reading, a burst is abandoned at its deadline
-and the flood ends there (what was written is counted).
+small next to the server's. When the server stops reading (its socket buffers are full) the
+writes wait: the rate achieved is then the rate the server took.
 """
 
 from __future__ import annotations
 
+import bisect
+import itertools
 import time
 from multiprocessing.connection import Connection
 from typing import Any
@@ -23,29 +25,30 @@ VARIANTS = 50  # distinct camera messages cycled through
 
 def _flood(client: RawClient, rate: float, seconds: float) -> dict[str, Any]:
     per_tick = max(1, round(rate * TICK))
-    frames = [client_frame(camera_message(i)) for i in range(VARIANTS)]
-    burst = b"".join(frames[i % VARIANTS] for i in range(per_tick))
+    variants = [client_frame(camera_message(i)) for i in range(VARIANTS)]
+    frames = [variants[i % VARIANTS] for i in range(per_tick)]
+    ends = list(itertools.accumulate(len(f) for f in frames))
+    burst = b"".join(frames)
     start = time.monotonic()
     end = start + seconds
     sent = ticks = 0
-    cut = False
     while (now := time.monotonic()) < end:
         due = start + ticks * TICK
         if now < due:
             time.sleep(due - now)
             continue
         ticks += 1
-        written = client.send(burst, min(end, now + 1.0))
+        # Blocks while the server does not read (its socket is full): the flood then goes at
+        # the pace the server takes it, as a real client's would.
+        written = client.send(burst, end)
+        sent += bisect.bisect_right(ends, written)
         if written < len(burst):
-            cut = True
-            break
-        sent += per_tick
+            break  # the end came in the middle of a burst
     elapsed = time.monotonic() - start
     return {
         "sent": sent,
         "seconds": elapsed,
         "rate": sent / elapsed if elapsed > 0 else 0.0,
-        "cut": cut,
         "closed_by_server": client.closed_by_server,
     }
 
@@ -99,7 +102,7 @@ class Flooder(Child):
         self.conn.send("go")
 
     def end(self) -> dict[str, Any]:
-        """What was sent: ``sent``, ``seconds``, ``rate``, ``cut`` (the server stopped
-        reading), ``closed_by_server``."""
+        """What was sent: ``sent`` (whole messages), ``seconds``, ``rate``,
+        ``closed_by_server``."""
         result: dict[str, Any] = self.receive(self.seconds + 30.0, "the flood")
         return result

@@ -7,11 +7,14 @@
 
 from __future__ import annotations
 
+import math
+import os
+import time
 from collections.abc import Callable
 
-from poinsot.app.load import contention, soak, storm
+from poinsot.app.load import contention, procfs, soak, storm
 from poinsot.app.load.config import Config, Report, Say
-from poinsot.app.load.figures import COMPLETES, Figure, at_most
+from poinsot.app.load.figures import COMPLETES, Figure, at_most, info
 from poinsot.app.load.server_process import ServerProcess
 
 Phase = Callable[[ServerProcess, Config, Report, Say], None]
@@ -33,6 +36,8 @@ def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:
     except Exception as exc:
         report.add(Figure(name, "completed", 0.0, f"failed: {exc}", COMPLETES))
         return
+    machine, load, started = procfs.Machine.now(), os.getloadavg()[0], time.monotonic()
+    server_cpu = _cpu_seconds(server.pid)
     try:
         say(f"{name}: server pid {server.pid}, port {server.port}")
         BODIES[name](server, cfg, report, say)
@@ -40,6 +45,8 @@ def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:
         failure = f"failed: {type(exc).__name__}: {exc}"
         report.add(Figure(name, "completed", 0.0, failure, COMPLETES))
     finally:
+        server_cpu = _cpu_seconds(server.pid) - server_cpu
+        report.add(_machine(name, machine, load, server_cpu, time.monotonic() - started))
         server.finish()
     lines = server.log_errors()
     goal = at_most("max_errors", "<= {:g} lines") if name == "soak" else None
@@ -50,3 +57,27 @@ def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:
     else:
         server.remove_log()
     report.add(Figure(name, "server log errors", float(len(lines)), text, goal))
+
+
+def _cpu_seconds(pid: int) -> float:
+    try:
+        return procfs.usage(pid).cpu_seconds
+    except OSError:
+        return math.nan
+
+
+def _machine(
+    phase: str, machine: procfs.Machine, load: float, server_cpu: float, seconds: float
+) -> Figure:
+    """How busy the (shared) machine was during the phase, and how much of it was the server:
+    the rest is the clients and whatever else runs here."""
+    cores = os.cpu_count() or 1
+    busy = procfs.Machine.now().busy_since(machine)
+    server = server_cpu / (seconds * cores) if seconds > 0 else math.nan
+    return info(
+        phase,
+        "the machine meanwhile",
+        f"load average {load:.1f} -> {os.getloadavg()[0]:.1f}; {cores} cores {busy:.0%} busy, "
+        f"{server:.0%} of them the server",
+        busy=busy,
+    )

@@ -48,6 +48,26 @@ def cpu_percent(first: Usage, last: Usage) -> float:
     return 100.0 * (last.cpu_seconds - first.cpu_seconds) / elapsed if elapsed > 0 else 0.0
 
 
+@dataclasses.dataclass(frozen=True)
+class Machine:
+    """The whole machine's CPU time so far, from ``/proc/stat`` (clock ticks)."""
+
+    busy: int
+    total: int
+
+    @staticmethod
+    def now() -> Machine:
+        with open("/proc/stat") as f:
+            ticks = [int(x) for x in f.readline().split()[1:9]]  # user .. steal
+        idle = ticks[3] + ticks[4]  # idle, iowait
+        return Machine(sum(ticks) - idle, sum(ticks))
+
+    def busy_since(self, earlier: Machine) -> float:
+        """The fraction of all cores' time that was busy between two looks."""
+        total = self.total - earlier.total
+        return (self.busy - earlier.busy) / total if total > 0 else 0.0
+
+
 class Sampler:
     """Looks at some processes every ``interval`` seconds in a thread, until :meth:`stop` (or
     ``max_samples`` looks, so that it always ends)."""

@@ -100,9 +100,11 @@ def test_storm_visits_every_way_and_sessions_come_back(report):
 def test_stall_stops_one_client_and_measures_the_others(report):
     stalled = report.figure("stall", "the stalled client").detail
     assert stalled["late_fps"] == 0  # nothing read while stalled
+    assert stalled["after_fps"] > 0  # a short stall: it reads again (its backlog first)
     assert stalled["sessions"] == 3
     keep = report.figure("stall", "others' frame rate")
-    assert keep.detail["clients"] == 2 and keep.detail["before_p50"] > 0
+    assert keep.detail["clients"] == 2
+    assert keep.detail["before_p50"] > 0 and keep.detail["after_p50"] > 0
     assert keep.value > 0
 
 
@@ -113,6 +115,8 @@ def test_flood_sends_and_measures_the_others(report):
     assert report.figure("flood", "server CPU").detail["sessions"] == TINY.clients + 1
     keep = report.figure("flood", "others' frame rate")
     assert keep.detail["clients"] == 3 and keep.value > 0
+    for phase in PHASES:
+        assert 0 <= report.figure(phase, "the machine meanwhile").detail["busy"] <= 1
 
 
 # -- the goals, judged on the same figures -----------------------------------------------------
