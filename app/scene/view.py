@@ -46,13 +46,14 @@ def apply_theme(client: viser.ClientHandle) -> None:
 def configure_theme(
     gui: viser.GuiApi, *, dark_mode: bool = True, large_controls: bool = False
 ) -> None:
-    """No share button (it needs the internet), brand colour of the ellipsoid; dark unless a
-    lecturer switches to light, wide controls for the projector's large text."""
+    """No share button (it needs the internet), the brand colour of the theme
+    (:func:`palette.brand`); dark unless a lecturer switches to light, wide controls for the
+    projector's large text."""
     gui.configure_theme(
         dark_mode=dark_mode,
         show_share_button=False,
         show_logo=False,
-        brand_color=palette.BRAND,
+        brand_color=palette.brand(dark_mode),
         control_width="large" if large_controls else "medium",
     )
 
