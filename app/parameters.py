@@ -33,6 +33,11 @@ class Parameters:
 
     ``omega0``: an exact initial omega given by a preset (data), used instead of the one built
     from D, |ω₀| and the pole; any edit drops it (the sliders then speak).
+
+    ``D_asked``: the D the user chose, while the moments keep it out of [min I, max I] (then
+    ``D`` is clamped); None when ``D`` is the user's own. A moment passing through a value
+    that narrows the range (even an impossible body) therefore does not move the user's D for
+    good: once the range holds it again, D is back.
     """
 
     inertia: Vector
@@ -40,6 +45,7 @@ class Parameters:
     pole_sign: int = 1
     omega_norm: float = 1.0
     omega0: Vector | None = None
+    D_asked: float | None = None
 
     @classmethod
     def from_preset(cls, preset: Preset) -> Parameters:
@@ -61,17 +67,33 @@ class Parameters:
 
     # -- edits (each drops a preset's exact omega0) ----------------------------------------
     def with_inertia(self, index: int, value: float) -> Parameters:
-        """Change one moment; D is clamped into the new [min I, max I]."""
+        """Change one moment; the user's D is clamped into the new [min I, max I] (and kept
+        in ``D_asked`` for when the range holds it again)."""
         moments = list(self.inertia)
         moments[index] = float(value)
         inertia = _vector(moments)
-        D = min(max(self.D, min(inertia)), max(inertia))
-        return dataclasses.replace(self, inertia=inertia, D=D, omega0=None)
+        asked = self.D if self.D_asked is None else self.D_asked
+        D = min(max(asked, min(inertia)), max(inertia))
+        return dataclasses.replace(
+            self, inertia=inertia, D=D, omega0=None, D_asked=None if D == asked else asked
+        )
 
-    def with_D(self, D: float) -> Parameters:
-        """D, clamped into [min I, max I]."""
+    def with_D(self, D: float, snap: float = 0.0) -> Parameters:
+        """D, clamped into [min I, max I]; within ``snap`` of the intermediate moment it is
+        that moment exactly, the separatrix (a slider's value is only near I₂: D = 2.000 on
+        the slider arrived as 1.9999999999999996, a polhode of period 151 around the minor
+        axis instead of the separatrix)."""
         lo, hi = self.D_range
-        return dataclasses.replace(self, D=min(max(float(D), lo), hi), omega0=None)
+        D = min(max(float(D), lo), hi)
+        if self.has_separatrix and abs(D - self.intermediate) <= snap:
+            D = self.intermediate
+        return dataclasses.replace(self, D=D, omega0=None, D_asked=None)
+
+    @property
+    def has_separatrix(self) -> bool:
+        """Three distinct moments: a triaxial body, whose D = I₂ separates two families."""
+        lo, hi = self.D_range
+        return lo < self.intermediate < hi
 
     def with_pole(self, sign: int) -> Parameters:
         return dataclasses.replace(self, pole_sign=1 if sign >= 0 else -1, omega0=None)
@@ -89,11 +111,13 @@ class Parameters:
         mid = self.intermediate
         if side == "major" and self.D < mid and mid > lo:
             frac = (mid - self.D) / (mid - lo)
-            return dataclasses.replace(self, D=mid + frac * (hi - mid), omega0=None)
-        if side == "minor" and self.D > mid and hi > mid:
+            D = mid + frac * (hi - mid)
+        elif side == "minor" and self.D > mid and hi > mid:
             frac = (self.D - mid) / (hi - mid)
-            return dataclasses.replace(self, D=mid - frac * (mid - lo), omega0=None)
-        return self
+            D = mid - frac * (mid - lo)
+        else:
+            return self
+        return dataclasses.replace(self, D=D, omega0=None, D_asked=None)
 
     def side(self) -> str:
         return "major" if self.D >= self.intermediate else "minor"

@@ -1,8 +1,11 @@
 """The control panel of one session: preset, sliders, playback, show/hide.
 
-Only the controls the current preset declares exist (:meth:`ControlPanel.declare` creates and
-removes whole groups; ``order`` keeps the layout stable whatever the creation order). A removed
-group is retired (:mod:`poinsot.app.live.widgets`: hidden at once, deleted a moment later).
+Only the controls the current preset declares are shown (:meth:`ControlPanel.declare` creates
+whole groups, or shows them again; ``order`` keeps the layout stable whatever the creation
+order). A group the preset does not declare is put away: the panel's own groups are hidden and
+kept for when a preset declares them again (:class:`~poinsot.app.live.widgets.Shelf`: no
+widget of theirs is ever deleted, so no update can reach a deleted one), the groups other
+modules add are retired (hidden at once, deleted later).
 Callbacks never touch the scene or block: they hand a small action to the session's frame
 thread via :class:`Actions`. Programmatic value changes (``event.client is None``) are
 ignored, so the session can mirror its state into the widgets without feedback loops. The
@@ -21,7 +24,7 @@ import viser
 
 from poinsot.app.elements import Control, Element, Plot
 from poinsot.app.live.motion_window import MotionWindow
-from poinsot.app.live.widgets import Removable, Retirement, set_marks, set_value
+from poinsot.app.live.widgets import Removable, Retirement, Shelf, set_marks, set_value
 from poinsot.app.parameters import (
     INERTIA_RANGE,
     OMEGA_NORM_RANGE,
@@ -93,12 +96,19 @@ class Widgets:
     speed: viser.GuiSliderHandle[float] | None = None
     trail: viser.GuiSliderHandle[int] | None = None
     pause: viser.GuiButtonHandle | None = None
+    side: viser.GuiButtonGroupHandle | None = None
 
     def forget(self, group: Group) -> None:
         """The widgets of ``group`` are gone."""
         for field in dataclasses.fields(self):
             if field.name == _MIRRORED.get(group):
                 setattr(self, field.name, field.default)  # () or None
+
+    def remember(self, group: Group, handles: list[Removable]) -> None:
+        """The widgets of ``group`` (as its builder returned them) are back."""
+        name = _MIRRORED.get(group)
+        if name is not None:
+            setattr(self, name, tuple(handles) if name == "inertia" else handles[0])
 
 
 #: The :class:`Widgets` field each group fills.
@@ -109,7 +119,12 @@ _MIRRORED: dict[Group, str] = {
     Control.SPEED: "speed",
     Control.TRAIL: "trail",
     Control.PLAYBACK: "pause",
+    Control.SIDE: "side",
 }
+#: The panel's own groups: put away on the :class:`Shelf` and shown again, never deleted.
+_SHELVED: frozenset[Group] = frozenset(Control) | {Plot.OMEGA}
+#: Step of the D slider; a value within half a step of I₂ is I₂ exactly (the separatrix).
+D_STEP = 0.001
 
 
 def slider_range(default: tuple[float, float], values: Iterable[float]) -> tuple[float, float]:
@@ -129,6 +144,8 @@ class ControlPanel:
         self.actions = actions
         self.retirement = retirement
         self.widgets = Widgets()
+        self.shelf = Shelf()
+        self._boxes: dict[Element, viser.GuiCheckboxHandle] = {}  # the show/hide checkboxes
         self._groups: dict[Group, list[Removable]] = {}
         self._folders: dict[str | Group, viser.GuiFolderHandle] = {}
         self._elements: frozenset[Element] = frozenset()
@@ -184,10 +201,9 @@ class ControlPanel:
         trail: int,
         visible: Callable[[Element], bool],
     ) -> None:
-        """Create exactly the declared groups (keeping existing ones), remove the others."""
+        """Show exactly the declared groups (keeping existing ones, creating or taking back the
+        missing ones), put the others away."""
         wanted: set[Group] = set(controls) | set(plots)
-        if Control.VISIBILITY in controls and elements != self._elements:
-            self._remove_group(Control.VISIBILITY)  # rebuilt below for the new elements
         self._elements = elements
         for key in list(self._groups):
             if key not in wanted:
@@ -205,10 +221,29 @@ class ControlPanel:
             Plot.MEASURED: lambda: [self.motion.add_plot(measured=True)],
             **self._extensions,
         }
+        taken = False
         for key in sorted(wanted, key=lambda k: _ORDER.get(k, 25.0)):
             if key not in self._groups:
-                self._groups[key] = builders[key]()
+                kept = self.shelf.take(key)
+                self._groups[key] = builders[key]() if kept is None else self._restore(key, kept)
+                taken = taken or kept is not None
+        if Control.VISIBILITY in self._groups:
+            self._show_boxes(elements, visible)
         self._prune_folders()
+        if taken:  # widgets taken back show the values of now
+            self.show_parameters(params)
+            if self.widgets.speed is not None:
+                set_value(self.widgets.speed, float(speed))
+            if self.widgets.trail is not None:
+                set_value(self.widgets.trail, int(trail))
+
+    def _restore(self, key: Group, handles: list[Removable]) -> list[Removable]:
+        """A group taken back from the shelf: the panel and the Motion window hold it again."""
+        self.widgets.remember(key, handles)
+        plot = handles[0]
+        if key is Plot.OMEGA and isinstance(plot, viser.GuiUplotHandle):
+            self.motion.restore_plot(plot)
+        return handles
 
     @property
     def groups(self) -> frozenset[Group]:
@@ -222,14 +257,21 @@ class ControlPanel:
         self.widgets.forget(key)
         if key in (Plot.OMEGA, Plot.MEASURED):
             self.motion.forget_plot()
-        self.retirement.retire(self._groups.pop(key, []))
+        handles = self._groups.pop(key, [])
+        if key in _SHELVED:
+            self.shelf.stow(key, handles)
+        else:
+            self.retirement.retire(handles)
 
     def _folder(self, name: str | Group, label: str, expand: bool = True) -> viser.GuiFolderHandle:
         if name not in self._folders:
             self._folders[name] = self.gui.add_folder(
                 label, order=_ORDER[name], expand_by_default=expand
             )
-        return self._folders[name]
+        folder = self._folders[name]
+        if not folder.visible:
+            folder.visible = True
+        return folder
 
     def _prune_folders(self) -> None:
         used: set[str | Group] = {"scene"}
@@ -240,8 +282,9 @@ class ControlPanel:
         for key in (Control.INERTIA, Control.VISIBILITY):
             if key in self._groups:
                 used.add(key)
-        for name in [n for n in self._folders if n not in used]:
-            self.retirement.retire([self._folders.pop(name)])
+        for name, folder in self._folders.items():
+            if folder.visible != (name in used):  # kept, like the groups inside
+                folder.visible = name in used
 
     # -- groups --------------------------------------------------------------------------
     def _build_inertia(self, params: Parameters) -> list[Removable]:
@@ -276,16 +319,16 @@ class ControlPanel:
                 "D = |L|²/2T",
                 lo,
                 hi,
-                0.001,
+                D_STEP,
                 float(params.D),
                 order=0.0,
                 marks=self._energy_marks(params),
-                hint="Energy parameter in [I_min, I_max]; D = I₂ is the separatrix.",
+                hint="Energy parameter in [I_min, I_max]; D = I₂ (its mark) is the separatrix.",
             )
 
         def move(handle: viser.GuiSliderHandle[float]) -> None:
             value = float(handle.value)
-            self.actions.edit(lambda p: p.with_D(value))
+            self.actions.edit(lambda p: p.with_D(value, snap=D_STEP / 2))
 
         self.widgets.energy = self._on_user(slider, move)
         return [slider]
@@ -312,6 +355,7 @@ class ControlPanel:
             sign = 1 if handle.value == POLE_OPTIONS[0] else -1
             self.actions.edit(lambda p: p.with_pole(sign))
 
+        self.widgets.side = side
         return [self._on_user(side, choose_side), self._on_user(pole, choose_pole)]
 
     def _build_omega_norm(self, params: Parameters) -> list[Removable]:
@@ -373,14 +417,26 @@ class ControlPanel:
     def _build_visibility(
         self, elements: frozenset[Element], visible: Callable[[Element], bool]
     ) -> list[Removable]:
-        boxes: list[Removable] = []
+        """A checkbox per element, made once (:meth:`_show_boxes` shows the declared ones)."""
         with self._folder(Control.VISIBILITY, "Show", expand=False):
-            for n, element in enumerate(e for e in Element if e in elements):
-                box = self.gui.add_checkbox(
-                    ELEMENT_LABELS[element], visible(element), order=float(n)
-                )
-                boxes.append(self._on_user(box, self._visibility_callback(element)))
-        return boxes
+            for n, element in enumerate(Element):
+                if element in elements and element not in self._boxes:
+                    box = self.gui.add_checkbox(
+                        ELEMENT_LABELS[element], visible(element), order=float(n)
+                    )
+                    self._boxes[element] = self._on_user(box, self._visibility_callback(element))
+        return list(self._boxes.values())
+
+    def _show_boxes(self, elements: frozenset[Element], visible: Callable[[Element], bool]) -> None:
+        """Show the checkboxes of ``elements`` (made if missing), ticked as the scene shows
+        them; hide the others."""
+        if not elements <= self._boxes.keys():
+            self._groups[Control.VISIBILITY] = self._build_visibility(elements, visible)
+        for element, box in self._boxes.items():
+            if box.visible != (element in elements):
+                box.visible = element in elements
+            if element in elements:
+                set_value(box, visible(element))
 
     def _visibility_callback(self, element: Element) -> Callable[[viser.GuiCheckboxHandle], None]:
         return lambda handle: self.actions.set_visible(element, bool(handle.value))
@@ -411,6 +467,8 @@ class ControlPanel:
             w.energy.min, w.energy.max = params.D_range
             set_marks(w.energy, self._energy_marks(params))
             set_value(w.energy, float(params.D))
+        if w.side is not None and w.side.visible != params.has_separatrix:
+            w.side.visible = params.has_separatrix  # a symmetric body has no separatrix
         if w.omega_norm is not None:
             lo, hi = slider_range(OMEGA_NORM_RANGE, (params.omega_norm,))
             if (w.omega_norm.min, w.omega_norm.max) != (lo, hi):

@@ -1,25 +1,34 @@
 """What a session does to viser's GUI widgets besides creating them: set their values, and
-remove them safely.
+put them away safely.
 
-Removal: the browser applies the GUI updates of one rendered frame after that frame's
-removals, so an update sent just before a removal would otherwise reach a widget that no
-longer exists and log a console error. A widget that goes is therefore hidden at once (no
-update can reach it after that) and deleted :data:`RETIRE_SECONDS` later. The control panel
-and the ghost's controls both remove widgets this way, through the session's one
-:class:`Retirement`.
+The browser applies all the GUI updates it has queued *after* the removals queued with them
+(viser's client drains its message queue once per rendered frame). So an update sent before
+a removal reaches a widget that no longer exists, and the browser logs "Tried to update
+non-existent component", whenever both wait in the same drain: that is, whenever the
+browser's main thread stalls for longer than the time between them (a software-WebGL browser
+compiling the shaders of a new scene, a long render for a screenshot). No delay is safe
+against every stall, so:
+
+- :class:`Shelf`: widgets that come back (the control panel's groups, when a preset declares
+  them again) are hidden and kept, never removed, and shown again when wanted;
+- :class:`Retirement`: widgets made per use (the ghost's readout and plot, a scene's
+  controls) are hidden at once and deleted :data:`RETIRE_SECONDS` later, longer than any
+  stall of a browser that still animates.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable
+from collections.abc import Hashable, Iterable
 from typing import Any, Protocol, TypeVar
 
 import viser
 from viser._messages import GuiSliderMark
 
-#: Delay between hiding a removed widget and deleting it [s].
-RETIRE_SECONDS = 1.5
+#: Delay between hiding a removed widget and deleting it [s]: a browser whose main thread
+#: stalls longer than this (1.5 s was seen to be too short for software WebGL switching
+#: between the sphere and a custom body) could still log an update to a deleted widget.
+RETIRE_SECONDS = 30.0
 
 T = TypeVar("T")
 
@@ -59,6 +68,32 @@ class Retirement:
                 waiting.append((due, handle))
         self._due = waiting
         return len(waiting)
+
+
+class Shelf:
+    """Groups of widgets put away instead of removed: hidden, kept under a key, and shown again
+    by :meth:`take` (no widget is ever deleted, so no update can ever reach a deleted one).
+    Driven by one thread (the session's frame thread)."""
+
+    def __init__(self) -> None:
+        self._kept: dict[Hashable, list[Removable]] = {}
+
+    def stow(self, key: Hashable, handles: Iterable[Removable]) -> None:
+        """Hide ``handles`` and keep them for :meth:`take`."""
+        kept = list(handles)
+        for handle in kept:
+            handle.visible = False
+        self._kept[key] = kept
+
+    def take(self, key: Hashable) -> list[Removable] | None:
+        """The widgets stowed under ``key``, shown again; None if there are none."""
+        kept = self._kept.pop(key, None)
+        for handle in kept or ():
+            handle.visible = True
+        return kept
+
+    def __contains__(self, key: Hashable) -> bool:
+        return key in self._kept
 
 
 def set_value(handle: viser.GuiInputHandle[T], value: T) -> None:

@@ -15,6 +15,7 @@ from test_scene_geometry import check_finite
 from poinsot.app.elements import Control, Element, Plot
 from poinsot.app.live.panel import ELEMENT_LABELS
 from poinsot.app.live.session import MAX_FPS, STEP_SECONDS
+from poinsot.app.parameters import Parameters
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, PRESETS, preset_by_key
 from poinsot.app.scene.trail import CHUNK_SEGMENTS
 
@@ -40,7 +41,7 @@ TRAIL_GROUPS = ("/space/body/polhode/", "/space/herpolhode/")
 CONTROL_LABELS: dict[Control, set[str]] = {
     Control.INERTIA: {"I₁", "I₂", "I₃"},
     Control.ENERGY: {"D = |L|²/2T"},
-    Control.SIDE: {"Side of separatrix", "Polhode"},
+    Control.SIDE: {"Polhode"},  # and "Side of separatrix" where the body has a separatrix
     Control.OMEGA_NORM: {"|ω₀|"},
     Control.SPEED: {"Speed"},
     Control.PLAYBACK: {"Pause", "Step", "Reset"},
@@ -98,6 +99,9 @@ def test_only_what_the_preset_declares_is_created(preset, make_app, make_probe):
     for control, names in CONTROL_LABELS.items():
         assert (names <= labels) == (control in preset.controls), control
         assert (names & labels == set()) == (control not in preset.controls), control
+    # A symmetric body (or a sphere) has no separatrix: no side of it to choose.
+    separatrix = Parameters.from_preset(preset).has_separatrix
+    assert ("Side of separatrix" in labels) == (Control.SIDE in preset.controls and separatrix)
     shown = {ELEMENT_LABELS[e] for e in preset.elements}
     hidden = {ELEMENT_LABELS[e] for e in Element if e not in preset.elements}
     assert shown <= labels and not hidden & labels

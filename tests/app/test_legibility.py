@@ -1,0 +1,122 @@
+"""What the picture promises, checked without a browser: the user's D survives an impossible
+body, D at I₂ on the slider is the exact separatrix, a stalled frame loop draws no chord
+through the body, symmetric bodies offer no separatrix, the panel never deletes its widgets,
+the labels' layout keeps boxes apart."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import session_of, wait_until
+
+from poinsot.app.live.panel import D_STEP
+from poinsot.app.live.widgets import Shelf
+from poinsot.app.parameters import Parameters
+from poinsot.app.presets import preset_by_key
+from poinsot.physics import Regime
+
+
+# -- the user's D (an impossible body on the way) -----------------------------------------
+def test_passing_through_an_impossible_body_keeps_the_users_D():
+    major = Parameters.from_preset(preset_by_key("major"))
+    assert major.D == 2.45
+    impossible = major.with_inertia(2, 0.1)  # I = (1, 2, 0.1): no real body
+    with pytest.raises(ValueError, match="no real body"):
+        impossible.check()
+    back = impossible.with_inertia(2, 2.6)
+    assert back.D == 2.45 and back.D_asked is None
+    assert back.build().D == pytest.approx(2.45, rel=1e-12)
+    # A range that still holds D leaves it alone; one that does not clamps it, for a while.
+    assert major.with_inertia(2, 2.5).D == 2.45
+    narrow = major.with_inertia(2, 2.2)
+    assert narrow.D == 2.2 and narrow.D_asked == 2.45
+    assert narrow.with_inertia(2, 2.6).D == 2.45
+    # A D the user sets while the range is narrow is the user's new D.
+    assert narrow.with_D(2.1).with_inertia(2, 2.6).D == 2.1
+
+
+def test_the_session_keeps_D_through_an_impossible_body(poinsot_app, probe):
+    """Major preset (D = 2.45), I₃ -> 0.1 (refused), back to 2.6: D is 2.45 again."""
+    session = session_of(poinsot_app)
+    uuid, _ = probe.widget("I₃")
+    probe.set_value(uuid, 0.1)
+    assert wait_until(lambda: "no real body" in session.status.lower(), 10), session.status
+    probe.set_value(uuid, 2.6)
+    assert wait_until(lambda: session.params.inertia[2] == 2.6 and not session.status, 10)
+    assert session.params.D == 2.45
+    assert session.body is not None and session.body.D == pytest.approx(2.45, rel=1e-12)
+
+
+# -- D = I₂ is the separatrix ---------------------------------------------------------------
+@pytest.mark.parametrize(
+    "inertia", [(1.0, 2.0, 2.6), (1.0, 2.2782, 3.1839), (2.6, 1.37, 1.4), (0.3, 0.7, 0.95)]
+)
+def test_D_within_half_a_step_of_I2_is_the_exact_separatrix(inertia):
+    p = Parameters(inertia, sorted(inertia)[0])
+    mid = sorted(inertia)[1]
+    for near in (mid, mid - 0.4 * D_STEP, mid + 0.49 * D_STEP, np.nextafter(mid, 0.0)):
+        q = p.with_D(float(near), snap=D_STEP / 2)
+        assert q.D == mid
+        body = q.build()
+        assert body.regime is Regime.SEPARATRIX and body.D == mid
+    assert p.with_D(mid + D_STEP, snap=D_STEP / 2).build().regime is not Regime.SEPARATRIX
+
+
+def test_a_symmetric_body_has_no_separatrix_to_snap_to():
+    disc = Parameters((1.0, 1.0, 1.9592), 1.45)
+    assert not disc.has_separatrix
+    assert disc.with_D(1.0004, snap=D_STEP / 2).D == 1.0004
+
+
+def test_the_D_slider_at_I2_gives_the_separatrix(poinsot_app, probe):
+    """I = (1, 2, 2.6) and the slider's value 2.000 as the browser sends it: the readout says
+    separatrix."""
+    session = session_of(poinsot_app)
+    uuid, _ = probe.widget("D = |L|²/2T")
+    probe.set_value(uuid, 1.9999999999999996)
+    assert wait_until(lambda: session.body is not None and session.params.D == 2.0, 10)
+    assert session.body.regime is Regime.SEPARATRIX
+    assert probe.wait_for(lambda p: any("separatrix" in t for t in _markdown(p)), 10)
+
+
+def _markdown(probe) -> list[str]:
+    _, widgets = probe.snapshot()
+    return [str(w.props.get("_markdown", "")) for w in widgets.values()]
+
+
+# -- the panel puts widgets away, it never deletes them -------------------------------------
+class FakeHandle:
+    def __init__(self) -> None:
+        self.visible = True
+        self.removed = False
+
+    def remove(self) -> None:
+        self.removed = True
+
+
+def test_the_shelf_hides_keeps_and_gives_back():
+    shelf, handles = Shelf(), [FakeHandle(), FakeHandle()]
+    shelf.stow("energy", handles)
+    assert "energy" in shelf and all(not h.visible and not h.removed for h in handles)
+    assert shelf.take("energy") == handles and all(h.visible for h in handles)
+    assert shelf.take("energy") is None and "energy" not in shelf
+
+
+def test_switching_sphere_and_custom_deletes_no_panel_widget(poinsot_app, probe):
+    """The browser logs an error for an update that reaches a deleted widget; the panel's
+    widgets are only hidden and shown, so the widgets it ever made are all still there."""
+    from poinsot.app.presets import CUSTOM
+
+    session = session_of(poinsot_app)
+    removed: list[str] = []
+    probe.add_listener(
+        lambda m, _t: removed.append(m["uuid"]) if m["type"] == "GuiRemoveMessage" else None
+    )
+    uuid, _ = probe.widget("Preset")
+    for _ in range(4):
+        for preset in (preset_by_key("sphere"), CUSTOM):
+            probe.set_value(uuid, preset.label)
+            assert wait_until(lambda p=preset: session.preset is p, 10)
+    assert probe.wait_for(lambda p: "D = |L|²/2T" in p.labels(), 10)
+    assert removed == []
+    assert session.stats.errors == 0, session.stats.last_error
