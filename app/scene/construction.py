@@ -43,7 +43,11 @@ from poinsot.physics import FreeRigidBody
 
 #: Trace points are at most this far apart [display units] (see scene/sampling.py).
 MAX_CHORD = 0.02
-#: At most this many grid samples per frame (after a long stall the trace takes a chord).
+#: After a stall of the frame loop, the grid samples missed are drawn from the exact solution
+#: (one physics call, however many frames were missed), up to this many; after a longer gap
+#: the traces are lifted (a new piece starts, joined to nothing) and this frame draws its last
+#: MAX_SAMPLES_PER_FRAME samples. Never a straight chord through the body.
+MAX_FILL_SAMPLES = 4096
 MAX_SAMPLES_PER_FRAME = 64
 #: The traces are sent every TRAIL_EVERY frames (30 Hz at 60 frames per second): half the
 #: messages, and the trace's end trails the contact point by at most one frame.
@@ -225,8 +229,13 @@ class PoinsotScene:
         restart = last is None or k < last
         if last is None or k <= last:  # k == last: a redraw (new elements), same time
             k_first = k
-        else:
-            k_first = max(last + 1, k - MAX_SAMPLES_PER_FRAME + 1)
+        elif k - last <= MAX_FILL_SAMPLES:  # every sample since the last frame
+            k_first = last + 1
+        else:  # too long a gap to fill: the traces go on from here, apart
+            k_first = k - MAX_SAMPLES_PER_FRAME + 1
+            self.flush_trails()
+            for trail in self._trails.values():
+                trail.lift()
         with self._atomic():
             return self._draw(k_first, k, restart)
 

@@ -73,11 +73,16 @@ class Trail:
     def visible(self, visible: bool) -> None:
         self.group.visible = visible
 
-    def points(self) -> np.ndarray:
-        """All points currently drawn, oldest first, shape (N, 3) (for tests and exports)."""
+    def segments(self) -> np.ndarray:
+        """All segments currently drawn, oldest first, shape (N, 2, 3) (for tests)."""
         parts = [h.points for h, _ in self._frozen]
         parts.append(self._buffer[: self._n])
-        segments = np.concatenate(parts) if parts else np.zeros((0, 2, 3), np.float32)
+        return np.concatenate(parts).reshape(-1, 2, 3)
+
+    def points(self) -> np.ndarray:
+        """All points currently drawn, oldest first, shape (N, 3) (for tests and exports; a
+        lifted trail's gap is not marked)."""
+        segments = self.segments()
         if len(segments) == 0:
             return np.zeros((0, 3), dtype=np.float32)
         return np.concatenate([segments[:, 0], segments[-1:, 1]])
@@ -92,6 +97,11 @@ class Trail:
             self._head.remove()
         self._head = None
         self._n = 0
+        self._last = None
+
+    def lift(self) -> None:
+        """Lift the pen: the next :meth:`append` starts a new piece of the polyline, joined to
+        nothing drawn before (after a gap in time, never a straight chord across it)."""
         self._last = None
 
     def append(self, points: np.ndarray) -> None:

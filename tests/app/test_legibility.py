@@ -120,3 +120,38 @@ def test_switching_sphere_and_custom_deletes_no_panel_widget(poinsot_app, probe)
     assert probe.wait_for(lambda p: "D = |L|²/2T" in p.labels(), 10)
     assert removed == []
     assert session.stats.errors == 0, session.stats.last_error
+
+
+# -- a stalled frame loop -------------------------------------------------------------------
+def _off_surface(segments: np.ndarray, semi_axes: np.ndarray) -> float:
+    """Largest relative distance from the ellipsoid of a segment's end and midpoint points, as
+    drawn (before the trail node's inflation)."""
+    points = np.concatenate([segments[:, 0], segments[:, 1], segments.mean(axis=1)])
+    radius = np.sqrt(np.sum((points / semi_axes) ** 2, axis=1))
+    return float(np.max(np.abs(radius - 1.0)))
+
+
+@pytest.mark.parametrize("stall", [2.0, 60.0])
+def test_after_a_stall_no_trace_segment_cuts_through_the_body(stall):
+    """60 frames a second for a second, then nothing for ``stall`` seconds (filled from the
+    exact solution after 2 s, lifted after 60 s), then frames again: every polhode segment
+    stays on the ellipsoid within the margin it is drawn off it, every herpolhode segment is a
+    short chord."""
+    from poinsot.app.elements import Element
+    from poinsot.app.exports.stage import Stage
+    from poinsot.app.scene.construction import MAX_CHORD
+    from poinsot.app.scene.geometry import POLHODE_INFLATE
+
+    with Stage.from_preset(preset_by_key("major"), trail_points=6000) as stage:
+        times = [k / 60.0 for k in range(61)]
+        times += [times[-1] + stall + k / 60.0 for k in range(1, 30)]
+        for t in times:
+            stage.advance(t)
+        stage.scene.flush_trails()
+        semi = stage.scene.geometry.semi_axes
+        polhode = stage.scene.trail(Element.POLHODE).segments()
+        herpolhode = stage.scene.trail(Element.HERPOLHODE).segments()
+    assert len(polhode) > 100
+    assert _off_surface(polhode, semi) < POLHODE_INFLATE - 1.0
+    chords = np.linalg.norm(herpolhode[:, 1] - herpolhode[:, 0], axis=1)
+    assert chords.max() < 2 * MAX_CHORD
