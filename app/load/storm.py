@@ -22,6 +22,7 @@ server's threads, RSS and live sessions as the baseline, storms, then gives the 
 from __future__ import annotations
 
 import collections
+import dataclasses
 import queue
 import threading
 import time
@@ -155,6 +156,26 @@ class Storm(Child):
 P = "storm"
 
 
+@dataclasses.dataclass(frozen=True)
+class _Look:
+    """The server's threads and RSS (``/proc``) and its own status, at one moment."""
+
+    usage: procfs.Usage
+    status: dict[str, Any]
+
+    @staticmethod
+    def take(server: ServerProcess) -> _Look:
+        return _Look(procfs.usage(server.pid), server.status())
+
+    def deviations(self, baseline: _Look) -> tuple[float, float, float]:
+        """|after / before - 1| of threads, RSS and live sessions."""
+        return (
+            relative(self.usage.threads, baseline.usage.threads),
+            relative(self.usage.rss_bytes, baseline.usage.rss_bytes),
+            relative(self.status["sessions"], baseline.status["sessions"]),
+        )
+
+
 def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
     steady = max(0, min(cfg.storm_steady, cfg.clients))
     say(f"storm: {steady} steady clients, warm-up visits")
@@ -164,23 +185,40 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
     ):
         server.wait_for_sessions(steady, 30.0)
         time.sleep(2.0)
-        before, status0 = procfs.usage(server.pid), server.status()
+        before = _Look.take(server)
         say(f"storm: {cfg.storm} connects and departures ({', '.join(KINDS)})")
         result = visits.run()
         say(f"storm: settling (at most {cfg.settle_seconds:g} s)")
-        start = time.monotonic()
-        while True:
-            after, status1 = procfs.usage(server.pid), server.status()
-            deviations = (
-                relative(after.threads, before.threads),
-                relative(after.rss_bytes, before.rss_bytes),
-                relative(status1["sessions"], status0["sessions"]),
-            )
-            waited = time.monotonic() - start
-            if max(deviations) <= cfg.settle_tolerance or waited >= cfg.settle_seconds:
-                break
-            time.sleep(0.5)
+        after, waited = _settle(server, before, cfg)
         steady_window = fleet.window(min(2.0, cfg.settle_seconds)) if steady else None
+    _add_visits(report, cfg, result)
+    _add_return(report, before, after)
+    report.add(info(P, "settle time", f"{waited:.1f} s (at most {cfg.settle_seconds:g} s)"))
+    if steady_window is not None:
+        report.add(
+            info(
+                P,
+                f"the {steady} steady clients after",
+                f"{fps_text(steady_window.fps)}, {steady_window.silent} silent",
+                clients=len(steady_window.fps),
+                silent=steady_window.silent,
+            )
+        )
+
+
+def _settle(server: ServerProcess, before: _Look, cfg: Config) -> tuple[_Look, float]:
+    """Look every half second until everything is back within the tolerance, or the settle
+    time is up; the last look and the seconds waited."""
+    start = time.monotonic()
+    while True:
+        after = _Look.take(server)
+        waited = time.monotonic() - start
+        if max(after.deviations(before)) <= cfg.settle_tolerance or waited >= cfg.settle_seconds:
+            return after, waited
+        time.sleep(0.5)
+
+
+def _add_visits(report: Report, cfg: Config, result: dict[str, Any]) -> None:
     done, failed = result["done"], result["failed"]
     report.add(
         info(
@@ -197,54 +235,48 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         ),
     )
     report.notes.extend(f"storm: {reason}" for reason in result["reasons"])
+
+
+def _add_return(report: Report, before: _Look, after: _Look) -> None:
     goal = at_most("storm_tolerance", "back within {:g} %", 100)
+    threads, rss, sessions = after.deviations(before)
+    b, a = before.usage, after.usage
     report.add(
         Figure(
             P,
             "server threads",
-            deviations[0],
-            f"{before.threads} -> {after.threads}",
+            threads,
+            f"{b.threads} -> {a.threads}",
             goal,
-            {"before": before.threads, "after": after.threads},
+            {"before": b.threads, "after": a.threads},
         ),
         Figure(
             P,
             "server RSS",
-            deviations[1],
-            f"{before.rss_bytes / MB:.0f} -> {after.rss_bytes / MB:.0f} MB "
-            f"({after.rss_bytes / before.rss_bytes - 1:+.1%})",
+            rss,
+            f"{b.rss_bytes / MB:.0f} -> {a.rss_bytes / MB:.0f} MB "
+            f"({a.rss_bytes / b.rss_bytes - 1:+.1%})",
             goal,
         ),
         Figure(
             P,
             "live sessions",
-            deviations[2],
-            f"{status0['sessions']} -> {status1['sessions']} "
-            f"(session threads {status1['session_threads']}, "
-            f"pending departures {status1['pending_departures']})",
+            sessions,
+            f"{before.status['sessions']} -> {after.status['sessions']} "
+            f"(session threads {after.status['session_threads']}, "
+            f"pending departures {after.status['pending_departures']})",
             goal,
             {
-                "before": status0["sessions"],
-                "after": status1["sessions"],
-                "session_threads": status1["session_threads"],
-                "pending_departures": status1["pending_departures"],
+                "before": before.status["sessions"],
+                "after": after.status["sessions"],
+                "session_threads": after.status["session_threads"],
+                "pending_departures": after.status["pending_departures"],
             },
         ),
-        info(P, "settle time", f"{waited:.1f} s (at most {cfg.settle_seconds:g} s)"),
     )
-    changed = _thread_changes(status0["threads"], status1["threads"])
+    changed = _thread_changes(before.status["threads"], after.status["threads"])
     if changed:
         report.notes.append(f"storm: server threads by kind, before -> after: {changed}")
-    if steady_window is not None:
-        report.add(
-            info(
-                P,
-                f"the {steady} steady clients after",
-                f"{fps_text(steady_window.fps)}, {steady_window.silent} silent",
-                clients=len(steady_window.fps),
-                silent=steady_window.silent,
-            )
-        )
 
 
 def _thread_changes(before: dict[str, int], after: dict[str, int]) -> str:
