@@ -72,9 +72,13 @@ class Host(Protocol):
 
 
 class _Folder:
-    """The status and readout lines of one folder (None while the folder does not exist)."""
+    """The status and readout lines of the folder of ``group``, kept here and mirrored into
+    its widgets while they exist: while the panel shows the group or keeps it put away on its
+    shelf (hidden, shown again as it is); a group it retired is deleted, and no update may
+    reach a deleted widget (a later declaration builds the folder anew from these lines)."""
 
-    def __init__(self) -> None:
+    def __init__(self, group: Control, panel: ControlPanel) -> None:
+        self.group, self.panel = group, panel
         self.status_md: viser.GuiMarkdownHandle | None = None
         self.readout_md: viser.GuiMarkdownHandle | None = None
         self.status = ""
@@ -82,6 +86,8 @@ class _Folder:
 
     def show(self, status: str | None = None, readout: str | None = None) -> None:
         """Change the lines (frame thread); mirrored into the widgets if they exist."""
+        if self.group not in self.panel.groups and self.group not in self.panel.shelf:
+            self.status_md = self.readout_md = None
         if status is not None:
             self.status = status
             if self.status_md is not None:
@@ -105,8 +111,8 @@ class UploadControls:
         self.toss_preset: Preset | None = None
         self.mesh: MeshBody | None = None
         self.mesh_preset: Preset | None = None
-        self.toss_lines = _Folder()
-        self.mesh_lines = _Folder()
+        self.toss_lines = _Folder(Control.TOSS, host.panel)
+        self.mesh_lines = _Folder(Control.MESH, host.panel)
         #: Uploads finished (shown or refused); tests wait on it.
         self.finished = 0
         self._latest = {"toss": 0, "mesh": 0}
