@@ -1,0 +1,189 @@
+"""The scenes (app/scenes) in the live server, observed through websocket probes: each creates
+exactly the nodes and widgets it declares, the menu switches between scenes and presets
+creating and removing exactly, bad input leaves a message and the last valid scene, and per
+frame only poses and trail increments are sent."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+from conftest import session_of, wait_until
+from scene_probing import (
+    ALWAYS,
+    CONSTRUCTION_TRAILS,
+    plot_titles,
+    scene_node_names,
+    start,
+    visible_labels,
+)
+
+from poinsot.app.elements import Control, Element
+from poinsot.app.live.panel import ELEMENT_LABELS
+from poinsot.app.presets import preset_by_key
+from poinsot.app.scenes import SCENES, scene_by_name
+from poinsot.app.scenes.spec import SceneSpec
+
+#: Nodes of each element of the Poinsot construction (as in test_server).
+ELEMENT_NODES: dict[Element, set[str]] = {
+    Element.ELLIPSOID: {"/space/body/ellipsoid"},
+    Element.AXES: {f"/space/body/axis{i}" for i in (1, 2, 3)}
+    | {f"/space/body/axis{i}/label" for i in (1, 2, 3)}
+    | {"/space/origin"},
+    Element.PLANE: {"/space/plane", "/space/plane/disc", "/space/plane/grid", "/space/plane/rim"},
+    Element.CONTACT: {"/space/tip/contact"},
+    Element.OMEGA: {"/space/omega", "/space/tip/omega_label"},
+    Element.L: {"/space/L", "/space/L_label"},
+    Element.POLHODE: {"/space/body/polhode"},
+    Element.POLHODE_FULL: {"/space/body/polhode_full"},
+    Element.HERPOLHODE: {"/space/herpolhode"},
+    Element.SOLID: {"/space/body/solid"},
+}
+#: The panel's shared groups: their widgets' labels and the folder they go in.
+SHARED_LABELS: dict[Control, set[str]] = {
+    Control.SPEED: {"Speed", "Playback"},
+    Control.PLAYBACK: {"Pause", "Step", "Reset", "Playback"},
+    Control.TRAIL: {"Trail length", "Playback"},
+    Control.VISIBILITY: {"Show"},
+}
+IDS = [s.name for s in SCENES]
+
+
+def expected_nodes(spec: SceneSpec) -> set[str]:
+    names = set(ALWAYS) | set(spec.node_names())
+    for element in spec.elements:
+        names |= ELEMENT_NODES[element]
+    return names
+
+
+def trails_of(spec: SceneSpec) -> tuple[str, ...]:
+    return CONSTRUCTION_TRAILS + tuple(t for p in spec.parts for t in p.trails)
+
+
+def expected_labels(spec: SceneSpec) -> set[str]:
+    labels = set(spec.control_labels()) | {spec.label.removeprefix("Scene: ")}
+    for control in spec.shared:
+        labels |= SHARED_LABELS[control]
+    if Control.VISIBILITY in spec.shared:
+        labels |= {ELEMENT_LABELS[e] for e in spec.elements}
+    return labels
+
+
+def common_labels(make_app, make_probe) -> set[str]:
+    """What every session shows whatever it plays: the menu, the lecture and ghost folders
+    (read off a session on the sphere preset, minus the sphere's own groups)."""
+    sphere = preset_by_key("sphere")
+    app = make_app(sphere)
+    probe = make_probe(app)
+    session = session_of(app)
+    assert wait_until(lambda: session.stats.frames > 3, 15)
+    time.sleep(0.5)
+    own = {ELEMENT_LABELS[e] for e in sphere.elements}
+    for control in sphere.controls:
+        own |= SHARED_LABELS.get(control, set())
+    own |= {"I₁", "I₂", "I₃", "|ω₀|", "Body: principal moments", "Motion"}
+    return visible_labels(probe) - own
+
+
+@pytest.mark.parametrize("spec", SCENES, ids=IDS)
+def test_each_scene_creates_only_what_it_declares(spec, make_app, make_probe):
+    common = common_labels(make_app, make_probe)
+    _, session, probe = start(make_app, make_probe, spec)
+    expected = expected_nodes(spec)
+    trails = trails_of(spec)
+    assert probe.wait_for(lambda p: scene_node_names(p, trails) == expected, 15), (
+        scene_node_names(probe, trails) ^ expected
+    )
+    labels = expected_labels(spec)
+    assert probe.wait_for(lambda p: labels <= visible_labels(p), 10), labels - visible_labels(probe)
+    extra = visible_labels(probe) - labels - common
+    assert extra == set(), f"undeclared widgets: {extra}"
+    assert plot_titles(probe) == {p.title for p in spec.plots}
+    assert session.stats.errors == 0, session.stats.last_error
+
+
+def test_the_menu_switches_scenes_and_presets_exactly(make_app, make_probe):
+    app = make_app()
+    probe = make_probe(app)
+    session = session_of(app)
+    assert wait_until(lambda: session.stats.frames > 3, 15)
+    uuid, _ = probe.widget("Preset")
+    for name in ("polhode-family", "gyroscope-torque", "dzhanibekov", "explorer-1"):
+        spec = scene_by_name(name)
+        probe.set_value(uuid, spec.label)
+        assert wait_until(
+            lambda s=spec: (
+                session.showcase is not None
+                and session.showcase.spec is s
+                and session.showcase.loaded
+            ),
+            15,
+        )
+        expected, trails = expected_nodes(spec), trails_of(spec)
+        assert probe.wait_for(lambda p, e=expected, t=trails: scene_node_names(p, t) == e, 15), (
+            scene_node_names(probe, trails) ^ expected
+        )
+        assert probe.wait_for(lambda p, s=spec: plot_titles(p) == {x.title for x in s.plots}, 10)
+    preset = preset_by_key("t_handle")
+    probe.set_value(uuid, preset.label)
+    assert wait_until(lambda: session.showcase is None and session.preset is preset, 15)
+    names = set(ALWAYS)
+    for element in preset.elements:
+        names |= ELEMENT_NODES[element]
+    assert probe.wait_for(lambda p: scene_node_names(p, CONSTRUCTION_TRAILS) == names, 15), (
+        scene_node_names(probe, CONSTRUCTION_TRAILS) ^ names
+    )
+    assert probe.wait_for(lambda p: plot_titles(p) == {"ω in the body frame"}, 10)
+    assert wait_until(lambda: session.body is not None and session.body.inertia[2] > 3.0, 10)
+    assert session.stats.errors == 0, session.stats.last_error
+
+
+def test_bad_input_keeps_the_last_scene_and_says_why(make_app, make_probe):
+    spec = scene_by_name("gyroscope-torque")
+    _, session, probe = start(make_app, make_probe, spec)
+    showcase = session.showcase
+    assert showcase is not None
+    model = showcase.showcase.model
+    generation = session.generation
+    uuid, _ = probe.widget("spin ω₃")
+    probe.set_value(uuid, 0.0)  # the slider stops at 0.5; a message from elsewhere may not
+    assert wait_until(lambda: session.generation > generation, 10)
+    assert "a gyroscope must spin" in session.status
+    assert showcase.showcase.model is model  # the last valid scene is kept
+    assert probe.wait_for(
+        lambda p: any("a gyroscope must spin" in str(w.props.get("_markdown", "")) for w in p.widgets.values()), 5
+    )
+    generation = session.generation
+    probe.set_value(uuid, 2.0)
+    assert wait_until(lambda: session.generation > generation and session.status == "", 10)
+    assert showcase.showcase.model is not model
+    assert session.stats.errors == 0, session.stats.last_error
+
+
+#: What a frame may send (as in test_server): poses, node updates, trail chunks, GUI values.
+PER_FRAME_TYPES = {
+    "SetOrientationMessage",
+    "SetPositionMessage",
+    "SceneNodeUpdateMessage",
+    "LineSegmentsMessage",
+    "RemoveSceneNodeMessage",
+    "SetSceneNodeVisibilityMessage",
+    "GuiUpdateMessage",
+}
+
+
+@pytest.mark.parametrize("name", ["explorer-1", "symmetric-top"])
+def test_per_frame_only_poses_and_trail_increments(name, make_app, make_probe):
+    spec = scene_by_name(name)
+    _, session, probe = start(make_app, make_probe, spec)
+    trails = trails_of(spec)
+    assert wait_until(lambda: session.stats.frames > 30, 10)
+    start_batch, frames = len(probe.batches), session.stats.frames
+    time.sleep(1.5)
+    assert session.stats.frames - frames > 30
+    for batch in probe.batches[start_batch:]:
+        for kind, node in zip(batch.types, batch.names, strict=True):
+            assert kind in PER_FRAME_TYPES, (kind, node)
+            if kind in ("LineSegmentsMessage", "RemoveSceneNodeMessage"):
+                assert node.startswith(tuple(t + "/c" for t in trails)), node
+    assert session.stats.errors == 0, session.stats.last_error

@@ -1,0 +1,153 @@
+"""Helpers for the scene tests: start a server on a scene, read what it sends through the
+websocket probe (poses, positions, arrows, trails, readouts, plots) at chosen times.
+
+The times are set on the session's clock (paused, then reset to each time); the data are read
+from the probe's model of the scene as sent, once the browser-side pose equals the one the
+session drew for that time."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+from conftest import session_of, wait_until
+from scipy.spatial.transform import Rotation
+
+from poinsot.app.live.probe import Node, Probe
+from poinsot.app.live.server import PoinsotApp
+from poinsot.app.live.session import Session
+from poinsot.app.scene.batch import Frame
+from poinsot.app.scene.frames import xyzw_from_wxyz
+
+#: Nodes every session has, whatever it shows.
+ALWAYS = {"/WorldAxes", "/space", "/space/body", "/space/tip", "/lights", "/lights/fill"}
+#: Trail groups of the Poinsot construction (their chunks come and go).
+CONSTRUCTION_TRAILS = ("/space/body/polhode", "/space/herpolhode")
+
+
+def start(make_app, make_probe, spec) -> tuple[PoinsotApp, Session, Probe]:
+    """A server whose browsers start with scene ``spec``, a probe on it, once it has drawn."""
+    app = make_app(scene=spec)
+    probe = make_probe(app)
+    session = session_of(app)
+    assert wait_until(lambda: session.running and session.stats.frames > 3, 20), "no frames"
+    assert wait_until(lambda: session.showcase is not None and session.showcase.loaded, 20)
+    return app, session, probe
+
+
+def sent_at(session: Session, probe: Probe, t: float) -> tuple[Frame, dict[str, Node]]:
+    """Pause the clock at ``t`` and return the session's frame and the nodes as sent."""
+    session.clock.paused = True
+    session.clock.reset(t)
+
+    def drawn() -> bool:
+        frame = session.frame
+        return frame is not None and t - 0.06 < frame.t <= t + 1e-9
+
+    assert wait_until(drawn, 10), f"the session did not draw t = {t}"
+    frame = session.frame
+    assert frame is not None
+    assert probe.wait_for(
+        lambda p: (
+            "/space/body" in p.nodes
+            and np.allclose(p.nodes["/space/body"].wxyz, frame.wxyz, atol=1e-9)
+        ),
+        10,
+    ), "the pose never arrived"
+    nodes, _ = probe.snapshot()
+    return frame, nodes
+
+
+def rotation(node: Node) -> Rotation:
+    return Rotation.from_quat(xyzw_from_wxyz(np.asarray(node.wxyz)))
+
+
+def arrow_tip(node: Node) -> np.ndarray:
+    """The end of a one-arrow node as sent (its points are (1, 2, 3))."""
+    return np.asarray(node.props["points"], dtype=np.float64).reshape(-1, 2, 3)[0, 1]
+
+
+def segments(node: Node) -> np.ndarray:
+    """A line-segments node's points as sent, (n, 2, 3)."""
+    return np.asarray(node.props["points"], dtype=np.float64).reshape(-1, 2, 3)
+
+
+def trail_points(nodes: dict[str, Node], group: str) -> np.ndarray:
+    """The points of a trail as sent: its chunks ``group/c<n>`` in order, chained."""
+    chunks = sorted(
+        (int(name.rsplit("/c", 1)[1]), node)
+        for name, node in nodes.items()
+        if name.startswith(group + "/c") and name.rsplit("/c", 1)[1].isdigit()
+    )
+    if not chunks:
+        return np.zeros((0, 3))
+    parts = [segments(node) for _, node in chunks]
+    segs = np.concatenate(parts)
+    return np.concatenate([segs[:, 0], segs[-1:, 1]])
+
+
+def scene_node_names(probe: Probe, trails: tuple[str, ...]) -> set[str]:
+    """The nodes as sent, without the chunks of the given trail groups."""
+    nodes, _ = probe.snapshot()
+    return {name for name in nodes if not any(name.startswith(group + "/c") for group in trails)}
+
+
+def visible_labels(probe: Probe) -> set[str]:
+    _, widgets = probe.snapshot()
+    return {
+        str(w.props["label"])
+        for w in widgets.values()
+        if w.props.get("label") and w.props.get("visible", True)
+    }
+
+
+def plot_titles(probe: Probe) -> set[str]:
+    _, widgets = probe.snapshot()
+    return {
+        str(w.props.get("title"))
+        for w in widgets.values()
+        if w.type == "GuiUplotMessage" and w.props.get("visible", True)
+    }
+
+
+def plot_data(probe: Probe, title: str) -> list[np.ndarray]:
+    """The data last sent to the plot titled ``title``: [x, series...]."""
+    _, widgets = probe.snapshot()
+    for w in widgets.values():
+        if w.type == "GuiUplotMessage" and w.props.get("title") == title:
+            return [np.asarray(a, dtype=np.float64) for a in w.props["data"]]
+    raise KeyError(title)
+
+
+_CELL = re.compile(r"(?<!\\)\|")
+
+
+def readout_table(probe: Probe) -> dict[str, tuple[str, str]]:
+    """The readout table as shown: quantity -> (theory, measured)."""
+    _, widgets = probe.snapshot()
+    for w in widgets.values():
+        text = str(w.props.get("_markdown", ""))
+        if w.type == "GuiMarkdownMessage" and text.startswith("| quantity | theory | measured |"):
+            rows = {}
+            for line in text.splitlines()[2:]:
+                if not line.startswith("|"):
+                    break
+                cells = [c.strip().replace("\\|", "|") for c in _CELL.split(line)[1:-1]]
+                rows[cells[0]] = (cells[1], cells[2])
+            return rows
+    return {}
+
+
+def number_in(text: str) -> float:
+    """The first number of a readout cell ("1.234 (+2e-09)", "12.5 %", "30.000000°")."""
+    match = re.search(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?", text.replace("−", "-"))
+    assert match, f"no number in {text!r}"
+    return float(match.group(0))
+
+
+def wait_readouts(probe: Probe, names, timeout: float = 10.0) -> dict[str, tuple[str, str]]:
+    """The readout table once it shows every quantity in ``names``."""
+    assert probe.wait_for(lambda p: set(names) <= set(readout_table(p)), timeout), readout_table(
+        probe
+    )
+    return readout_table(probe)
