@@ -88,9 +88,7 @@ def stall(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
     runs out. So the stall is long by default, and its last third is judged on its own."""
     n, seconds = cfg.clients, cfg.stall_seconds
     reference, tail = min(REFERENCE_SECONDS, seconds), seconds / 3.0
-    say(
-        f"stall: {n} clients; {reference:g} s, {seconds:g} s with client 0 stalled, {reference:g} s"
-    )
+    say(f"stall: {n} clients, client 0 stalls for {seconds:g} s ({reference:g} s either side)")
     with _fleet(server, cfg, n) as fleet:
         time.sleep(warmup(seconds))
         before = fleet.window(reference)
