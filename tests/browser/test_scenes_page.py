@@ -1,0 +1,130 @@
+"""The scenes in a real browser (Debian's Chromium through playwright, WebGL through
+SwiftShader): every scene renders a picture that is not blank and differs from the others; each
+part it declares is on the picture (the colours of its lines are there, and hiding it from its
+checkbox in the page changes the picture); its readouts and controls are in the page; the menu
+takes the browser from a preset to a scene and back."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import session_of, wait_until
+from test_live_page import amber_fraction
+
+from poinsot.app.elements import Element
+from poinsot.app.presets import preset_by_key
+from poinsot.app.scenes import SCENES, scene_by_name
+from poinsot.app.scenes.spec import SceneSpec
+
+pytestmark = pytest.mark.browser
+
+WIDTH, HEIGHT = 1280, 800
+#: A pixel shows a line's colour when its RGB is this close (sum of absolute differences):
+#: loose, because a line seen through a translucent surface (the ellipsoid, Landau's sphere, a
+#: cone) is blended with it. Hiding the part must take these pixels away (check_parts).
+COLOUR_TOLERANCE = 90
+#: Pixels of a line's colour that make it "on the picture".
+MIN_COLOUR_PIXELS = 12
+
+
+def render(session) -> np.ndarray:
+    """The browser's render of its 3D view (no panel, no notice), laid on black, (H, W, 3),
+    once two renders in a row agree (the browser decodes new nodes asynchronously)."""
+
+    def once() -> np.ndarray:
+        rgba = session.client.get_render(HEIGHT, WIDTH, transport_format="png", timeout=60.0)
+        return (rgba[..., :3].astype(np.float64) * (rgba[..., 3:4] / 255.0)).astype(np.int16)
+
+    previous = once()
+    for _ in range(10):
+        current = once()
+        if np.array_equal(current, previous):
+            return current
+        previous = current
+    raise AssertionError("the picture did not settle")
+
+
+def colour_pixels(rgb: np.ndarray, color) -> int:
+    return int(np.sum(np.abs(rgb - np.asarray(color)).sum(axis=2) < COLOUR_TOLERANCE))
+
+
+def changed(a: np.ndarray, b: np.ndarray) -> float:
+    """The fraction of pixels that differ visibly between two pictures."""
+    return float(np.mean(np.abs(a - b).sum(axis=2) > 40))
+
+
+def settle(page, session, spec: SceneSpec) -> None:
+    """Let the scene play a moment (its traces grow), then pause it."""
+    assert wait_until(lambda: session.showcase is not None and session.showcase.loaded, 20)
+    assert wait_until(lambda: session.stats.frames > 60, 30), "the scene is not animating"
+    session.clock.paused = True
+    page.page.wait_for_timeout(600)
+
+
+def check_parts(page, session, spec: SceneSpec, shown: np.ndarray) -> None:
+    """Each part: its lines' colours are on the picture; hiding it changes the picture."""
+    drawing = session.showcase.showcase.drawing
+    for part in spec.parts:
+        for color in part.colors:
+            assert colour_pixels(shown, color) >= MIN_COLOUR_PIXELS, (spec.name, part.key, color)
+        page.set_checkbox(part.label, False)
+        assert wait_until(lambda p=part: not drawing.parts.is_visible(p.key), 10), part.key
+        page.page.wait_for_timeout(400)
+        hidden = render(session)
+        assert changed(shown, hidden) > 2e-4, (spec.name, part.key)
+        for color in part.colors:
+            assert colour_pixels(hidden, color) < colour_pixels(shown, color), (part.key, color)
+        page.set_checkbox(part.label, True)
+        assert wait_until(lambda p=part: drawing.parts.is_visible(p.key), 10), part.key
+    page.page.wait_for_timeout(400)
+
+
+def test_every_scene_draws_its_parts_distinctly(make_app, open_page):
+    pictures: dict[str, np.ndarray] = {}
+    for spec in SCENES:
+        app = make_app(scene=spec)
+        page = open_page(app.url, width=WIDTH, height=HEIGHT)
+        session = session_of(app)
+        settle(page, session, spec)
+        shown = render(session)
+        drawn = np.abs(shown - shown[0, 0]).sum(axis=2) > 30
+        assert drawn.mean() > 0.03, (spec.name, drawn.mean())  # not blank
+        if Element.ELLIPSOID in spec.elements:
+            assert amber_fraction(shown.astype(np.uint8)) > 0.005, spec.name
+        check_parts(page, session, spec, shown)
+        for quantity in spec.readouts:  # the readout table and the controls are in the page
+            assert page.page.get_by_text(quantity.split(" ")[0], exact=False).count() >= 1
+        for control in spec.controls:
+            assert page.control_count(control.label) == 1, control.label
+        assert page.errors == [], (spec.name, page.errors)
+        assert session.stats.errors == 0, session.stats.last_error
+        pictures[spec.name] = shown
+        page.page.context.close()  # one rendering page at a time (software WebGL is slow)
+        app.stop()
+    names = list(pictures)
+    for i, a in enumerate(names):
+        for b in names[i + 1 :]:
+            assert changed(pictures[a], pictures[b]) > 0.03, (a, b)
+
+
+def test_the_menu_takes_the_browser_to_a_scene_and_back(make_app, open_page):
+    app = make_app()
+    page = open_page(app.url, width=WIDTH, height=HEIGHT)
+    session = session_of(app)
+    assert wait_until(lambda: session.stats.frames > 20, 20)
+    spec = scene_by_name("dzhanibekov")
+    page.choose("Preset", spec.label)
+    assert wait_until(lambda: session.showcase is not None and session.showcase.loaded, 20)
+    assert wait_until(lambda: page.control_count("ε from the intermediate axis") == 1, 15)
+    assert page.control_count("D = |L|²/2T") == 0  # the preset's energy slider is gone
+    page.choose("ε from the intermediate axis", "1e-12")
+    assert wait_until(lambda: session.showcase.showcase.model.epsilon == 1e-12, 15)
+    assert wait_until(lambda: page.page.get_by_text("1.058e-24").count() >= 1, 15)
+    page.page.locator(".uplot-container").first.wait_for(state="visible", timeout=20000)
+    preset = preset_by_key("oblate")
+    page.choose("Preset", preset.label)
+    assert wait_until(lambda: session.showcase is None and session.preset is preset, 15)
+    assert wait_until(lambda: page.control_count("ε from the intermediate axis") == 0, 15)
+    assert page.control_count("D = |L|²/2T") == 1
+    assert page.errors == []
+    assert session.stats.errors == 0, session.stats.last_error
