@@ -97,14 +97,19 @@ ADVICE = {
 }
 
 
+def too_large(size: int, limit: int, name: str, kind: str) -> str:
+    """What to tell about a file of ``size`` bytes over ``limit``; ``kind`` ("toss" or "mesh")
+    picks the advice."""
+    return (
+        f"{name} is {size / 2**20:.3g} MB; files up to {limit / 2**20:.3g} MB are accepted: "
+        + ADVICE[kind]
+    )
+
+
 def check_size(size: int, limit: int, name: str, kind: str) -> None:
-    """ValueError if ``size`` bytes is over ``limit`` (before anything is parsed); ``kind``
-    ("toss" or "mesh") picks the advice."""
+    """ValueError if ``size`` bytes is over ``limit`` (checked before anything is parsed)."""
     if size > limit:
-        raise ValueError(
-            f"{name} is {size / 2**20:.3g} MB; files up to {limit / 2**20:.3g} MB are accepted: "
-            + ADVICE[kind]
-        )
+        raise ValueError(too_large(size, limit, name, kind))
 
 
 # -- a recording ----------------------------------------------------------------------------

@@ -208,12 +208,8 @@ class UploadControls:
         self._refused(kind, own_bodies.display_name(name), size, cap)
 
     def _refused(self, kind: str, name: str, size: int, cap: int) -> None:
-        try:
-            own_bodies.check_size(size, cap, name, kind)
-        except ValueError as exc:
-            message = f"⚠ {exc}. The body shown is kept."
-        else:  # pragma: no cover - refused means over the cap
-            return
+        """A file over the cap: say so, never parse it (any thread)."""
+        message = f"⚠ {own_bodies.too_large(size, cap, name, kind)}. The body shown is kept."
         ticket = self._ticket(kind)
         self.host.post(lambda: self._show_failure(kind, ticket, message))
 
