@@ -276,15 +276,19 @@ def mesh_preset(body: MeshBody) -> Preset:
 
 
 def mesh_markdown(body: MeshBody) -> str:
-    """What was measured: the name, size, moments and whether it was repaired."""
+    """What was measured: the name, size and moments."""
     moments = ", ".join(f"I{_SUBSCRIPTS[k]} = {body.ratios[k]:.4g}" for k in range(3))
-    lines = [
+    return (
         f"**{body.name}**: {len(body.mesh.vertices):,} vertices, {len(body.mesh.faces):,} "
-        f"faces; moments at uniform density (largest = 1): {moments}",
-    ]
-    if body.repaired:
-        lines.append(
-            "_Repaired:_ the mesh was not closed; trimesh closed its holes and fixed its "
-            "normals, so the moments are those of the repaired solid."
-        )
-    return "\n\n".join(lines)
+        f"faces; moments at uniform density (largest = 1): {moments}"
+    )
+
+
+def repair_note(body: MeshBody) -> str:
+    """The status after a mesh was measured: says so if trimesh had to repair it."""
+    if not body.repaired:
+        return ""
+    return (
+        f"Repaired: {body.name} was not closed; trimesh closed its holes and fixed its "
+        "normals, and the moments are those of the repaired solid."
+    )

@@ -276,6 +276,7 @@ class UploadControls:
         else:
             body: MeshBody = result
             self.mesh, self.mesh_preset = body, preset
-            self.mesh_lines.show(status="", readout=own_bodies.mesh_markdown(body))
+            note = own_bodies.repair_note(body)
+            self.mesh_lines.show(status=note, readout=own_bodies.mesh_markdown(body))
         self.host.choose_preset(preset)
         self.finished += 1

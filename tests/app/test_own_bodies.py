@@ -80,7 +80,10 @@ def test_a_mesh_is_a_preset_drawn_as_itself():
     Parameters.from_preset(preset).build()
     repaired = own_bodies.mesh_preset(load_mesh_body(box_stl(drop_faces=1), "holed.stl"))
     assert "repaired" in repaired.source
-    assert "Repaired" in own_bodies.mesh_markdown(load_mesh_body(box_stl(drop_faces=1), "h.stl"))
+    assert own_bodies.repair_note(load_mesh_body(box_stl(drop_faces=1), "h.stl")).startswith(
+        "Repaired: h.stl was not closed"
+    )
+    assert own_bodies.repair_note(body) == ""
 
 
 @pytest.mark.parametrize("key", ["book", "phone", "racquet", "t_handle"])

@@ -390,7 +390,7 @@ def test_a_mesh_upload_becomes_the_body(mesh_page, probe):
 
     assert probe.wait_for(lambda p: solid_vertices(p) == len(measured.mesh.vertices), 10)
     assert "box.stl" in session.uploads.mesh_lines.readout
-    assert "Repaired" not in session.uploads.mesh_lines.readout
+    assert session.uploads.mesh_lines.status == ""  # nothing to repair
     assert session.stats.errors == 0, session.stats.last_error
     check_finite(probe)
 
@@ -400,6 +400,7 @@ def test_a_mesh_with_a_small_hole_is_repaired_and_says_so(mesh_page, probe):
     upload(probe, MESH, "holed box.stl", box_stl(drop_faces=1))
     finished(session, 1)
     assert wait_until(lambda: session.preset.key == "mesh_body", 10)
+    assert session.uploads.mesh_lines.status.startswith("Repaired: holed box.stl")
     assert probe.wait_for(lambda p: any("Repaired" in t for t in markdown_texts(p)), 10)
     assert "repaired" in session.preset.source
 
