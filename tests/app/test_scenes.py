@@ -150,8 +150,9 @@ def test_bad_input_keeps_the_last_scene_and_says_why(make_app, make_probe):
     assert wait_until(lambda: session.generation > generation, 10)
     assert "a gyroscope must spin" in session.status
     assert showcase.showcase.model is model  # the last valid scene is kept
+    said = "a gyroscope must spin"
     assert probe.wait_for(
-        lambda p: any("a gyroscope must spin" in str(w.props.get("_markdown", "")) for w in p.widgets.values()), 5
+        lambda p: any(said in str(w.props.get("_markdown", "")) for w in p.widgets.values()), 5
     )
     generation = session.generation
     probe.set_value(uuid, 2.0)
