@@ -309,8 +309,11 @@ def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     # 2: view along L. The browser reports its camera back to the server.
     page.page.keyboard.press("2")
     top = VIEWS["top"]
-    assert wait_until(near(top.position), 10), ("top view", camera.position)
-    assert np.allclose(camera.look_at, top.look_at, atol=1e-3)
+    # The browser reports its camera while the view animates: wait for the settled state
+    # (position and look-at both at the view's), not the first report that passes one.
+    assert wait_until(
+        lambda: near(top.position)() and np.allclose(camera.look_at, top.look_at, atol=1e-3), 10
+    ), ("top view", camera.position, camera.look_at)
     # 4: ride along. Paused, the camera sits exactly where the body carries BODY_VIEW ...
     page.page.keyboard.press("Space")
     assert wait_until(lambda: session.clock.paused, 5), "space did not pause"
