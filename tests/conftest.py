@@ -24,17 +24,23 @@ import re
 import shutil
 import time
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pytest
 
+from poinsot.app.cli import main as cli_main
 from poinsot.app.exports.screenshot import CHROMIUM_ARGS, CHROMIUM_ENV, DEFAULT_CHROMIUM
 from poinsot.app.live.lecture import LectureControls
 from poinsot.app.live.probe import Probe
 from poinsot.app.live.server import PoinsotApp
 from poinsot.app.live.session import Session
 from poinsot.app.presets import DEFAULT_PRESET, Preset
+from poinsot.app.report.cases import CASES, StudyConfig
+from poinsot.app.report.exact import load_reference
+from poinsot.app.report.progress import Progress
+from poinsot.app.report.study import CaseResult, study_case
 
 if TYPE_CHECKING:
     from playwright.sync_api import FloatRect, Page
@@ -272,3 +278,29 @@ def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
     yield open_
     for context in contexts:
         context.close()
+
+
+# -- the report's study (one conftest for the whole suite: a second conftest.py in a subfolder
+# would shadow this module's name for the tests that import helpers from it) ----------------
+# ``quick_report``: one ``poinsot report --quick`` through the real command line (session
+# scope, ~30 s on the 2-core CI machine), for the tests that read the files it writes.
+# ``small_study``: three cases (Toutatis, 1 - m = 1e-14, the separatrix) at the ``--quick``
+# settings, run through the study itself without writing a report.
+SMALL_STUDY_CASES = ("Toutatis", "near-separatrix 1-m=1e-14", "separatrix")
+
+
+@pytest.fixture(scope="session")
+def quick_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("report")
+    assert cli_main(["report", "--quick", "--out", str(out)]) == 0
+    return out
+
+
+@pytest.fixture(scope="session")
+def small_study() -> list[CaseResult]:
+    by_name = {c.name: c for c in CASES}
+    quick = StudyConfig.for_mode(quick=True)
+    config = dataclasses.replace(quick, cases=tuple(by_name[n] for n in SMALL_STUDY_CASES))
+    reference_cls, _ = load_reference()
+    progress = Progress(1, enabled=False)
+    return [study_case(case, config, reference_cls, progress) for case in config.cases]
