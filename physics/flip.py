@@ -50,8 +50,18 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special
 from scipy.integrate import solve_ivp
 
-from poinsot.physics import FreeRigidBody, Regime
+from poinsot.physics.exact import ldexp, pow2_below
 from poinsot.physics.family import sorted_moments
+from poinsot.physics.free_body import FreeRigidBody
+from poinsot.physics.regime import Regime
+from poinsot.physics.validation import (
+    InputTypeError,
+    check_count,
+    check_number,
+    check_positive,
+    check_vector,
+    grid_size,
+)
 
 __all__ = [
     "FlipTheory",
@@ -67,6 +77,13 @@ __all__ = [
 _STEPS_PER_RATE = 10.0
 #: measure_growth_rate gives up after this many grid samples.
 _GROWTH_MAX_SAMPLES = 1 << 24
+_GROWTH_CHUNK = 4096
+#: integrated_flip_times integrates at most this many radians of the fastest rotation (DOP853
+#: takes a few steps per radian: beyond this it would run for minutes).
+_MAX_RADIANS = 1e4
+#: Tolerances below this scipy raises to it with a warning: refused instead; above the largest
+#: the steps are so long that the solution may run off to infinity.
+_MIN_RTOL, _MAX_RTOL = 100.0 * float(np.finfo(float).eps), 1e-2
 
 
 def flip_initial_omega(
@@ -78,16 +95,14 @@ def flip_initial_omega(
     Raises:
         ValueError: unless ``0 < ε < π/2`` and ``spin > 0`` (a spin exactly about e2 never flips).
     """
-    eps, spin, beta = float(epsilon), float(spin), float(azimuth)
-    if not (math.isfinite(eps) and 0.0 < eps < 0.5 * math.pi):
+    eps = check_number(epsilon, "the angle ε from the intermediate axis")
+    if not 0.0 < eps < 0.5 * math.pi:
         raise ValueError(
             f"the angle ε from the intermediate axis must lie in (0, π/2) rad, got {epsilon!r} "
             "(ε = 0 is a spin exactly about e2, which never flips)"
         )
-    if not (math.isfinite(spin) and spin > 0.0):
-        raise ValueError(f"the spin rate must be a positive finite number, got {spin!r}")
-    if not math.isfinite(beta):
-        raise ValueError(f"the azimuth β must be finite, got {azimuth!r}")
+    spin = check_positive(spin, "the spin rate")
+    beta = check_number(azimuth, "the azimuth β")
     s = math.sin(eps)
     return spin * np.array([s * math.cos(beta), math.cos(eps), s * math.sin(beta)])
 
@@ -137,56 +152,93 @@ def flip_theory(inertia: ArrayLike, omega0: ArrayLike) -> FlipTheory:
         ValueError: moments not sorted/distinct, ω0 not finite, along a principal axis, or
             exactly on the separatrix (it then flips once and never again).
     """
-    J = sorted_moments(inertia)
-    I1, I2, I3 = J
-    w = np.asarray(omega0, dtype=float)
-    if w.shape != (3,) or not np.all(np.isfinite(w)):
-        raise ValueError(f"omega0 must be three finite numbers, got {omega0!r}")
+    moments = sorted_moments(inertia)
+    w = check_vector(omega0, "omega0")
     if int(np.count_nonzero(w)) < 2:
         raise ValueError(
             f"omega0 = {w.tolist()} is a spin about a principal axis: it never flips; tilt it "
             "from e2 (see flip_initial_omega)"
         )
-    d1, d2, d3 = _deltas(J, w)
+    # Moments and ω over exact powers of two: the squares of ω ~ 1e200 or of moments ~1e-200
+    # would leave the double range; every quantity below is a ratio of factors near 1.
+    scale = pow2_below(moments[2])
+    J1, J2, J3 = J = (moments[0] / scale, moments[1] / scale, moments[2] / scale)
+    w_exp = math.frexp(float(np.max(np.abs(w))))[1] - 1
+    ws = np.ldexp(w, -w_exp)
+    d1, d2, d3 = _deltas(J, ws)
     if d2 == 0.0:
         raise ValueError(
-            "omega0 lies exactly on the separatrix (G² = 2T I2): the body flips once and never "
-            "again; change the azimuth of the tilt"
+            "omega0 lies on the separatrix (G² = 2T I2 to double precision): the body flips "
+            "once and never again; change the azimuth of the tilt"
+        )
+    if d1 <= 0.0 or d3 >= 0.0:
+        raise ValueError(
+            f"omega0 = {w.tolist()} is a spin about a principal axis to double precision (its "
+            "other components are too small to count): it never flips; tilt it from e2"
         )
     major = d2 > 0.0
     # A1² = -Δ3/(I1(I3 - I1)) and A3² = Δ1/(I3(I3 - I1)) in both families [LL76 Eq. 37.10].
-    a31 = math.sqrt(d1 * I1 / (-d3 * I3))  # A3/A1
-    w1, w3 = abs(float(w[0])), abs(float(w[2]))
+    a31 = math.sqrt(d1 / -d3) * math.sqrt(J1 / J3)  # A3/A1
+    w1, w3 = abs(float(ws[0])), abs(float(ws[2]))
     if major:
-        lam = math.sqrt((I3 - I2) * d1 / (I1 * I2 * I3))
-        mc = d2 * (I3 - I1) / (d1 * (I3 - I2))
-        ratio = w1 * a31 / w3 if w3 > 0.0 else 0.0
+        lam = math.sqrt((J3 - J2) / J3) * math.sqrt(d1 / J1) / math.sqrt(J2)
+        mc = d2 / d1 * ((J3 - J1) / (J3 - J2))
+        ratio = w1 * a31 / w3 if w3 > 0.0 and w1 > 0.0 else 0.0
     else:
-        lam = math.sqrt((I2 - I1) * -d3 / (I1 * I2 * I3))
-        mc = d2 * (I3 - I1) / (d3 * (I2 - I1))
-        ratio = w3 / (a31 * w1) if w1 > 0.0 else 0.0
+        lam = math.sqrt((J2 - J1) / J1) * math.sqrt(-d3 / J3) / math.sqrt(J2)
+        mc = d2 / d3 * ((J3 - J1) / (J2 - J1))
+        ratio = w3 / (a31 * w1) if w1 > 0.0 and w3 > 0.0 else 0.0
     K = float(special.ellipkm1(mc))
     delta = float(special.ellipkinc(math.asin(min(ratio, 1.0)), 1.0 - mc))
     # dω2/dt = (I3 - I1) ω3 ω1 / I2: growing means the closest approach to e2 is still ahead.
     growing = (float(w[0]) * float(w[2]) * float(w[1])) > 0.0
-    first = (K + delta if growing else K - delta) / lam
-    sigma = abs(float(w[1])) * math.sqrt((I2 - I1) * (I3 - I2) / (I1 * I3))
-    return FlipTheory(
+    sigma = abs(float(ws[1])) * math.sqrt((J2 - J1) / J1) * math.sqrt((J3 - J2) / J3)
+    times = [ldexp(x / lam, -w_exp) for x in (K + delta if growing else K - delta, 2.0 * K)]
+    asymptotic = ldexp(math.log(16.0 / mc) / lam, -w_exp) if mc > 0.0 else math.inf
+    theory = FlipTheory(
         regime=Regime.MAJOR_AXIS if major else Regime.MINOR_AXIS,
         complementary_parameter=mc,
         K=K,
-        frequency=lam,
-        time_between_flips=2.0 * K / lam,
-        first_flip_time=first,
-        growth_rate=sigma,
-        asymptotic_time_between_flips=math.log(16.0 / mc) / lam,
+        frequency=ldexp(lam, w_exp),
+        time_between_flips=times[1],
+        first_flip_time=times[0],
+        growth_rate=ldexp(sigma, w_exp),
+        asymptotic_time_between_flips=asymptotic,
+    )
+    _check_clock(theory)
+    return theory
+
+
+def _check_clock(theory: FlipTheory) -> None:
+    """Refuse a clock that does not fit in doubles in the caller's units."""
+    values = (
+        theory.K,
+        theory.frequency,
+        theory.time_between_flips,
+        theory.first_flip_time,
+        theory.growth_rate,
+    )
+    if all(map(math.isfinite, values)) and theory.time_between_flips > 0.0:
+        return
+    raise ValueError(
+        "the flip clock of this motion lies beyond the double-precision range in your units "
+        f"(K = {theory.K:g}, λ = {theory.frequency:g}, 2K/λ = {theory.time_between_flips:g}): "
+        "tilt ω0 further from e2, or use a time unit closer to 1/|ω0|"
     )
 
 
+def check_body(body: object, what: str) -> FreeRigidBody:
+    """``body`` if it is a :class:`FreeRigidBody`, else an InputTypeError."""
+    if not isinstance(body, FreeRigidBody):
+        raise InputTypeError(f"{what} needs a FreeRigidBody, got {type(body).__name__}")
+    return body
+
+
 def _fastest_rate(inertia: NDArray[np.float64], omega0: NDArray[np.float64]) -> float:
-    """A bound on the rates of Euler's equations: ``|ω| max|Iⱼ - Iₖ|/Iᵢ`` (or ``|ω|``)."""
+    """A bound on the rates of Euler's equations: ``|ω| max|Iⱼ - Iₖ|/Iᵢ`` (or ``|ω|``); inf
+    where it leaves the double range."""
     spread = (float(inertia.max()) - float(inertia.min())) / float(inertia.min())
-    return float(np.linalg.norm(omega0)) * max(1.0, spread)
+    return math.hypot(*omega0.tolist()) * max(1.0, spread)
 
 
 def measure_flips(
@@ -204,16 +256,19 @@ def measure_flips(
         step: the grid spacing [time] (> 0); it must be shorter than half the time between
             flips, which every default is.
     """
-    t_end = float(t_end)
-    if not (math.isfinite(t_end) and t_end > 0.0):
-        raise ValueError(f"t_end must be a positive finite time, got {t_end!r}")
-    if axis not in (0, 1, 2):
-        raise ValueError(f"axis must be 0, 1 or 2, got {axis!r}")
+    check_body(body, "measure_flips")
+    t_end = check_positive(t_end, "t_end")
+    axis = check_count(axis, "axis (0, 1 or 2)", 0, 2)
     if step is None:
-        step = 1.0 / (_STEPS_PER_RATE * _fastest_rate(body.inertia, body.omega0))
-    if not (math.isfinite(step) and step > 0.0):
-        raise ValueError(f"step must be a positive finite time, got {step!r}")
-    n = int(math.ceil(t_end / step))
+        rate = _fastest_rate(body.inertia, body.omega0)
+        if rate == 0.0:  # at rest: nothing changes sign
+            return np.empty(0)
+        step = 1.0 / (_STEPS_PER_RATE * rate)
+    else:
+        step = check_positive(step, "step")
+    n = grid_size(
+        t_end, step, "searching for flips up to t_end", "use a shorter t_end or a larger step"
+    )
     t = np.linspace(0.0, t_end, n + 1)
     w = body.omega(t)[:, axis]
     sign = np.sign(w)
@@ -263,10 +318,19 @@ def measure_growth_rate(
         ValueError: if there is less than two e-folds between the two (ω0 too far from e2 for
             an exponential stretch: use ``ε`` below ``stop_amplitude / (start_factor e²)``).
     """
-    w0 = np.asarray(body.omega0, dtype=float)
-    norm = float(np.linalg.norm(w0))
-    p0 = math.hypot(float(w0[0]), float(w0[2])) / norm
-    lo, hi = p0 * float(start_factor), float(stop_amplitude)
+    check_body(body, "measure_growth_rate")
+    w0, (I1, I2, I3) = body.omega0, body.inertia.tolist()
+    if not (I1 < I2 < I3 or I1 > I2 > I3):
+        raise ValueError(
+            f"e2 is not the intermediate axis of the moments {[I1, I2, I3]}: a perturbation off "
+            "e2 grows only about the intermediate axis; give the moments with it second"
+        )
+    if not np.any(w0):
+        raise ValueError("the body is at rest: there is no perturbation to grow")
+    start_factor = check_positive(start_factor, "start_factor")
+    hi = check_positive(stop_amplitude, "stop_amplitude")
+    p0 = _off_axis(w0[None, :])[0]
+    lo = p0 * start_factor
     if not (p0 > 0.0 and lo * math.e**2 < hi < 1.0):
         raise ValueError(
             f"no exponential stretch: the perturbation starts at {p0:.3g} of |ω|, it must grow "
@@ -275,13 +339,27 @@ def measure_growth_rate(
         )
     if step is None:
         step = 1.0 / (_STEPS_PER_RATE * _fastest_rate(body.inertia, w0))
+    else:
+        step = check_positive(step, "step")
+    # It grows like e^{σt} [LL76 §37]: about ln(hi/p0)/σ to reach hi.
+    sigma = abs(float(w0[1])) * math.sqrt(abs(I2 - I1) / I1) * math.sqrt(abs(I3 - I2) / I3)
+    needed = math.log(hi / p0) / (sigma * step) if sigma * step > 0.0 else math.inf
+    if not needed <= _GROWTH_MAX_SAMPLES:
+        raise ValueError(
+            f"the perturbation would take about {needed:.3g} grid steps to grow to {hi:g} of "
+            f"|ω|, more than {_GROWTH_MAX_SAMPLES}: use a larger step or a start closer to e2"
+        )
+    if not math.isfinite(step * (needed + 2 * _GROWTH_CHUNK)):
+        raise ValueError(
+            "the grid of this slow motion reaches beyond the double range in your time unit: "
+            "use a longer time unit (then ω0 is a larger number)"
+        )
     # Walk the grid in chunks until p passes hi (p grows monotonically on this stretch).
-    chunk = 4096
+    chunk = _GROWTH_CHUNK
     times, amps = [], []
     for start in range(0, _GROWTH_MAX_SAMPLES, chunk):
         t = step * np.arange(start, start + chunk)
-        w = body.omega(t)
-        p = np.hypot(w[:, 0], w[:, 2]) / np.linalg.norm(w, axis=1)
+        p = _off_axis(body.omega(t))
         times.append(t)
         amps.append(p)
         if p.max() >= hi:
@@ -297,10 +375,29 @@ def measure_growth_rate(
     inside = p >= lo
     begin = int(np.argmax(inside))
     t, logp = t[begin:], np.log(p[begin:])
-    rate, offset = np.polyfit(t, logp, 1)
-    residual = float(np.abs(logp - (rate * t + offset)).max())
-    window = (float(t[0]), float(t[-1]))
-    return GrowthFit(float(rate), window, float(rate) * (window[1] - window[0]), residual)
+    if t.size < 3:
+        raise ValueError(
+            f"only {t.size} grid samples on the exponential stretch: use a smaller step"
+        )
+    # The line in the time since the window's start over its length, x in [0, 1]: the squares
+    # of times ~1e-300 would underflow in the fit.
+    span = float(t[-1] - t[0])
+    x = (t - t[0]) / span
+    slope, offset = np.polyfit(x, logp, 1)
+    residual = float(np.abs(logp - (slope * x + offset)).max())
+    rate = float(slope) / span
+    if not math.isfinite(rate):
+        raise ValueError(
+            f"the growth rate is beyond the double-precision range in your units ({slope:.3g} "
+            f"e-folds in {span:.3g}): use a time unit closer to 1/|ω0|"
+        )
+    return GrowthFit(rate, (float(t[0]), float(t[-1])), float(slope), residual)
+
+
+def _off_axis(w: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``|(ω1, ω3)|/|ω|`` for rows of ``w`` (hypot: no overflow of the squares)."""
+    side = np.hypot(w[:, 0], w[:, 2])
+    return side / np.hypot(side, w[:, 1])
 
 
 def integrated_flip_times(
@@ -315,9 +412,26 @@ def integrated_flip_times(
     the flip times are wrong by O(1/σ) (the demo ``python -m poinsot.physics.flip`` prints it).
     """
     J = np.asarray(sorted_moments(inertia))
-    w0 = np.asarray(omega0, dtype=float)
-    if w0.shape != (3,) or not np.all(np.isfinite(w0)):
-        raise ValueError(f"omega0 must be three finite numbers, got {omega0!r}")
+    w0 = check_vector(omega0, "omega0")
+    t_end = check_positive(t_end, "t_end")
+    rtol = check_positive(rtol, "rtol")
+    if not _MIN_RTOL <= rtol <= _MAX_RTOL:
+        raise ValueError(
+            f"rtol must lie between {_MIN_RTOL:.3g} (scipy's floor) and {_MAX_RTOL:g}, got {rtol!r}"
+        )
+    w_max = float(np.max(np.abs(w0)))
+    if w_max == 0.0:  # at rest: ω2 stays 0
+        return np.empty(0)
+    # The same equations for ω/2^e in the time t·2^e (exact powers of two): ω ~ 1e200 would
+    # overflow in the products ω_j ω_k.
+    w_exp = math.frexp(w_max)[1] - 1
+    ws, tau_end = np.ldexp(w0, -w_exp), ldexp(t_end, w_exp)
+    radians = _fastest_rate(J, ws) * tau_end
+    if not radians <= _MAX_RADIANS:
+        raise ValueError(
+            f"t_end spans {radians:.3g} radians of the fastest rotation, more than "
+            f"{_MAX_RADIANS:g} for an integration: use a shorter t_end"
+        )
     c = np.array([(J[1] - J[2]) / J[0], (J[2] - J[0]) / J[1], (J[0] - J[1]) / J[2]])
 
     def euler(_t: float, w: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -326,16 +440,20 @@ def integrated_flip_times(
     def omega2(_t: float, w: NDArray[np.float64]) -> float:
         return float(w[1])
 
-    sol = solve_ivp(
-        euler,
-        (0.0, float(t_end)),
-        w0,
-        method="DOP853",
-        rtol=rtol,
-        atol=rtol * float(np.abs(w0).max()),
-        events=omega2,
-    )
-    return np.asarray(sol.t_events[0], dtype=float)
+    with np.errstate(all="ignore"):  # a run that leaves the range is refused just below
+        sol = solve_ivp(
+            euler,
+            (0.0, tau_end),
+            ws,
+            method="DOP853",
+            rtol=rtol,
+            atol=rtol * float(np.abs(ws).max()),
+            events=omega2,
+        )
+    times = np.asarray(sol.t_events[0], dtype=float)
+    if sol.status < 0 or not (np.all(np.isfinite(sol.y)) and np.all(np.isfinite(times))):
+        raise ValueError(f"DOP853 failed ({sol.message}): use a smaller rtol or a shorter t_end")
+    return np.ldexp(times, -w_exp)
 
 
 def _demo() -> None:  # pragma: no cover - a printout for the report
