@@ -77,7 +77,7 @@ class Propagation:
         t0 = check_number(t0, "t0")
         self.integrator, self.setting, self.t0 = integrator, value, t0
         # The run is carried in the scaled units of the registry (exact powers of two).
-        self._units = units = Scaled.of(inertia, omega0)
+        self._units = units = Scaled.of(integrator, inertia, omega0)
         self._h = units.setting(integrator, value)
         if not (math.isfinite(self._h) and self._h > 0.0):
             raise ValueError(

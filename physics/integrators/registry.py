@@ -1,9 +1,12 @@
 """The registry of numerical methods and the one entry point, :func:`integrate`.
 
 Every method runs in units where the largest moment and the largest ``|ω0|`` component are
-powers of two near 1 (:class:`Scaled`): exact scalings, so the steps and the results are those
-of the caller's units bit for bit, except that ω ~ 1e200 (whose products ω_j ω_k would
-overflow) or ~1e-200 (which would underflow) stays in range.
+powers of two near 1 (:class:`Scaled`): exact scalings, so that ω ~ 1e200 (whose products
+ω_j ω_k would overflow) or ~1e-200 (which would underflow) stays in range. The fixed-step
+methods take the same steps bit for bit in any units. scipy's first step of the adaptive
+pairs mixes the scales of ω and of its derivative, so their time is rescaled only where it
+must be (``|ω0|`` outside ``[1e-100, 1e100]``): elsewhere they run exactly as in the caller's
+units.
 """
 
 from __future__ import annotations
@@ -121,7 +124,7 @@ def integrate(
         raise ValueError("t_eval must be a non-empty 1-D array of finite times")
     if t_eval[0] < 0.0 or np.any(t_eval[1:] < t_eval[:-1]):
         raise ValueError("t_eval must be non-negative and non-decreasing")
-    units = Scaled.of(inertia, omega0)
+    units = Scaled.of(integrator, inertia, omega0)
     tau, h = units.time(t_eval), units.setting(integrator, value)
     units.check_cost(integrator, float(tau[-1]) if tau.size else 0.0, h, tau.size)
     run = integrator.run(units.inertia, units.omega0, attitude0, tau, h)
@@ -170,10 +173,12 @@ class Scaled(NamedTuple):
     w_exp: int
 
     @classmethod
-    def of(cls, inertia: np.ndarray, omega0: np.ndarray) -> Scaled:
+    def of(cls, integrator: Integrator, inertia: np.ndarray, omega0: np.ndarray) -> Scaled:
         i_exp = math.frexp(float(inertia.max()))[1] - 1
         w_max = float(np.max(np.abs(omega0)))
         w_exp = math.frexp(w_max)[1] - 1 if w_max > 0.0 else 0
+        if integrator.kind == "adaptive" and _SAFE_OMEGA[0] <= w_max <= _SAFE_OMEGA[1]:
+            w_exp = 0  # see the module docstring
         return cls(np.ldexp(inertia, -i_exp), np.ldexp(omega0, -w_exp), w_exp)
 
     def time(self, t: np.ndarray) -> np.ndarray:
@@ -222,3 +227,5 @@ class Scaled(NamedTuple):
 
 
 _ADVICE = "use a larger step or fewer, earlier output times"
+#: Where the adaptive pairs keep the caller's time unit.
+_SAFE_OMEGA = (1e-100, 1e100)
