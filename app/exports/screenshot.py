@@ -225,8 +225,9 @@ def headless_chromium(executable: str) -> Iterator[Browser]:
         from playwright.sync_api import sync_playwright
     except ImportError as exc:
         raise BrowserMissing(
-            "the playwright Python package is missing: pip install playwright "
-            "(no `playwright install` needed; it drives the system Chromium)"
+            "the Python package playwright is missing: make install (or pip install "
+            "'poinsot[lecture]') installs it; it drives the system's Chromium, no browser "
+            "download needed"
         ) from exc
     with sync_playwright() as pw:
         browser = pw.chromium.launch(

@@ -1,0 +1,301 @@
+"""Where the scene's labels go on screen: each label's box beside its point, beyond the tip of
+what it names, clear of the other labels and of the contact point, for the camera of the
+browser that shows it.
+
+viser draws a label as a box of constant pixel size (an em of 12 CSS px times its font scale)
+whose corner or edge, its *anchor*, sits on the label's point. Labels pile up when their
+points meet on screen: seen along L, the tips of L and ω and the end of axis 3 all fall near
+the centre. So the server lays them out, a few times a second, from the camera the browser
+reports (:class:`Camera`):
+
+- each label has a point (the tip of its arrow or axis, pushed a little beyond it) and a root
+  (where its arrow starts): the box goes on the side of the point that faces away from the
+  root on screen, "beyond the tip";
+- labels are placed in order of importance, each taking the first of its anchors (ordered by
+  that outward direction) whose box overlaps no box placed before and no marker (the contact
+  point); if none is free, the one that overlaps least;
+- a label whose point may move (:attr:`Slot.movable`: L's, ω's, the herpolhode's, which hang
+  from frames that only translate) is also pushed, in the screen plane, far enough from its
+  root that its box clears the marker drawn there.
+
+Only anchors and these offsets change, and only when they do: a label rides on its frame
+(the body, the contact point) between two layouts, with no message of its own.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import viser
+from scipy.spatial.transform import Rotation
+
+#: CSS pixels of a label's em at font scale 1 (viser's screen-size labels).
+EM_PX = 12.0
+#: A label box: the line height and the padding of viser's label, in ems, and the mean
+#: advance of a character (a sans-serif font; Greek and digits alike).
+LINE_EM = 1.2
+PAD_EM = 0.24
+CHAR_EM = 0.55
+#: Gap kept between boxes, and between a box and a marker [CSS px].
+GAP_PX = 3.0
+
+#: Anchor -> where the box lies from the label's point, as the fractions (fx, fy) of its width
+#: and height by which its top-left corner is offset (screen y points down).
+ANCHORS: dict[str, tuple[float, float]] = {
+    f"{v}-{h}": (fx, fy)
+    for v, fy in (("top", 0.0), ("center", -0.5), ("bottom", -1.0))
+    for h, fx in (("left", 0.0), ("center", -0.5), ("right", -1.0))
+    if (v, h) != ("center", "center")
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class Camera:
+    """A perspective camera as the browser reports it: position, look-at point and up
+    direction (world), vertical field of view [rad], and the view's size [CSS px]."""
+
+    position: np.ndarray
+    look_at: np.ndarray
+    up: np.ndarray
+    fov: float
+    width: float
+    height: float
+
+    def axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The camera's forward, right and up unit vectors (world)."""
+        forward = np.asarray(self.look_at, float) - np.asarray(self.position, float)
+        forward /= np.linalg.norm(forward)
+        right = np.cross(forward, self.up)
+        norm = np.linalg.norm(right)
+        if norm < 1e-9:  # looking along "up": any right angle will do
+            right = np.cross(forward, (1.0, 0.0, 0.0) if abs(forward[0]) < 0.9 else (0, 1.0, 0))
+            norm = np.linalg.norm(right)
+        right /= norm
+        return forward, right, np.cross(right, forward)
+
+    def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Screen positions (N, 2) [CSS px, y down] and depths (N,) of world points (N, 3)."""
+        forward, right, up = self.axes()
+        d = np.asarray(points, float).reshape(-1, 3) - np.asarray(self.position, float)
+        depth = d @ forward
+        focal = 0.5 * self.height / math.tan(0.5 * self.fov)
+        safe = np.where(depth > 1e-6, depth, 1e-6)
+        x = 0.5 * self.width + focal * (d @ right) / safe
+        y = 0.5 * self.height - focal * (d @ up) / safe
+        return np.stack([x, y], axis=1), depth
+
+    def world_per_px(self, depth: float) -> float:
+        """World length of one CSS pixel at ``depth`` (in the screen plane)."""
+        return 2.0 * depth * math.tan(0.5 * self.fov) / self.height
+
+
+def box_size(text: str, scale: float) -> tuple[float, float]:
+    """(width, height) [CSS px] of a one-line label's box at font scale ``scale``."""
+    em = EM_PX * scale
+    return (len(text) * CHAR_EM + PAD_EM) * em, (LINE_EM + PAD_EM) * em
+
+
+@dataclasses.dataclass
+class Slot:
+    """A label to lay out: its ``point`` (world), beyond the ``tip`` of the arrow or axis it
+    names, which starts at ``root``. ``movable``: the point may be pushed in the screen plane,
+    to at least ``clearance`` CSS px beyond the tip (clear of a marker drawn there)."""
+
+    key: str
+    text: str
+    scale: float
+    point: np.ndarray
+    tip: np.ndarray
+    root: np.ndarray
+    movable: bool = False
+    clearance: float = 0.0
+    anchor: str = "bottom-left"
+
+
+@dataclasses.dataclass(frozen=True)
+class Placement:
+    """Where a label goes: its anchor, its world offset (movable labels; zero otherwise) and
+    its box on screen [x0, y0, x1, y1] (CSS px)."""
+
+    anchor: str
+    offset: np.ndarray
+    box: tuple[float, float, float, float]
+    overlap: float
+
+
+def _box(point: np.ndarray, size: tuple[float, float], anchor: str) -> np.ndarray:
+    fx, fy = ANCHORS[anchor]
+    x0, y0 = point[0] + fx * size[0], point[1] + fy * size[1]
+    return np.array([x0, y0, x0 + size[0], y0 + size[1]])
+
+
+def _overlap(a: np.ndarray, b: np.ndarray) -> float:
+    w = min(a[2], b[2]) - max(a[0], b[0]) + GAP_PX
+    h = min(a[3], b[3]) - max(a[1], b[1]) + GAP_PX
+    return max(w, 0.0) * max(h, 0.0)
+
+
+def _disc_overlap(box: np.ndarray, centre: np.ndarray, radius: float) -> float:
+    """Area-like measure of a box's overlap with a disc (0 if apart by GAP_PX)."""
+    nearest = np.clip(centre, box[:2], box[2:])
+    reach = radius + GAP_PX - float(np.linalg.norm(nearest - centre))
+    return max(reach, 0.0) ** 2
+
+
+def _ranked(direction: np.ndarray, current: str) -> list[str]:
+    """Anchors, the one whose box lies most along ``direction`` (screen) first; the current
+    anchor wins ties, so that a label does not flicker between equals."""
+
+    def score(anchor: str) -> float:
+        fx, fy = ANCHORS[anchor]
+        towards = np.array([fx + 0.5, fy + 0.5])
+        towards /= np.linalg.norm(towards)
+        return -float(towards @ direction) - (1e-3 if anchor == current else 0.0)
+
+    return sorted(ANCHORS, key=score)
+
+
+def _outward(*candidates: np.ndarray) -> np.ndarray:
+    """The first screen direction (unit) longer than 2 px; up-right if there is none (an arrow
+    seen end-on)."""
+    for vector in candidates:
+        length = float(np.linalg.norm(vector))
+        if length > 2.0:
+            return vector / length
+    return np.array([math.sqrt(0.5), -math.sqrt(0.5)])
+
+
+#: Points along an arrow that the boxes keep clear of.
+ARROW_SAMPLES = 12
+
+
+def lay_out(
+    slots: Sequence[Slot],
+    camera: Camera,
+    markers: Sequence[tuple[np.ndarray, float]] = (),
+    arrows: Sequence[tuple[np.ndarray, np.ndarray, float]] = (),
+) -> dict[str, Placement]:
+    """Place ``slots`` in their order (most important first); ``markers``: (world point,
+    radius [CSS px]) that no box may cover; ``arrows``: (start, end, half-width [CSS px]) that
+    the boxes avoid crossing. Labels behind the camera keep their anchor."""
+    _, right, up = camera.axes()
+    boxes: list[np.ndarray] = []
+    points = [(np.asarray(p, float), float(r)) for p, r in markers]
+    for start, end, radius in arrows:
+        for f in np.linspace(0.0, 1.0, ARROW_SAMPLES):
+            points.append(((1.0 - f) * np.asarray(start, float) + f * np.asarray(end), radius))
+    discs = []
+    for point, radius in points:
+        screen, depth = camera.project(point)
+        if depth[0] > 0:
+            discs.append((screen[0], radius))
+    placed: dict[str, Placement] = {}
+    for slot in slots:
+        (point, tip, root), depth = camera.project(np.array([slot.point, slot.tip, slot.root]))
+        if depth[0] <= 0:
+            continue
+        direction = _outward(tip - root, point - tip)
+        offset = np.zeros(3)
+        beyond = float((point - tip) @ direction)
+        if slot.movable and beyond < slot.clearance:  # pushed clear of the tip's marker
+            push = slot.clearance - beyond
+            point = point + push * direction
+            offset = (
+                push
+                * camera.world_per_px(float(depth[0]))
+                * (direction[0] * right - direction[1] * up)
+            )
+        size = box_size(slot.text, slot.scale)
+        best: Placement | None = None
+        for anchor in _ranked(direction, slot.anchor):
+            box = _box(point, size, anchor)
+            cost = sum(_overlap(box, other) for other in boxes)
+            cost += sum(_disc_overlap(box, c, r) for c, r in discs)
+            if best is None or cost < best.overlap:
+                best = Placement(anchor, offset, (box[0], box[1], box[2], box[3]), cost)
+            if cost == 0.0:
+                break
+        assert best is not None
+        boxes.append(np.array(best.box))
+        placed[slot.key] = best
+    return placed
+
+
+def overlapping(boxes: Sequence[tuple[float, float, float, float]]) -> list[tuple[int, int]]:
+    """Pairs of boxes that overlap (for tests): indices (i, j), i < j."""
+    pairs = []
+    for i, a in enumerate(boxes):
+        for j in range(i + 1, len(boxes)):
+            b = boxes[j]
+            if min(a[2], b[2]) > max(a[0], b[0]) and min(a[3], b[3]) > max(a[1], b[1]):
+                pairs.append((i, j))
+    return pairs
+
+
+#: A movable label's position is resent only when it moved by more than this [display units].
+POSITION_TOLERANCE = 2e-3
+
+
+@dataclasses.dataclass(frozen=True)
+class Pose:
+    """What the labels' points depend on at a layout: the body's attitude (body -> space), the
+    contact point (world) and the camera."""
+
+    rotation: Rotation
+    contact: np.ndarray
+    camera: Camera
+
+
+class LabelNode:
+    """A label node of the scene, its own font scale, and the anchor and position the layout
+    last sent it (so that only changes are sent)."""
+
+    def __init__(self, handle: viser.LabelHandle, key: str, text: str, scale: float) -> None:
+        self.handle, self.key, self.text, self.scale = handle, key, text, float(scale)
+        self.look_scale = 1.0
+        self.anchor: str = handle.anchor
+        self.position = np.asarray(handle.position, dtype=np.float64)
+
+    def restyle(self, look_scale: float) -> None:
+        if look_scale != self.look_scale:
+            self.look_scale = look_scale
+            self.handle.font_screen_scale = self.scale * look_scale
+
+    def slot(
+        self,
+        point: np.ndarray,
+        tip: np.ndarray,
+        root: np.ndarray,
+        *,
+        movable: bool = False,
+        clearance: float = 0.0,
+    ) -> Slot:
+        """The layout's view of this label, its points in world coordinates."""
+        return Slot(
+            self.key,
+            self.text,
+            self.scale * self.look_scale,
+            np.asarray(point, float),
+            np.asarray(tip, float),
+            np.asarray(root, float),
+            movable,
+            clearance,
+            self.anchor,
+        )
+
+    def place(self, placement: Placement | None, base: np.ndarray | None = None) -> None:
+        """Send the placement's anchor, and for a label hung from a frame that only translates
+        its position ``base`` (in that frame) plus the placement's offset, if they changed."""
+        if placement is None:
+            return
+        if placement.anchor != self.anchor:
+            self.anchor = placement.anchor
+            self.handle.anchor = placement.anchor  # type: ignore[assignment]
+        if base is not None:
+            position = np.asarray(base, float) + placement.offset
+            if np.max(np.abs(position - self.position)) > POSITION_TOLERANCE:
+                self.position = position
+                self.handle.position = position
