@@ -400,6 +400,10 @@ def screenshot_command(
             if isinstance(scene, SceneSpec) and view == "default":
                 camera = scene.view
             stage.set_initial_camera(camera)
+            if isinstance(stage, Stage):  # the labels laid out for this camera and window
+                stage.lay_out_labels(
+                    camera, (round(WINDOW_HEIGHT * size[0] / size[1]), WINDOW_HEIGHT)
+                )
             ground = None if background == "transparent" else THEME_BACKGROUND[background == "dark"]
             shot = capture(stage, camera, size, chromium=chromium, background=ground, fit=fit)
         except BrowserMissing as exc:

@@ -40,7 +40,7 @@ LINE_EM = 1.2
 PAD_EM = 0.24
 CHAR_EM = 0.55
 #: Gap kept between boxes, and between a box and a marker [CSS px].
-GAP_PX = 3.0
+GAP_PX = 4.0
 
 #: Anchor -> where the box lies from the label's point, as the fractions (fx, fy) of its width
 #: and height by which its top-left corner is offset (screen y points down).
