@@ -15,8 +15,8 @@ reports (:class:`Camera`):
   that outward direction) whose box overlaps no box placed before and no marker (the contact
   point); if none is free, the one that overlaps least;
 - a label whose point may move (:attr:`Slot.movable`: L's, ω's, the herpolhode's, which hang
-  from frames that only translate) is also pushed, in the screen plane, far enough from its
-  root that its box clears the marker drawn there.
+  from frames that only translate) may also be pushed, in the screen plane, in one of eight
+  directions (the outward one first), far enough beyond its tip to clear a marker drawn there.
 
 Only anchors and these offsets change, and only when they do: a label rides on its frame
 (the body, the contact point) between two layouts, with no message of its own.
@@ -198,23 +198,15 @@ def lay_out(
         if depth[0] <= 0:
             continue
         direction = _outward(tip - root, point - tip)
-        offset = np.zeros(3)
-        beyond = float((point - tip) @ direction)
-        if slot.movable and beyond < slot.clearance:  # pushed clear of the tip's marker
-            push = slot.clearance - beyond
-            point = point + push * direction
-            offset = (
-                push
-                * camera.world_per_px(float(depth[0]))
-                * (direction[0] * right - direction[1] * up)
-            )
         size = box_size(slot.text, slot.scale)
+        per_px = camera.world_per_px(float(depth[0]))
         best: Placement | None = None
-        for anchor in _ranked(direction, slot.anchor):
-            box = _box(point, size, anchor)
+        for anchor, shift in _options(slot, point, tip, direction):
+            box = _box(point + shift, size, anchor)
             cost = sum(_overlap(box, other) for other in boxes)
             cost += sum(_disc_overlap(box, c, r) for c, r in discs)
             if best is None or cost < best.overlap:
+                offset = per_px * (shift[0] * right - shift[1] * up)
                 best = Placement(anchor, offset, (box[0], box[1], box[2], box[3]), cost)
             if cost == 0.0:
                 break
@@ -222,6 +214,35 @@ def lay_out(
         boxes.append(np.array(best.box))
         placed[slot.key] = best
     return placed
+
+
+#: The eight screen directions a movable label may be pushed in (y down).
+_DIRECTIONS = np.array(
+    [[math.cos(a), math.sin(a)] for a in np.arange(8) * math.pi / 4.0], dtype=np.float64
+)
+
+
+def _anchor_towards(direction: np.ndarray) -> str:
+    """The anchor whose box lies from its point in ``direction`` (screen, y down)."""
+    dx, dy = direction
+    horizontal = "left" if dx > 0.38 else "right" if dx < -0.38 else "center"
+    vertical = "bottom" if dy < -0.38 else "top" if dy > 0.38 else "center"
+    return f"{vertical}-{horizontal}"
+
+
+def _options(
+    slot: Slot, point: np.ndarray, tip: np.ndarray, direction: np.ndarray
+) -> list[tuple[str, np.ndarray]]:
+    """(anchor, screen shift of the point) to try, best first. A fixed label tries its anchors
+    round its point, those along ``direction`` first; a movable one is also pushed, at least
+    ``clearance`` beyond its tip, in each of eight directions, the outward one first."""
+    none = np.zeros(2)
+    if not slot.movable:
+        return [(anchor, none) for anchor in _ranked(direction, slot.anchor)]
+    reach = max(float(np.linalg.norm(point - tip)), slot.clearance)
+    order = np.argsort(-(_DIRECTIONS @ direction))
+    pushes = [(_anchor_towards(d), tip + reach * d - point) for d in _DIRECTIONS[order]]
+    return pushes + [(anchor, none) for anchor in _ranked(direction, slot.anchor)]
 
 
 def overlapping(boxes: Sequence[tuple[float, float, float, float]]) -> list[tuple[int, int]]:
@@ -286,16 +307,25 @@ class LabelNode:
             self.anchor,
         )
 
-    def place(self, placement: Placement | None, base: np.ndarray | None = None) -> None:
-        """Send the placement's anchor, and for a label hung from a frame that only translates
-        its position ``base`` (in that frame) plus the placement's offset, if they changed."""
+    def place(
+        self,
+        placement: Placement | None,
+        base: np.ndarray | None = None,
+        rotation: Rotation | None = None,
+    ) -> None:
+        """Send the placement's anchor and, given the label's ``base`` position in its frame,
+        that position plus the placement's offset (turned into the frame by ``rotation``, the
+        frame's attitude at the layout, for a label on the body), if they changed."""
         if placement is None:
             return
         if placement.anchor != self.anchor:
             self.anchor = placement.anchor
             self.handle.anchor = placement.anchor  # type: ignore[assignment]
         if base is not None:
-            position = np.asarray(base, float) + placement.offset
+            offset = placement.offset
+            if rotation is not None:  # a world offset, into the body's coordinates
+                offset = rotation.inv().apply(offset)
+            position = np.asarray(base, float) + offset
             if np.max(np.abs(position - self.position)) > POSITION_TOLERANCE:
                 self.position = position
                 self.handle.position = position

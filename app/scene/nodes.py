@@ -16,6 +16,7 @@ from collections.abc import Callable
 
 import numpy as np
 import viser
+from scipy.spatial.transform import Rotation
 
 from poinsot.app.elements import Element
 from poinsot.app.scene import meshes, palette
@@ -40,8 +41,11 @@ ORIGIN_RADIUS = 0.03
 #: How far a label's point lies beyond the tip it names [display units].
 BEYOND = 0.05
 #: Screen distance [CSS px] a label keeps from the contact point's marker and from L's head.
-MARKER_CLEARANCE = 12.0
+MARKER_CLEARANCE = 14.0
 HEAD_CLEARANCE = 6.0
+#: How far the labels on the body (axes, polhode) may be pushed beyond their tips [CSS px]:
+#: far enough to step round the contact point's marker where the tips crowd together.
+BODY_CLEARANCE = 10.0
 #: An arrow's points before its first fit: along +z, unit length.
 _UNIT_ARROW = np.array([[[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]], np.float32)
 #: A line-segments node's points before its first fit: one degenerate segment.
@@ -138,13 +142,15 @@ class PrincipalAxes(Drawing):
             f"{root}/origin", radius=ORIGIN_RADIUS, color=palette.ORIGIN, cast_shadow=False
         )
         self.ends = np.zeros((3, 3))
+        self._rotation: Rotation | None = None  # the body's attitude at the last layout
         super().__init__([*self.lines, *self.labels, self.origin])
 
     def fit(self, geometry: Geometry) -> None:
         self.ends = geometry.axis_ends()
-        for line, label, end in zip(self.lines, self.labels, self.ends, strict=True):
+        for line, node, end in zip(self.lines, self.nodes, self.ends, strict=True):
             line.points = np.array([[-end, end]], dtype=np.float32)
-            label.position = end * (1.0 + BEYOND)  # beyond the axis's tip, on the axis
+            node.position = end * (1.0 + BEYOND)  # beyond the axis's tip, on the axis
+            node.handle.position = node.position
 
     def restyle(self, look: Look) -> None:
         for line, color in zip(self.lines, look.axes, strict=True):
@@ -155,15 +161,18 @@ class PrincipalAxes(Drawing):
         self.origin.color = look.origin
 
     def slots(self, pose: Pose) -> list[Slot]:
+        self._rotation = pose.rotation
         tips = pose.rotation.apply(self.ends)
         return [
-            node.slot(tip * (1.0 + BEYOND), tip, np.zeros(3))
+            node.slot(
+                tip * (1.0 + BEYOND), tip, np.zeros(3), movable=True, clearance=BODY_CLEARANCE
+            )
             for node, tip in zip(self.nodes, tips, strict=True)
         ]
 
     def place(self, placements: dict[str, Placement]) -> None:
-        for node in self.nodes:
-            node.place(placements.get(node.key))
+        for node, end in zip(self.nodes, self.ends, strict=True):
+            node.place(placements.get(node.key), end * (1.0 + BEYOND), self._rotation)
 
 
 class InvariablePlane(Drawing):
@@ -380,13 +389,15 @@ class Trace(Drawing):
         self.point = np.zeros(3)  # the named point: on the polhode (body), on the ring (space)
         self.ring = (0.0, 0.0)  # herpolhode: the radius of its ring and the plane's height
         self._base = np.zeros(3)  # herpolhode: the label's point before the layout's push
+        self._rotation: Rotation | None = None  # polhode: the body's attitude at the layout
 
     def fit(self, geometry: Geometry) -> None:
         if self.element is Element.POLHODE:  # a point of the curve, on the body
             self.point = geometry.polhode[int(np.argmax(geometry.polhode[:, 0]))]
             radius = float(np.linalg.norm(self.point))
             outward = self.point / radius if radius > 0 else np.zeros(3)
-            self.node.handle.position = self.point * POLHODE_INFLATE + BEYOND * outward
+            self.node.position = self.point * POLHODE_INFLATE + BEYOND * outward
+            self.node.handle.position = self.node.position
         else:  # the ring's near side in the default view, until the layout turns it
             self.ring = (geometry.herpolhode_radius, geometry.plane_height)
             self.node.position = self._on_ring(np.array([0.93, 0.37]), BEYOND)
@@ -403,18 +414,24 @@ class Trace(Drawing):
 
     def slots(self, pose: Pose) -> list[Slot]:
         if self.element is Element.POLHODE:
+            self._rotation = pose.rotation
             tip = pose.rotation.apply(self.point)
             radius = float(np.linalg.norm(tip))
             point = tip * (1.0 + BEYOND / radius) if radius > 0 else tip
-            return [self.node.slot(point, tip, np.zeros(3))]
+            return [self.node.slot(point, tip, np.zeros(3), movable=True, clearance=BODY_CLEARANCE)]
         toward = _screen_right(pose)
         tip, centre = self._on_ring(toward), np.array([0.0, 0.0, self.ring[1]])
         self._base = self._on_ring(toward, BEYOND)
         return [self.node.slot(self._base, tip, centre, movable=True, clearance=HEAD_CLEARANCE)]
 
     def place(self, placements: dict[str, Placement]) -> None:
-        base = None if self.element is Element.POLHODE else self._base
-        self.node.place(placements.get(self.node.key), base)
+        placement = placements.get(self.node.key)
+        if self.element is Element.POLHODE:
+            radius = float(np.linalg.norm(self.point))
+            base = self.point * (POLHODE_INFLATE + BEYOND / radius) if radius > 0 else self.point
+            self.node.place(placement, base, self._rotation)
+        else:
+            self.node.place(placement, self._base)
 
     def set_visible(self, visible: bool) -> None:
         super().set_visible(visible)
