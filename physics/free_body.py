@@ -213,7 +213,7 @@ class FreeRigidBody:
         self._inertia_scaled = s.inertia
         if self.regime is Regime.REST:
             self.D = 0.0
-            self.plane_distance = 0.0
+            self._plane_distance_scaled = 0.0
             self.plane_normal = np.array([0.0, 0.0, 1.0])
             return
         # D = G²/2T lies in [min I, max I]; on the separatrix it is I2 exactly (Δ2 = 0).
@@ -225,7 +225,7 @@ class FreeRigidBody:
             ratio = G * (G / two_T) if two_T > 0 else 0.0
             scaled_D = min(max(ratio, float(s.J.min())), float(s.J.max()))
         self.D = scaled_D * self._I_ref
-        self.plane_distance = two_T / G * self._w_ref  # 2T/G <= |ω|
+        self._plane_distance_scaled = two_T / G  # 2T/G <= |ω|: may pass 1.8e308 with |ω|
         G_space = math.hypot(*self._L_scaled.tolist())  # no underflow of G² for moments ~1e-300
         self.plane_normal = self._L_scaled / G_space
 
@@ -316,6 +316,14 @@ class FreeRigidBody:
     # Each may exceed the double range for extreme units (ω0 ~ 1e200 with moments ~1e100 has an
     # energy ~1e500): it is computed when read, from its exact scaled value, and raises a
     # ValueError saying so rather than returning inf.
+
+    @property
+    def plane_distance(self) -> float:
+        """``2T/G`` [rad per time unit], the distance of the invariable plane ``x·L = 2T`` from
+        the fixed point [FM06 Eq. 7.55]."""
+        return _in_units(
+            self._plane_distance_scaled, self._w_exp, "the distance 2T/|L| of the plane", _SLOWER
+        )
 
     @property
     def energy(self) -> float:
