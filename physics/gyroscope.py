@@ -140,6 +140,11 @@ class Gyroscope:
         self.omega0 = w.copy()
         self.attitude0 = attitude0
         w3 = float(w[2])
+        if (J3 - J) * w3 == 0.0:  # (J3 - J) ω3 underflowed: ω1* is beyond the range
+            raise ValueError(
+                f"(J3 - J) ω3 = ({J3:g} - {J:g}) · {w3:g} underflows: ω1* = -M/((J3 - J) ω3) is "
+                "beyond the double-precision range; express the moments and ω0 in other units"
+            )
         self.nutation_center = -M / ((J3 - J) * w3)
         """ω1* [rad/time], the centre of the nutation circle [FM06 Eq. 7.91]."""
         self.nutation_rate = (J3 - J) / J * w3
@@ -208,6 +213,8 @@ class Gyroscope:
         counts = np.ceil(np.diff(edges) / h - 1e-12).astype(np.int64)
         counts = np.maximum(counts, np.where(np.diff(edges) > 0.0, 1, 0))
         total = int(counts.sum())
+        if total == 0:  # every output time is t = 0
+            return np.tile(self.attitude0.as_quat(), (t_eval.size, 1)), 0
         # Every step's start and length, interval by interval (each interval cut evenly).
         interval = np.repeat(np.arange(counts.size), counts)
         first = np.cumsum(counts) - counts
@@ -216,9 +223,10 @@ class Gyroscope:
         start = edges[interval] + k * length
         wa = self.omega(start + (0.5 - _SQRT3 / 6.0) * length)
         wb = self.omega(start + (0.5 + _SQRT3 / 6.0) * length)
-        theta = 0.5 * length[:, None] * (wa + wb) + (_SQRT3 / 12.0 * length**2)[:, None] * np.cross(
-            wa, wb
-        )
+        # h ω_a × h ω_b rather than h² (ω_a × ω_b): the angles, not ω² (which overflows for
+        # ω ~ 1e200 however short the step).
+        ha, hb = length[:, None] * wa, length[:, None] * wb
+        theta = 0.5 * (ha + hb) + (_SQRT3 / 12.0) * np.cross(ha, hb)
         angle = np.linalg.norm(theta, axis=1)
         half_sinc = 0.5 * np.sinc(angle / (2.0 * math.pi))  # sin(a/2)/a, finite at a = 0
         steps = np.concatenate([theta * half_sinc[:, None], np.cos(0.5 * angle)[:, None]], axis=1)
@@ -241,6 +249,12 @@ class Gyroscope:
         if tt[0] < 0.0 or np.any(tt[1:] < tt[:-1]):
             raise ValueError("t must be non-negative and non-decreasing (the run starts at 0)")
         h = self._default_step() if step is None else check_positive(step, "the step")
+        turn = h * self._fastest_rate()
+        if not turn <= math.pi:
+            raise ValueError(
+                f"a step of {h:g} turns the body by up to {turn:.3g} rad, more than half a turn: "
+                f"too long for Magnus-4; use a step below {h * math.pi / turn:.3g}"
+            )
         steps = grid_size(
             float(tt[-1]), 0.5 * h, "the Magnus run up to t", "use a larger step or shorter t"
         )
