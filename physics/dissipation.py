@@ -181,9 +181,16 @@ class EnergySink:
                 f"|L|² = {G2:g} in your units is outside [{_G2_RANGE[0]:g}, {_G2_RANGE[1]:g}], "
                 "where the law squares it: express the moments or ω0 in other units"
             )
-        with np.errstate(over="ignore"):
+        with np.errstate(over="ignore", invalid="ignore"):
             # 2T₀ - G²/I3 = Σ Iᵢ ωᵢ² (I3 - Iᵢ)/I3: non-negative terms.
             self.excess0 = float(np.sum(m0 * w0 * ((J[2] - J) / J[2])))
+        two_T0 = G2 / float(J[2]) + self.excess0
+        if not math.isfinite(two_T0):
+            raise ValueError(
+                f"the energy 2T of this body is beyond the double-precision range in your units "
+                f"(|L|² = {G2:g} with a largest moment {float(J[2]):g}): express the moments or "
+                "ω0 in other units"
+            )
         if self.excess0 == 0.0:
             raise ValueError(
                 "omega0 is a spin about the major axis e3 (D = I3): there is no energy left "
@@ -206,7 +213,8 @@ class EnergySink:
         """``2T(t) = G²/I3 + (2T₀ - G²/I3) e^{-2κt}`` (the stated law), same shape as t."""
         tt = np.asarray(check_times(t, "t"), dtype=float)
         with np.errstate(over="ignore"):
-            out = self.G**2 / self.inertia[2] + self.excess0 * np.exp(-2.0 * self.kappa * tt)
+            # κt first: 2κ alone may overflow (κ ~ 1e308), and inf · 0 is NaN.
+            out = self.G**2 / self.inertia[2] + self.excess0 * np.exp(-2.0 * (self.kappa * tt))
         if not np.all(np.isfinite(out)):
             raise ValueError(
                 "t lies so far before the start that 2T(t) of the law passes the double range; "

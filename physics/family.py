@@ -230,19 +230,26 @@ def _branch(
 
     if D == I2:
         A1 = amplitude(j3 - j2, j1, j3 - j1)
+        A2 = amplitude(1.0, j2, 1.0)
         A3 = amplitude(j2 - j1, j3, j3 - j1)
-        return np.stack([s1 * A1 * cos, amplitude(1.0, j2, 1.0) * sin, s3 * A3 * cos], axis=-1)
+        _check_amplitudes(A1, A2, A3)
+        return np.stack([s1 * A1 * cos, A2 * sin, s3 * A3 * cos], axis=-1)
     A1 = amplitude(j3 - d, j1, j3 - j1)
     A3 = amplitude(d - j1, j3, j3 - j1)
+    A2 = amplitude(j3 - d, j2, j3 - j2) if D > I2 else amplitude(d - j1, j2, j2 - j1)
+    _check_amplitudes(A1, A2, A3)
     if D > I2:
-        A2 = amplitude(j3 - d, j2, j3 - j2)
         mc = (I3 - I1) / (I3 - I2) * ((D - I2) / (D - I1))
         dn = np.sqrt(cos * cos + mc * sin * sin)
         return np.stack([A1 * cos, A2 * sin, s3 * A3 * dn], axis=-1)
-    A2 = amplitude(d - j1, j2, j2 - j1)
     mc = (I3 - I1) / (I2 - I1) * ((I2 - D) / (I3 - D))
     dn = np.sqrt(cos * cos + mc * sin * sin)
     return np.stack([s1 * A1 * dn, A2 * sin, A3 * cos], axis=-1)
+
+
+def _check_amplitudes(*amplitudes: float) -> None:
+    if not all(map(math.isfinite, amplitudes)):
+        raise ValueError(f"the polhodes of this D reach values {_OUT_OF_RANGE}")
 
 
 def _separatrix_arcs(J: NDArray[np.float64], two_T: float, n: int) -> _Parts:
