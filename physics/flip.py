@@ -52,10 +52,16 @@ from scipy.integrate import solve_ivp
 
 from poinsot.physics.exact import ldexp, pow2_below
 from poinsot.physics.family import sorted_moments
+from poinsot.physics.flip_growth import (
+    STEPS_PER_RATE,
+    GrowthFit,
+    check_body,
+    fastest_rate,
+    measure_growth_rate,
+)
 from poinsot.physics.free_body import FreeRigidBody
 from poinsot.physics.regime import Regime
 from poinsot.physics.validation import (
-    InputTypeError,
     check_count,
     check_number,
     check_positive,
@@ -73,11 +79,6 @@ __all__ = [
     "measure_growth_rate",
 ]
 
-#: Grid steps per fastest time scale of Euler's equations when looking for sign changes.
-_STEPS_PER_RATE = 10.0
-#: measure_growth_rate gives up after this many grid samples.
-_GROWTH_MAX_SAMPLES = 1 << 24
-_GROWTH_CHUNK = 4096
 #: integrated_flip_times integrates at most this many radians of the fastest rotation (DOP853
 #: takes a few steps per radian: beyond this it would run for minutes).
 _MAX_RADIANS = 1e4
@@ -159,23 +160,8 @@ def flip_theory(inertia: ArrayLike, omega0: ArrayLike) -> FlipTheory:
             f"omega0 = {w.tolist()} is a spin about a principal axis: it never flips; tilt it "
             "from e2 (see flip_initial_omega)"
         )
-    # Moments and ω over exact powers of two: the squares of ω ~ 1e200 or of moments ~1e-200
-    # would leave the double range; every quantity below is a ratio of factors near 1.
-    scale = pow2_below(moments[2])
-    J1, J2, J3 = J = (moments[0] / scale, moments[1] / scale, moments[2] / scale)
-    w_exp = math.frexp(float(np.max(np.abs(w))))[1] - 1
-    ws = np.ldexp(w, -w_exp)
-    d1, d2, d3 = _deltas(J, ws)
-    if d2 == 0.0:
-        raise ValueError(
-            "omega0 lies on the separatrix (G² = 2T I2 to double precision): the body flips "
-            "once and never again; change the azimuth of the tilt"
-        )
-    if d1 <= 0.0 or d3 >= 0.0:
-        raise ValueError(
-            f"omega0 = {w.tolist()} is a spin about a principal axis to double precision (its "
-            "other components are too small to count): it never flips; tilt it from e2"
-        )
+    J, ws, w_exp, (d1, d2, d3) = _scaled_deltas(moments, w)
+    J1, J2, J3 = J
     major = d2 > 0.0
     # A1² = -Δ3/(I1(I3 - I1)) and A3² = Δ1/(I3(I3 - I1)) in both families [LL76 Eq. 37.10].
     a31 = math.sqrt(d1 / -d3) * math.sqrt(J1 / J3)  # A3/A1
@@ -209,6 +195,30 @@ def flip_theory(inertia: ArrayLike, omega0: ArrayLike) -> FlipTheory:
     return theory
 
 
+def _scaled_deltas(
+    moments: tuple[float, float, float], w: NDArray[np.float64]
+) -> tuple[tuple[float, float, float], NDArray[np.float64], int, tuple[float, float, float]]:
+    """Moments and ω over exact powers of two (the squares of ω ~ 1e200 or of moments ~1e-200
+    would leave the double range; every quantity of the clock is a ratio of factors near 1),
+    the exponent of ω's scale, and the Δᵢ; refused on the separatrix or an axis."""
+    scale = pow2_below(moments[2])
+    J = (moments[0] / scale, moments[1] / scale, moments[2] / scale)
+    w_exp = math.frexp(float(np.max(np.abs(w))))[1] - 1
+    ws = np.ldexp(w, -w_exp)
+    d1, d2, d3 = _deltas(J, ws)
+    if d2 == 0.0:
+        raise ValueError(
+            "omega0 lies on the separatrix (G² = 2T I2 to double precision): the body flips "
+            "once and never again; change the azimuth of the tilt"
+        )
+    if d1 <= 0.0 or d3 >= 0.0:
+        raise ValueError(
+            f"omega0 = {w.tolist()} is a spin about a principal axis to double precision (its "
+            "other components are too small to count): it never flips; tilt it from e2"
+        )
+    return J, ws, w_exp, (d1, d2, d3)
+
+
 def _check_clock(theory: FlipTheory) -> None:
     """Refuse a clock that does not fit in doubles in the caller's units."""
     values = (
@@ -225,20 +235,6 @@ def _check_clock(theory: FlipTheory) -> None:
         f"(K = {theory.K:g}, λ = {theory.frequency:g}, 2K/λ = {theory.time_between_flips:g}): "
         "tilt ω0 further from e2, or use a time unit closer to 1/|ω0|"
     )
-
-
-def check_body(body: object, what: str) -> FreeRigidBody:
-    """``body`` if it is a :class:`FreeRigidBody`, else an InputTypeError."""
-    if not isinstance(body, FreeRigidBody):
-        raise InputTypeError(f"{what} needs a FreeRigidBody, got {type(body).__name__}")
-    return body
-
-
-def _fastest_rate(inertia: NDArray[np.float64], omega0: NDArray[np.float64]) -> float:
-    """A bound on the rates of Euler's equations: ``|ω| max|Iⱼ - Iₖ|/Iᵢ`` (or ``|ω|``); inf
-    where it leaves the double range."""
-    spread = (float(inertia.max()) - float(inertia.min())) / float(inertia.min())
-    return math.hypot(*omega0.tolist()) * max(1.0, spread)
 
 
 def measure_flips(
@@ -260,10 +256,10 @@ def measure_flips(
     t_end = check_positive(t_end, "t_end")
     axis = check_count(axis, "axis (0, 1 or 2)", 0, 2)
     if step is None:
-        rate = _fastest_rate(body.inertia, body.omega0)
+        rate = fastest_rate(body.inertia, body.omega0)
         if rate == 0.0:  # at rest: nothing changes sign
             return np.empty(0)
-        step = 1.0 / (_STEPS_PER_RATE * rate)
+        step = 1.0 / (STEPS_PER_RATE * rate)
     else:
         step = check_positive(step, "step")
     n = grid_size(
@@ -283,121 +279,6 @@ def measure_flips(
         optimize.brentq(component, t[i], t[i + 1], xtol=1e-300, rtol=4.0 * eps) for i in brackets
     ]  # one root per flip: a loop over the flips, not over the samples
     return np.sort(np.concatenate([exact, np.asarray(refined, dtype=float)]))
-
-
-@dataclass(frozen=True)
-class GrowthFit:
-    """A straight-line fit of ``ln |(ω1, ω3)|`` against t on the exponential stretch.
-
-    Attributes:
-        rate: the measured σ [1/time]. window: (t_start, t_stop) of the fit [time].
-        e_folds: ``σ (t_stop - t_start)``, how long the stretch is.
-        residual: the largest deviation of ``ln |(ω1, ω3)|`` from the line.
-    """
-
-    rate: float
-    window: tuple[float, float]
-    e_folds: float
-    residual: float
-
-
-def measure_growth_rate(
-    body: FreeRigidBody,
-    start_factor: float = math.exp(5.0),
-    stop_amplitude: float = 1e-3,
-    step: float | None = None,
-) -> GrowthFit:
-    """The growth rate of the perturbation off ``e2``, read from the motion (sorted moments).
-
-    ``p(t) = |(ω1, ω3)|/|ω|`` grows like ``cosh``-type mixtures of ``e^{±σt}`` at first and
-    bends over when it is no longer small. The fit window starts where ``p`` has grown by
-    ``start_factor`` (the decaying mode has died down: its weight ~1/start_factor²) and stops
-    where ``p`` reaches ``stop_amplitude`` (the nonlinear terms are O(p²) relative).
-
-    Raises:
-        ValueError: if there is less than two e-folds between the two (ω0 too far from e2 for
-            an exponential stretch: use ``ε`` below ``stop_amplitude / (start_factor e²)``).
-    """
-    check_body(body, "measure_growth_rate")
-    w0, (I1, I2, I3) = body.omega0, body.inertia.tolist()
-    if not (I1 < I2 < I3 or I1 > I2 > I3):
-        raise ValueError(
-            f"e2 is not the intermediate axis of the moments {[I1, I2, I3]}: a perturbation off "
-            "e2 grows only about the intermediate axis; give the moments with it second"
-        )
-    if not np.any(w0):
-        raise ValueError("the body is at rest: there is no perturbation to grow")
-    start_factor = check_positive(start_factor, "start_factor")
-    hi = check_positive(stop_amplitude, "stop_amplitude")
-    p0 = _off_axis(w0[None, :])[0]
-    lo = p0 * start_factor
-    if not (p0 > 0.0 and lo * math.e**2 < hi < 1.0):
-        raise ValueError(
-            f"no exponential stretch: the perturbation starts at {p0:.3g} of |ω|, it must grow "
-            f"by {start_factor:.3g} and then by two e-folds before it reaches {hi:g}; "
-            "start closer to the intermediate axis"
-        )
-    if step is None:
-        step = 1.0 / (_STEPS_PER_RATE * _fastest_rate(body.inertia, w0))
-    else:
-        step = check_positive(step, "step")
-    # It grows like e^{σt} [LL76 §37]: about ln(hi/p0)/σ to reach hi.
-    sigma = abs(float(w0[1])) * math.sqrt(abs(I2 - I1) / I1) * math.sqrt(abs(I3 - I2) / I3)
-    needed = math.log(hi / p0) / (sigma * step) if sigma * step > 0.0 else math.inf
-    if not needed <= _GROWTH_MAX_SAMPLES:
-        raise ValueError(
-            f"the perturbation would take about {needed:.3g} grid steps to grow to {hi:g} of "
-            f"|ω|, more than {_GROWTH_MAX_SAMPLES}: use a larger step or a start closer to e2"
-        )
-    if not math.isfinite(step * (needed + 2 * _GROWTH_CHUNK)):
-        raise ValueError(
-            "the grid of this slow motion reaches beyond the double range in your time unit: "
-            "use a longer time unit (then ω0 is a larger number)"
-        )
-    # Walk the grid in chunks until p passes hi (p grows monotonically on this stretch).
-    chunk = _GROWTH_CHUNK
-    times, amps = [], []
-    for start in range(0, _GROWTH_MAX_SAMPLES, chunk):
-        t = step * np.arange(start, start + chunk)
-        p = _off_axis(body.omega(t))
-        times.append(t)
-        amps.append(p)
-        if p.max() >= hi:
-            break
-    else:
-        raise ValueError(
-            f"the perturbation did not reach {hi:g} of |ω| within {_GROWTH_MAX_SAMPLES} grid "
-            "steps: this motion does not leave the intermediate axis (is e2 the intermediate axis?)"
-        )
-    t, p = np.concatenate(times), np.concatenate(amps)
-    first_hi = int(np.argmax(p >= hi))
-    t, p = t[:first_hi], p[:first_hi]
-    inside = p >= lo
-    begin = int(np.argmax(inside))
-    t, logp = t[begin:], np.log(p[begin:])
-    if t.size < 3:
-        raise ValueError(
-            f"only {t.size} grid samples on the exponential stretch: use a smaller step"
-        )
-    # The line in the time since the window's start over its length, x in [0, 1]: the squares
-    # of times ~1e-300 would underflow in the fit.
-    span = float(t[-1] - t[0])
-    x = (t - t[0]) / span
-    slope, offset = np.polyfit(x, logp, 1)
-    residual = float(np.abs(logp - (slope * x + offset)).max())
-    rate = float(slope) / span
-    if not math.isfinite(rate):
-        raise ValueError(
-            f"the growth rate is beyond the double-precision range in your units ({slope:.3g} "
-            f"e-folds in {span:.3g}): use a time unit closer to 1/|ω0|"
-        )
-    return GrowthFit(rate, (float(t[0]), float(t[-1])), float(slope), residual)
-
-
-def _off_axis(w: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``|(ω1, ω3)|/|ω|`` for rows of ``w`` (hypot: no overflow of the squares)."""
-    side = np.hypot(w[:, 0], w[:, 2])
-    return side / np.hypot(side, w[:, 1])
 
 
 def integrated_flip_times(
@@ -426,7 +307,7 @@ def integrated_flip_times(
     # overflow in the products ω_j ω_k.
     w_exp = math.frexp(w_max)[1] - 1
     ws, tau_end = np.ldexp(w0, -w_exp), ldexp(t_end, w_exp)
-    radians = _fastest_rate(J, ws) * tau_end
+    radians = fastest_rate(J, ws) * tau_end
     if not radians <= _MAX_RADIANS:
         raise ValueError(
             f"t_end spans {radians:.3g} radians of the fastest rotation, more than "
