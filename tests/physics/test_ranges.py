@@ -53,6 +53,14 @@ def test_contact_point_of_a_spin_near_the_top_of_the_range() -> None:
     np.testing.assert_allclose(height, body.plane_distance / 1e308, rtol=1e-14)
 
 
+def test_plane_distance_beyond_the_range_is_refused_when_read() -> None:
+    """2T/G <= |ω|, which may pass 1.8e308 with ω0 = (-1.8e308, 0, 1.8e308): it was inf."""
+    body = FreeRigidBody((1.9e299, 2.2e300, 2.7e300), (-BIG, 0.0, BIG))
+    with pytest.raises(ValueError, match=r"distance 2T/\|L\| of the plane .* shorter time unit"):
+        _ = body.plane_distance
+    assert np.all(np.isfinite(body.omega(np.array([0.0, 1e-320]))))
+
+
 def test_a_period_below_the_smallest_double_is_refused() -> None:
     """It underflowed to 0.0, a period that divided by zero downstream."""
     body = FreeRigidBody((3.0, 3.0, 7.4e66), (1.8e305, 1.3e305, 2.2e306))
@@ -168,6 +176,10 @@ def test_gyroscope_constants_and_runs_are_bounded() -> None:
         gyro.attitude([0.0, 1e9])
     with pytest.raises(ValueError, match="samples"):
         gyro.measure_drift(2, 10**9)
+    # A step of 5e300 rad squared the angles in the cross product: an overflow warning.
+    fast = Gyroscope(0.19, 2.2e-308, -2e-139, (2.7e299, 0.0, -5.0e300))
+    with pytest.raises(ValueError, match="more than half a turn"):
+        fast.attitude([2.5], 2.0)
 
 
 def test_energy_sink_windows_and_ranges() -> None:
