@@ -16,7 +16,8 @@ reports (:class:`Camera`):
   point); if none is free, the one that overlaps least;
 - a label whose point may move (:attr:`Slot.movable`: L's, ω's, the herpolhode's, which hang
   from frames that only translate) may also be pushed, in the screen plane, in one of eight
-  directions (the outward one first), far enough beyond its tip to clear a marker drawn there.
+  directions (the outward one first), far enough beyond its tip to clear a marker drawn there,
+  and farther (up to PUSH_RINGS times) where that is taken.
 
 Only anchors and these offsets change, and only when they do: a label rides on its frame
 (the body, the contact point) between two layouts, with no message of its own.
@@ -170,6 +171,13 @@ def _outward(*candidates: np.ndarray) -> np.ndarray:
 
 #: Points along an arrow that the boxes keep clear of.
 ARROW_SAMPLES = 12
+#: Where no place is free, what is worst to cover: another label, then a marker, then an
+#: arrow's shaft (weights of the overlaps).
+LABEL_WEIGHT = 10.0
+MARKER_WEIGHT = 5.0
+#: A movable label is pushed up to this many times its clearance before it settles for the
+#: least overlap.
+PUSH_RINGS = 3
 
 
 def lay_out(
@@ -183,15 +191,16 @@ def lay_out(
     the boxes avoid crossing. Labels behind the camera keep their anchor."""
     _, right, up = camera.axes()
     boxes: list[np.ndarray] = []
-    points = [(np.asarray(p, float), float(r)) for p, r in markers]
+    points = [(np.asarray(p, float), float(r), MARKER_WEIGHT) for p, r in markers]
     for start, end, radius in arrows:
         for f in np.linspace(0.0, 1.0, ARROW_SAMPLES):
-            points.append(((1.0 - f) * np.asarray(start, float) + f * np.asarray(end), radius))
+            at = (1.0 - f) * np.asarray(start, float) + f * np.asarray(end)
+            points.append((at, radius, 1.0))
     discs = []
-    for point, radius in points:
+    for point, radius, weight in points:
         screen, depth = camera.project(point)
         if depth[0] > 0:
-            discs.append((screen[0], radius))
+            discs.append((screen[0], radius, weight))
     placed: dict[str, Placement] = {}
     for slot in slots:
         (point, tip, root), depth = camera.project(np.array([slot.point, slot.tip, slot.root]))
@@ -203,8 +212,8 @@ def lay_out(
         best: Placement | None = None
         for anchor, shift in _options(slot, point, tip, direction):
             box = _box(point + shift, size, anchor)
-            cost = sum(_overlap(box, other) for other in boxes)
-            cost += sum(_disc_overlap(box, c, r) for c, r in discs)
+            cost = LABEL_WEIGHT * sum(_overlap(box, other) for other in boxes)
+            cost += sum(w * _disc_overlap(box, c, r) for c, r, w in discs)
             if best is None or cost < best.overlap:
                 offset = per_px * (shift[0] * right - shift[1] * up)
                 best = Placement(anchor, offset, (box[0], box[1], box[2], box[3]), cost)
@@ -239,9 +248,13 @@ def _options(
     none = np.zeros(2)
     if not slot.movable:
         return [(anchor, none) for anchor in _ranked(direction, slot.anchor)]
-    reach = max(float(np.linalg.norm(point - tip)), slot.clearance)
+    reach = max(float(np.linalg.norm(point - tip)), slot.clearance, 1.0)
     order = np.argsort(-(_DIRECTIONS @ direction))
-    pushes = [(_anchor_towards(d), tip + reach * d - point) for d in _DIRECTIONS[order]]
+    pushes = [
+        (_anchor_towards(d), tip + ring * reach * d - point)
+        for ring in range(1, PUSH_RINGS + 1)
+        for d in _DIRECTIONS[order]
+    ]
     return pushes + [(anchor, none) for anchor in _ranked(direction, slot.anchor)]
 
 
