@@ -160,10 +160,8 @@ def real_number(value: object, name: str) -> float:
     Decimal or a 0-d array; refuses arrays, text, None, bools and complex numbers."""
     if type(value) is float:
         return value
-    if isinstance(value, np.ndarray | list | tuple):
-        shape = np.shape(value) if not isinstance(value, np.ndarray) else value.shape
-        if shape != ():
-            raise ValueError(f"{name} must be one number, not {_show(value)} (shape {shape})")
+    if isinstance(value, list | tuple) or (isinstance(value, np.ndarray) and value.ndim):
+        raise ValueError(f"{name} must be one number, not the sequence {_show(value)}")
     arr = real_array(value, name, "a real number")
     if arr.shape != ():
         raise ValueError(f"{name} must be one number, not {_show(value)}")

@@ -138,6 +138,13 @@ def test_every_module_refuses_the_same_way() -> None:
         Propagation("splitting", GOOD_I, W, None, 1j)
 
 
+@pytest.mark.parametrize("value", [[1.0, [2.0, 3.0]], [1.0], (), np.array([2.0])], ids=repr)
+def test_one_number_is_not_a_sequence(value) -> None:
+    """np.shape of a ragged list raised numpy's own ValueError before the check could."""
+    with pytest.raises(ValueError, match="D must be one number, not the sequence"):
+        FreeRigidBody.from_energy(GOOD_I, value)
+
+
 def test_real_array_keeps_float64_arrays_as_they_are() -> None:
     """The common case costs nothing: a float64 array is returned itself."""
     arr = np.array([1.0, 2.0, 3.0])
