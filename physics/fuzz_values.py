@@ -119,6 +119,7 @@ def odd_scalar(src: Source) -> Any:
             [1.0],
             (),
             [[2.0]],
+            [1.0, [2.0, 3.0]],
             np.array(1.5),
             np.array([1.5]),
             np.float32(3.5),
