@@ -37,8 +37,9 @@ from poinsot.app.scene.view import DEFAULT_VIEW, View, configure_theme
 LARGE_TEXT_PERCENT = 130
 #: ... and of the projector mode.
 PROJECTOR_TEXT_PERCENT = 150
-#: Labels are laid out this often [Hz] (their boxes ride on their frames in between).
-LABEL_HZ = 10.0
+#: Labels are laid out this often [Hz] (their boxes ride on their frames in between; a
+#: layout costs about a millisecond), and only when the camera or the time has changed.
+LABEL_HZ = 6.0
 #: The two-view camera: from the front (x runs across the screen, the body frame's picture on
 #: the right), this high above the plane [degrees] and this far from the middle between the
 #: pictures [display units].
@@ -118,6 +119,7 @@ class Display:
         self._lock = threading.Lock()
         self.body_view: BodyView | None = None
         self._next_layout = 0.0
+        self._laid_out: tuple | None = None  # (camera, time) of the last layout
 
     # -- wishes (any thread) ---------------------------------------------------------------
     def request(self, **changes: bool) -> None:
@@ -144,12 +146,18 @@ class Display:
             view.advance(frame)
         if now >= self._next_layout:
             self._next_layout = now + 1.0 / LABEL_HZ
-            self.lay_out_labels()
+            self.lay_out_labels(None if frame is None else frame.t)
 
-    def lay_out_labels(self) -> dict:
+    def lay_out_labels(self, t: float | None = None) -> dict:
+        """Lay the labels out for the browser's camera (not again for the same camera and
+        time ``t``, when given: a paused, unmoved picture)."""
         camera = browser_camera(self.client)
         if camera is None or not all(math.isfinite(v) for v in camera.position):
             return {}
+        key = (*camera.position, *camera.look_at, *camera.up, camera.fov, camera.width, t)
+        if t is not None and key == self._laid_out:
+            return {}
+        self._laid_out = key
         return self.session.scene.lay_out_labels(camera)
 
     def _attitude0(self, frame: Frame) -> np.ndarray:

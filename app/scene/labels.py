@@ -26,6 +26,7 @@ Only anchors and these offsets change, and only when they do: a label rides on i
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Sequence
 
@@ -67,6 +68,10 @@ class Camera:
 
     def axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The camera's forward, right and up unit vectors (world)."""
+        return self._axes
+
+    @functools.cached_property
+    def _axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         forward = np.asarray(self.look_at, float) - np.asarray(self.position, float)
         forward /= np.linalg.norm(forward)
         right = np.cross(forward, self.up)
@@ -127,43 +132,49 @@ class Placement:
     overlap: float
 
 
-def _box(point: np.ndarray, size: tuple[float, float], anchor: str) -> np.ndarray:
-    fx, fy = ANCHORS[anchor]
-    x0, y0 = point[0] + fx * size[0], point[1] + fy * size[1]
-    return np.array([x0, y0, x0 + size[0], y0 + size[1]])
+def _costs(
+    boxes: np.ndarray,
+    placed: np.ndarray,
+    centres: np.ndarray,
+    radii: np.ndarray,
+    weights: np.ndarray,
+) -> np.ndarray:
+    """The cost of each candidate box (K, 4): its overlap with the boxes placed (M, 4), each
+    grown by GAP_PX, times LABEL_WEIGHT, plus its weighted reach into the discs (D)."""
+    cost = np.zeros(len(boxes))
+    if len(placed):
+        w = np.minimum(boxes[:, None, 2], placed[None, :, 2])
+        w = w - np.maximum(boxes[:, None, 0], placed[None, :, 0]) + GAP_PX
+        h = np.minimum(boxes[:, None, 3], placed[None, :, 3])
+        h = h - np.maximum(boxes[:, None, 1], placed[None, :, 1]) + GAP_PX
+        cost += LABEL_WEIGHT * np.sum(np.maximum(w, 0.0) * np.maximum(h, 0.0), axis=1)
+    if len(centres):
+        nearest = np.minimum(np.maximum(centres[None], boxes[:, None, :2]), boxes[:, None, 2:])
+        gap = nearest - centres[None]
+        reach = radii[None, :] + GAP_PX - np.hypot(gap[..., 0], gap[..., 1])
+        cost += np.sum(weights[None, :] * np.maximum(reach, 0.0) ** 2, axis=1)
+    return cost
 
 
-def _overlap(a: np.ndarray, b: np.ndarray) -> float:
-    w = min(a[2], b[2]) - max(a[0], b[0]) + GAP_PX
-    h = min(a[3], b[3]) - max(a[1], b[1]) + GAP_PX
-    return max(w, 0.0) * max(h, 0.0)
-
-
-def _disc_overlap(box: np.ndarray, centre: np.ndarray, radius: float) -> float:
-    """Area-like measure of a box's overlap with a disc (0 if apart by GAP_PX)."""
-    nearest = np.clip(centre, box[:2], box[2:])
-    reach = radius + GAP_PX - float(np.linalg.norm(nearest - centre))
-    return max(reach, 0.0) ** 2
+_ANCHOR_NAMES = tuple(ANCHORS)
+#: The unit direction (screen, y down) in which each anchor's box lies from its point.
+_ANCHOR_DIRECTIONS = np.array([[fx + 0.5, fy + 0.5] for fx, fy in ANCHORS.values()])
+_ANCHOR_DIRECTIONS /= np.linalg.norm(_ANCHOR_DIRECTIONS, axis=1)[:, None]
 
 
 def _ranked(direction: np.ndarray, current: str) -> list[str]:
     """Anchors, the one whose box lies most along ``direction`` (screen) first; the current
     anchor wins ties, so that a label does not flicker between equals."""
-
-    def score(anchor: str) -> float:
-        fx, fy = ANCHORS[anchor]
-        towards = np.array([fx + 0.5, fy + 0.5])
-        towards /= np.linalg.norm(towards)
-        return -float(towards @ direction) - (1e-3 if anchor == current else 0.0)
-
-    return sorted(ANCHORS, key=score)
+    score = -(_ANCHOR_DIRECTIONS @ direction)
+    score -= 1e-3 * np.array([name == current for name in _ANCHOR_NAMES])
+    return [_ANCHOR_NAMES[i] for i in np.argsort(score, kind="stable")]
 
 
 def _outward(*candidates: np.ndarray) -> np.ndarray:
     """The first screen direction (unit) longer than 2 px; up-right if there is none (an arrow
     seen end-on)."""
     for vector in candidates:
-        length = float(np.linalg.norm(vector))
+        length = math.hypot(float(vector[0]), float(vector[1]))
         if length > 2.0:
             return vector / length
     return np.array([math.sqrt(0.5), -math.sqrt(0.5)])
@@ -190,39 +201,53 @@ def lay_out(
     radius [CSS px]) that no box may cover; ``arrows``: (start, end, half-width [CSS px]) that
     the boxes avoid crossing. Labels behind the camera keep their anchor."""
     _, right, up = camera.axes()
-    boxes: list[np.ndarray] = []
-    points = [(np.asarray(p, float), float(r), MARKER_WEIGHT) for p, r in markers]
-    for start, end, radius in arrows:
-        for f in np.linspace(0.0, 1.0, ARROW_SAMPLES):
-            at = (1.0 - f) * np.asarray(start, float) + f * np.asarray(end)
-            points.append((at, radius, 1.0))
-    discs = []
-    for point, radius, weight in points:
-        screen, depth = camera.project(point)
-        if depth[0] > 0:
-            discs.append((screen[0], radius, weight))
+    centres, radii, weights = _discs(camera, markers, arrows)
+    placed_boxes = np.zeros((0, 4))
     placed: dict[str, Placement] = {}
-    for slot in slots:
-        (point, tip, root), depth = camera.project(np.array([slot.point, slot.tip, slot.root]))
-        if depth[0] <= 0:
+    if not slots:
+        return placed
+    points = np.array([[slot.point, slot.tip, slot.root] for slot in slots], float)
+    screen, depths = camera.project(points.reshape(-1, 3))
+    screen, depths = screen.reshape(-1, 3, 2), depths.reshape(-1, 3)
+    for slot, (point, tip, root), depth in zip(slots, screen, depths[:, 0], strict=True):
+        if depth <= 0:
             continue
         direction = _outward(tip - root, point - tip)
-        size = box_size(slot.text, slot.scale)
-        per_px = camera.world_per_px(float(depth[0]))
-        best: Placement | None = None
-        for anchor, shift in _options(slot, point, tip, direction):
-            box = _box(point + shift, size, anchor)
-            cost = LABEL_WEIGHT * sum(_overlap(box, other) for other in boxes)
-            cost += sum(w * _disc_overlap(box, c, r) for c, r, w in discs)
-            if best is None or cost < best.overlap:
-                offset = per_px * (shift[0] * right - shift[1] * up)
-                best = Placement(anchor, offset, (box[0], box[1], box[2], box[3]), cost)
-            if cost == 0.0:
-                break
-        assert best is not None
-        boxes.append(np.array(best.box))
-        placed[slot.key] = best
+        anchors, shifts = _options(slot, point, tip, direction)
+        width, height = box_size(slot.text, slot.scale)
+        corner = point + shifts + np.array([ANCHORS[a] for a in anchors]) * (width, height)
+        boxes = np.concatenate([corner, corner + (width, height)], axis=1)
+        cost = _costs(boxes, placed_boxes, centres, radii, weights)
+        free = np.flatnonzero(cost == 0.0)
+        k = int(free[0]) if len(free) else int(np.argmin(cost))
+        shift = shifts[k] * camera.world_per_px(float(depth))
+        offset = shift[0] * right - shift[1] * up
+        box = (float(boxes[k, 0]), float(boxes[k, 1]), float(boxes[k, 2]), float(boxes[k, 3]))
+        placed[slot.key] = Placement(anchors[k], offset, box, float(cost[k]))
+        placed_boxes = np.vstack([placed_boxes, boxes[k]])
     return placed
+
+
+def _discs(
+    camera: Camera,
+    markers: Sequence[tuple[np.ndarray, float]],
+    arrows: Sequence[tuple[np.ndarray, np.ndarray, float]],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Screen centres (D, 2), radii and weights of the discs the boxes keep clear of: the
+    markers, and ARROW_SAMPLES points along each arrow (those in front of the camera)."""
+    points = [np.asarray(p, float) for p, _ in markers]
+    radii = [float(r) for _, r in markers]
+    weights = [MARKER_WEIGHT] * len(markers)
+    f = np.linspace(0.0, 1.0, ARROW_SAMPLES)[:, None]
+    for start, end, radius in arrows:
+        points.extend((1.0 - f) * np.asarray(start, float) + f * np.asarray(end, float))
+        radii += [float(radius)] * ARROW_SAMPLES
+        weights += [1.0] * ARROW_SAMPLES
+    if not points:
+        return np.zeros((0, 2)), np.zeros(0), np.zeros(0)
+    screen, depth = camera.project(np.array(points))
+    front = depth > 0
+    return screen[front], np.array(radii)[front], np.array(weights)[front]
 
 
 #: The eight screen directions a movable label may be pushed in (y down).
@@ -239,23 +264,26 @@ def _anchor_towards(direction: np.ndarray) -> str:
     return f"{vertical}-{horizontal}"
 
 
+_DIRECTION_ANCHORS = [_anchor_towards(d) for d in _DIRECTIONS]
+
+
 def _options(
     slot: Slot, point: np.ndarray, tip: np.ndarray, direction: np.ndarray
-) -> list[tuple[str, np.ndarray]]:
-    """(anchor, screen shift of the point) to try, best first. A fixed label tries its anchors
-    round its point, those along ``direction`` first; a movable one is also pushed, at least
-    ``clearance`` beyond its tip, in each of eight directions, the outward one first."""
-    none = np.zeros(2)
+) -> tuple[list[str], np.ndarray]:
+    """The anchors and screen shifts of the point (K, 2) to try, best first. A fixed label
+    tries its anchors round its point, those along ``direction`` first; a movable one is first
+    pushed, at least ``clearance`` beyond its tip, in each of eight directions, the outward one
+    first (and up to PUSH_RINGS times as far)."""
+    ranked = _ranked(direction, slot.anchor)
     if not slot.movable:
-        return [(anchor, none) for anchor in _ranked(direction, slot.anchor)]
-    reach = max(float(np.linalg.norm(point - tip)), slot.clearance, 1.0)
-    order = np.argsort(-(_DIRECTIONS @ direction))
-    pushes = [
-        (_anchor_towards(d), tip + ring * reach * d - point)
-        for ring in range(1, PUSH_RINGS + 1)
-        for d in _DIRECTIONS[order]
-    ]
-    return pushes + [(anchor, none) for anchor in _ranked(direction, slot.anchor)]
+        return ranked, np.zeros((len(ranked), 2))
+    reach = max(math.hypot(*(point - tip)), slot.clearance, 1.0)
+    order = np.argsort(-(_DIRECTIONS @ direction), kind="stable")
+    rings = np.arange(1, PUSH_RINGS + 1, dtype=np.float64)
+    pushes = rings[:, None, None] * reach * _DIRECTIONS[order][None, :, :]
+    pushes = pushes.reshape(-1, 2) + (tip - point)
+    anchors = [_DIRECTION_ANCHORS[i] for i in order] * PUSH_RINGS
+    return anchors + ranked, np.vstack([pushes, np.zeros((len(ranked), 2))])
 
 
 def overlapping(boxes: Sequence[tuple[float, float, float, float]]) -> list[tuple[int, int]]:
