@@ -45,13 +45,19 @@ CAPTIONS: dict[str, str] = {
     "custom": "Your own body: the energy ellipsoid rolls without slipping on the invariable plane "
     "⊥ L; ω's tip, the contact point, traces the polhode on the body and the herpolhode on the "
     "plane.",
+    "fitted_toss": "A real toss: the exact free motion fitted to a gyroscope recording, its "
+    "measured ω drawn over the exact one; the ellipsoid of the fitted moments rolls on the "
+    "invariable plane.",
+    "mesh_body": "A body from its mesh: the moments of the solid at uniform density make the "
+    "energy ellipsoid, which rolls on the invariable plane while the polhode and the herpolhode "
+    "are traced.",
 }
 
 
 def caption(preset: Preset) -> str:
-    """The caption of ``preset``: its own, or the one written here for its key (a body of
-    one's own gets the custom one)."""
-    return preset.caption or CAPTIONS.get(preset.key, CAPTIONS["custom"])
+    """The caption of ``preset``: its own, or the one written here for its key; none for a
+    scene that has not written one."""
+    return preset.caption or CAPTIONS.get(preset.key, "")
 
 
 Shape = Literal["line", "arrow", "dot", "patch", "axes"]
