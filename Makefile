@@ -13,8 +13,10 @@ $(VENV)/bin/activate:
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --upgrade pip
 
+# `make run` installs what the README's commands need too: matplotlib (poinsot report, fit --plot)
+# and playwright (poinsot screenshot; Chromium itself comes from `make chromium`).
 $(VENV)/.installed: pyproject.toml | $(VENV)/bin/activate
-	$(PY) -m pip install -e .
+	$(PY) -m pip install -e '.[lecture]'
 	touch $@
 
 $(VENV)/.installed-test: pyproject.toml | $(VENV)/bin/activate

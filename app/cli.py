@@ -24,11 +24,21 @@ from typing import NoReturn
 from poinsot.app.exports.html import HTML_FPS
 from poinsot.app.exports.screenshot import parse_size, resolve_scene
 from poinsot.app.presets import PRESETS, Preset, preset_by_key
-from poinsot.app.scene.cameras import CAMERA_NAMES
+from poinsot.app.scene.cameras import CAMERA_NAMES, RIDE_ALONG, canonical
 from poinsot.app.scenes import scene_by_name, scene_names
 from poinsot.app.scenes.spec import SceneSpec
 
 DESCRIPTION = "Poinsot: torque-free rigid-body motion, live in the browser and offline."
+
+
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """--help shows every option's default, except where there is none to show (None, a
+    switch) or the help already says it."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        if action.default is None or action.nargs == 0 or "(default" in (action.help or ""):
+            return action.help
+        return super()._get_help_string(action)
 
 
 class CommandParser(argparse.ArgumentParser):
@@ -69,6 +79,23 @@ def _seconds(text: str) -> float:
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds")
     return value
+
+
+def _view(text: str) -> str:
+    """A camera view's name (:data:`~poinsot.app.scene.cameras.CAMERA_NAMES`, the words of the
+    browser's buttons; the older "top" and "body" are still understood)."""
+    try:
+        return canonical(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from exc
+
+
+def _fixed_view(text: str) -> str:
+    """A camera view that stands still (an HTML page's initial camera)."""
+    view = _view(text)
+    if view == RIDE_ALONG:
+        raise argparse.ArgumentTypeError("a page starts from a fixed view, not ride-along")
+    return view
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -214,8 +241,9 @@ def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
         "--preset",
         dest="scene",
         type=_preset,
+        default=PRESETS[0].key,
         metavar=keys,
-        help="scene to draw (default: the first)",
+        help="preset to draw",
     )
     which.add_argument(
         "--scene",
@@ -236,9 +264,11 @@ def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--size", type=_size, default="1920x1080", help="WIDTHxHEIGHT in pixels")
     parser.add_argument(
         "--view",
-        choices=CAMERA_NAMES,
+        type=_view,
         default="default",
-        help="camera: the scene's default view, along L (top), side, or fixed in the body",
+        metavar="{" + ",".join(CAMERA_NAMES) + "}",
+        help="camera, as the browser's buttons name it: the scene's default view, along L "
+        "(from above), the side, or riding on the body",
     )
     parser.add_argument(
         "--background",
@@ -253,7 +283,7 @@ def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
         help="keep the view's field of view instead of framing the construction",
     )
     parser.add_argument("--out", type=pathlib.Path, required=True, help="output .png file")
-    parser.set_defaults(func=screenshot, scene=PRESETS[0])
+    parser.set_defaults(func=screenshot)
 
 
 def _add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
@@ -273,9 +303,10 @@ def _add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fps", type=float, default=HTML_FPS, help="recorded frames per second")
     parser.add_argument(
         "--view",
+        type=_fixed_view,
         default="default",
-        choices=("default", "top", "side"),
-        help="initial camera (the viewer can still orbit)",
+        metavar="{" + ",".join(v for v in CAMERA_NAMES if v != RIDE_ALONG) + "}",
+        help="initial camera, as the browser's buttons name it (the viewer can still orbit)",
     )
     parser.add_argument("--light", action="store_true", help="light theme (default: dark)")
     parser.add_argument("--out", type=pathlib.Path, required=True, help="output .html file")
@@ -283,7 +314,9 @@ def _add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _add_benchmark_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--clients", type=int, nargs="+", default=[1, 20])
+    parser.add_argument(
+        "--clients", type=int, nargs="+", default=[1, 20], help="browsers per run, one run each"
+    )
     parser.add_argument("--seconds", type=float, default=5.0, help="steady-state window")
     parser.add_argument("--redraws", type=int, default=30, help="slider moves per run")
     parser.set_defaults(func=benchmark)
@@ -351,11 +384,17 @@ _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] =
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="poinsot", description=DESCRIPTION)
+    parser = argparse.ArgumentParser(
+        prog="poinsot", description=DESCRIPTION, formatter_class=HelpFormatter
+    )
     _add_serve_arguments(parser)  # `poinsot --host ...` is `poinsot serve --host ...`
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=CommandParser)
     for name, (help_text, add_arguments) in _SUBCOMMANDS.items():
-        add_arguments(sub.add_parser(name, help=help_text))
+        add_arguments(
+            sub.add_parser(
+                name, help=help_text, description=help_text, formatter_class=HelpFormatter
+            )
+        )
     return parser
 
 

@@ -46,6 +46,9 @@ class Preset:
     elements: frozenset[Element] = ALL_ELEMENTS
     controls: frozenset[Control] = STANDARD_CONTROLS
     plots: frozenset[Plot] = STANDARD_PLOTS
+    #: One or two sentences saying what the picture shows, over the legend (a scene sets its
+    #: own here; empty: :mod:`poinsot.app.live.legend` has the presets' captions).
+    caption: str = ""
 
     def __post_init__(self) -> None:
         if self.pole_sign not in (1, -1):

@@ -15,8 +15,10 @@ Rooms: :mod:`~poinsot.physics.free_body` (the public object), :mod:`~.classifica
 caller's axes, units and attitude), :mod:`~.elliptic` (Jacobi functions and integrals),
 :mod:`~.exact` and :mod:`~.precise` (exact and extra-precise arithmetic), :mod:`~.rotations`
 and :mod:`~.errors` (the quaternion algebra and the error measures), :mod:`~.integrators`
-(numerical methods to compare against), :mod:`~.initial_state`, :mod:`~.validation`,
-:mod:`~.relabelling`, :mod:`~.solids`.
+(numerical methods to compare against), :mod:`~.initial_state`, :mod:`~.validation` (every
+input check: a ValueError, or an InputTypeError for what is no real number),
+:mod:`~.relabelling`, :mod:`~.solids`, :mod:`~.fuzz` (odd input of every kind against the whole
+API: ``python -m poinsot.physics.fuzz --cases 100000``).
 """
 
 from poinsot.physics.free_body import FreeRigidBody

@@ -42,8 +42,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics import FreeRigidBody
+from poinsot.physics.exact import pow2_below
 from poinsot.physics.family import polhode_curves, polhode_points, sorted_moments
+from poinsot.physics.free_body import FreeRigidBody
+from poinsot.physics.validation import (
+    check_attitude,
+    check_number,
+    check_positive,
+    check_time_array,
+    check_times,
+    check_vector,
+)
 
 __all__ = ["EnergySink"]
 
@@ -56,10 +65,18 @@ _ZOOM_POINTS = 33
 _WINDOW_DECAY_FRACTION = 0.01
 #: ... and at most this many radians of the initial spin.
 _WINDOW_SPIN_ANGLE = 0.5
+#: The most windows a motion is built from (each is one exact body, ~0.5 ms and a few kB).
+MAX_WINDOWS = 20_000
+#: |L|² must lie between these: the law and the search for the nearest polhode point square
+#: momenta, whose squares must stay normal doubles (with room for the factor 4 of a distance).
+_G2_RANGE = (1e-300, 4e307)
 
 
 def _smallest_rotation(a: NDArray[np.float64], b: NDArray[np.float64]) -> Rotation:
     """The rotation by the smallest angle that takes the direction of ``a`` to that of ``b``."""
+    # Directions only: over their largest components, the products of momenta ~1e150 in the
+    # cross and dot products would overflow (and those of ~1e-150 underflow).
+    a, b = (x / pow2_below(float(np.max(np.abs(x)))) for x in (a, b))
     axis = np.cross(a, b)
     s = float(np.linalg.norm(axis))
     c = float(a @ b)
@@ -125,42 +142,85 @@ class EnergySink:
         attitude0: Rotation | None = None,
     ):
         J = np.array(sorted_moments(inertia))
-        w0 = np.asarray(omega0, dtype=float)
-        if w0.shape != (3,) or not np.all(np.isfinite(w0)) or not np.any(w0):
+        w0 = check_vector(omega0, "omega0")
+        if not np.any(w0):
             raise ValueError(f"omega0 must be three finite numbers, not all zero, got {omega0!r}")
-        self.kappa = _positive(kappa, "κ (the dissipation rate)")
-        self.t_end = _positive(t_end, "t_end")
-        m0 = J * w0
+        self.kappa = check_positive(kappa, "κ (the dissipation rate)")
+        self.t_end = check_positive(t_end, "t_end")
+        attitude0 = check_attitude(attitude0)
         self.inertia = J
-        self.G = float(np.linalg.norm(m0))
+        self._set_law(J, w0)
+        if window is None:
+            spin = math.hypot(*w0.tolist())
+            window = min(_WINDOW_DECAY_FRACTION / self.kappa, _WINDOW_SPIN_ANGLE / spin)
+        self.window = check_positive(window, "the window")
+        windows = self.t_end / self.window
+        if not windows <= MAX_WINDOWS:
+            raise ValueError(
+                f"t_end/window = {windows:.3g} windows, more than {MAX_WINDOWS:,} (each is one "
+                "exact motion): use a longer window or a shorter t_end"
+            )
+        count = int(math.ceil(windows))
+        self.starts = self.window * np.arange(count)
+        """(K,) the windows' start times t_k [time]."""
+        self.bodies = self._build(w0, attitude0)
+        """The exact motion of each window (local time ``t - t_k``)."""
+        self.regimes = [b.regime for b in self.bodies]
+        """The regime (polhode family) of each window."""
+
+    def _set_law(self, J: NDArray[np.float64], w0: NDArray[np.float64]) -> None:
+        """G, the excess 2T₀ - G²/I3, D₀ and t* of the stated law, refused where they leave
+        the range of doubles."""
+        with np.errstate(over="ignore"):
+            m0 = J * w0
+        self.G = math.hypot(*m0.tolist())
         """|m| = |L| [moment × rad/time], fixed."""
-        # 2T₀ - G²/I3 = Σ Iᵢ ωᵢ² (I3 - Iᵢ)/I3: non-negative terms.
-        self.excess0 = float(np.sum(J * w0 * w0 * (J[2] - J) / J[2]))
+        G2 = self.G * self.G
+        if not _G2_RANGE[0] <= G2 <= _G2_RANGE[1]:
+            raise ValueError(
+                f"|L|² = {G2:g} in your units is outside [{_G2_RANGE[0]:g}, {_G2_RANGE[1]:g}], "
+                "where the law squares it: express the moments or ω0 in other units"
+            )
+        with np.errstate(over="ignore", invalid="ignore"):
+            # 2T₀ - G²/I3 = Σ Iᵢ ωᵢ² (I3 - Iᵢ)/I3: non-negative terms.
+            self.excess0 = float(np.sum(m0 * w0 * ((J[2] - J) / J[2])))
+        two_T0 = G2 / float(J[2]) + self.excess0
+        if not math.isfinite(two_T0):
+            raise ValueError(
+                f"the energy 2T of this body is beyond the double-precision range in your units "
+                f"(|L|² = {G2:g} with a largest moment {float(J[2]):g}): express the moments or "
+                "ω0 in other units"
+            )
         if self.excess0 == 0.0:
             raise ValueError(
                 "omega0 is a spin about the major axis e3 (D = I3): there is no energy left "
                 "to dissipate at this |L|"
             )
         self.D0 = float(self.D(0.0))
-        ratio = self.excess0 * J[1] * J[2] / (self.G**2 * (J[2] - J[1]))
-        self.crossing_time = math.log(ratio) / (2.0 * self.kappa)
+        # excess0 I2 I3/(G² (I3 - I2)), one factor at a time: products of moments ~1e-150
+        # underflow.
+        I2, I3 = float(J[1]), float(J[2])
+        ratio = self.excess0 / G2 * (I2 / (I3 - I2)) * I3
+        self.crossing_time = math.log(ratio) / (2.0 * self.kappa) if ratio > 0.0 else -math.inf
         """t* [time] where D(t) = I2 (negative if the motion starts above the separatrix)."""
-        if window is None:
-            spin = float(np.linalg.norm(w0))
-            window = min(_WINDOW_DECAY_FRACTION / self.kappa, _WINDOW_SPIN_ANGLE / spin)
-        self.window = _positive(window, "the window")
-        count = int(math.ceil(self.t_end / self.window))
-        self.starts = self.window * np.arange(count)
-        """(K,) the windows' start times t_k [time]."""
-        self.bodies = self._build(w0, Rotation.identity() if attitude0 is None else attitude0)
-        """The exact motion of each window (local time ``t - t_k``)."""
-        self.regimes = [b.regime for b in self.bodies]
-        """The regime (polhode family) of each window."""
+        if not all(map(math.isfinite, (self.excess0, self.D0, self.crossing_time))):
+            raise ValueError(
+                "the energy of this body lies beyond the double-precision range in your units "
+                f"(2T₀ - |L|²/I3 = {self.excess0:g}): express the moments or ω0 in other units"
+            )
 
     def two_T(self, t: ArrayLike) -> NDArray[np.float64]:
         """``2T(t) = G²/I3 + (2T₀ - G²/I3) e^{-2κt}`` (the stated law), same shape as t."""
-        tt = np.asarray(t, dtype=float)
-        return self.G**2 / self.inertia[2] + self.excess0 * np.exp(-2.0 * self.kappa * tt)
+        tt = np.asarray(check_times(t, "t"), dtype=float)
+        with np.errstate(over="ignore"):
+            # κt first: 2κ alone may overflow (κ ~ 1e308), and inf · 0 is NaN.
+            out = self.G**2 / self.inertia[2] + self.excess0 * np.exp(-2.0 * (self.kappa * tt))
+        if not np.all(np.isfinite(out)):
+            raise ValueError(
+                "t lies so far before the start that 2T(t) of the law passes the double range; "
+                "use times closer to 0"
+            )
+        return out
 
     def D(self, t: ArrayLike) -> NDArray[np.float64]:
         """``D(t) = G²/2T(t)`` [moment], rising to I3; same shape as t."""
@@ -183,9 +243,7 @@ class EnergySink:
         return bodies
 
     def _locate(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-        tt = np.atleast_1d(np.asarray(t, dtype=float))
-        if tt.ndim != 1 or not np.all(np.isfinite(tt)):
-            raise ValueError("t must be a finite number or a 1-D array of finite numbers")
+        tt = check_time_array(t)
         if tt.size and (tt.min() < 0.0 or tt.max() > self.t_end):
             raise ValueError(f"t must lie in [0, t_end = {self.t_end:g}] where the motion is built")
         k = np.minimum((tt // self.window).astype(np.int64), self.starts.size - 1)
@@ -215,7 +273,7 @@ class EnergySink:
     def body_at(self, t: float) -> FreeRigidBody:
         """The exact torque-free motion of the window containing ``t``: its ``polhode()`` is the
         curve the tip of ω runs on at that time, its ``regime`` the family label."""
-        _, k = self._locate(t)
+        _, k = self._locate(check_number(t, "t"))
         return self.bodies[int(k[0])]
 
 

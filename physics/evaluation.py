@@ -65,8 +65,8 @@ class Evaluator:
             decades = math.log10(amplitude) + self.w_exp * math.log10(2.0)
             self.out_of_range = (
                 f"during this motion a component of ω reaches about 1e{decades:.0f} in your "
-                "units, beyond the largest double-precision number (1.8e308): use a longer "
-                "time unit (ω0 in smaller numbers)"
+                "units, beyond the largest double-precision number (1.8e308): use a shorter "
+                "time unit (then ω0 is a smaller number)"
             )
 
     def _anchor_at_zero(self, omega_s: Array, attitude0: Rotation) -> None:

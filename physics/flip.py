@@ -50,8 +50,24 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special
 from scipy.integrate import solve_ivp
 
-from poinsot.physics import FreeRigidBody, Regime
+from poinsot.physics.exact import ldexp, pow2_below
 from poinsot.physics.family import sorted_moments
+from poinsot.physics.flip_growth import (
+    STEPS_PER_RATE,
+    GrowthFit,
+    check_body,
+    fastest_rate,
+    measure_growth_rate,
+)
+from poinsot.physics.free_body import FreeRigidBody
+from poinsot.physics.regime import Regime
+from poinsot.physics.validation import (
+    check_count,
+    check_number,
+    check_positive,
+    check_vector,
+    grid_size,
+)
 
 __all__ = [
     "FlipTheory",
@@ -63,10 +79,12 @@ __all__ = [
     "measure_growth_rate",
 ]
 
-#: Grid steps per fastest time scale of Euler's equations when looking for sign changes.
-_STEPS_PER_RATE = 10.0
-#: measure_growth_rate gives up after this many grid samples.
-_GROWTH_MAX_SAMPLES = 1 << 24
+#: integrated_flip_times integrates at most this many radians of the fastest rotation (DOP853
+#: takes a few steps per radian: beyond this it would run for minutes).
+_MAX_RADIANS = 1e4
+#: Tolerances below this scipy raises to it with a warning: refused instead; above the largest
+#: the steps are so long that the solution may run off to infinity.
+_MIN_RTOL, _MAX_RTOL = 100.0 * float(np.finfo(float).eps), 1e-2
 
 
 def flip_initial_omega(
@@ -78,16 +96,14 @@ def flip_initial_omega(
     Raises:
         ValueError: unless ``0 < ε < π/2`` and ``spin > 0`` (a spin exactly about e2 never flips).
     """
-    eps, spin, beta = float(epsilon), float(spin), float(azimuth)
-    if not (math.isfinite(eps) and 0.0 < eps < 0.5 * math.pi):
+    eps = check_number(epsilon, "the angle ε from the intermediate axis")
+    if not 0.0 < eps < 0.5 * math.pi:
         raise ValueError(
             f"the angle ε from the intermediate axis must lie in (0, π/2) rad, got {epsilon!r} "
             "(ε = 0 is a spin exactly about e2, which never flips)"
         )
-    if not (math.isfinite(spin) and spin > 0.0):
-        raise ValueError(f"the spin rate must be a positive finite number, got {spin!r}")
-    if not math.isfinite(beta):
-        raise ValueError(f"the azimuth β must be finite, got {azimuth!r}")
+    spin = check_positive(spin, "the spin rate")
+    beta = check_number(azimuth, "the azimuth β")
     s = math.sin(eps)
     return spin * np.array([s * math.cos(beta), math.cos(eps), s * math.sin(beta)])
 
@@ -137,56 +153,88 @@ def flip_theory(inertia: ArrayLike, omega0: ArrayLike) -> FlipTheory:
         ValueError: moments not sorted/distinct, ω0 not finite, along a principal axis, or
             exactly on the separatrix (it then flips once and never again).
     """
-    J = sorted_moments(inertia)
-    I1, I2, I3 = J
-    w = np.asarray(omega0, dtype=float)
-    if w.shape != (3,) or not np.all(np.isfinite(w)):
-        raise ValueError(f"omega0 must be three finite numbers, got {omega0!r}")
+    moments = sorted_moments(inertia)
+    w = check_vector(omega0, "omega0")
     if int(np.count_nonzero(w)) < 2:
         raise ValueError(
             f"omega0 = {w.tolist()} is a spin about a principal axis: it never flips; tilt it "
             "from e2 (see flip_initial_omega)"
         )
-    d1, d2, d3 = _deltas(J, w)
-    if d2 == 0.0:
-        raise ValueError(
-            "omega0 lies exactly on the separatrix (G² = 2T I2): the body flips once and never "
-            "again; change the azimuth of the tilt"
-        )
+    J, ws, w_exp, (d1, d2, d3) = _scaled_deltas(moments, w)
+    J1, J2, J3 = J
     major = d2 > 0.0
     # A1² = -Δ3/(I1(I3 - I1)) and A3² = Δ1/(I3(I3 - I1)) in both families [LL76 Eq. 37.10].
-    a31 = math.sqrt(d1 * I1 / (-d3 * I3))  # A3/A1
-    w1, w3 = abs(float(w[0])), abs(float(w[2]))
+    a31 = math.sqrt(d1 / -d3) * math.sqrt(J1 / J3)  # A3/A1
+    w1, w3 = abs(float(ws[0])), abs(float(ws[2]))
     if major:
-        lam = math.sqrt((I3 - I2) * d1 / (I1 * I2 * I3))
-        mc = d2 * (I3 - I1) / (d1 * (I3 - I2))
-        ratio = w1 * a31 / w3 if w3 > 0.0 else 0.0
+        lam = math.sqrt((J3 - J2) / J3) * math.sqrt(d1 / J1) / math.sqrt(J2)
+        mc = d2 / d1 * ((J3 - J1) / (J3 - J2))
+        ratio = w1 * a31 / w3 if w3 > 0.0 and w1 > 0.0 else 0.0
     else:
-        lam = math.sqrt((I2 - I1) * -d3 / (I1 * I2 * I3))
-        mc = d2 * (I3 - I1) / (d3 * (I2 - I1))
-        ratio = w3 / (a31 * w1) if w1 > 0.0 else 0.0
+        lam = math.sqrt((J2 - J1) / J1) * math.sqrt(-d3 / J3) / math.sqrt(J2)
+        mc = d2 / d3 * ((J3 - J1) / (J2 - J1))
+        ratio = w3 / (a31 * w1) if w1 > 0.0 and w3 > 0.0 else 0.0
     K = float(special.ellipkm1(mc))
     delta = float(special.ellipkinc(math.asin(min(ratio, 1.0)), 1.0 - mc))
     # dω2/dt = (I3 - I1) ω3 ω1 / I2: growing means the closest approach to e2 is still ahead.
     growing = (float(w[0]) * float(w[2]) * float(w[1])) > 0.0
-    first = (K + delta if growing else K - delta) / lam
-    sigma = abs(float(w[1])) * math.sqrt((I2 - I1) * (I3 - I2) / (I1 * I3))
-    return FlipTheory(
+    sigma = abs(float(ws[1])) * math.sqrt((J2 - J1) / J1) * math.sqrt((J3 - J2) / J3)
+    times = [ldexp(x / lam, -w_exp) for x in (K + delta if growing else K - delta, 2.0 * K)]
+    asymptotic = ldexp(math.log(16.0 / mc) / lam, -w_exp) if mc > 0.0 else math.inf
+    theory = FlipTheory(
         regime=Regime.MAJOR_AXIS if major else Regime.MINOR_AXIS,
         complementary_parameter=mc,
         K=K,
-        frequency=lam,
-        time_between_flips=2.0 * K / lam,
-        first_flip_time=first,
-        growth_rate=sigma,
-        asymptotic_time_between_flips=math.log(16.0 / mc) / lam,
+        frequency=ldexp(lam, w_exp),
+        time_between_flips=times[1],
+        first_flip_time=times[0],
+        growth_rate=ldexp(sigma, w_exp),
+        asymptotic_time_between_flips=asymptotic,
     )
+    _check_clock(theory)
+    return theory
 
 
-def _fastest_rate(inertia: NDArray[np.float64], omega0: NDArray[np.float64]) -> float:
-    """A bound on the rates of Euler's equations: ``|ω| max|Iⱼ - Iₖ|/Iᵢ`` (or ``|ω|``)."""
-    spread = (float(inertia.max()) - float(inertia.min())) / float(inertia.min())
-    return float(np.linalg.norm(omega0)) * max(1.0, spread)
+def _scaled_deltas(
+    moments: tuple[float, float, float], w: NDArray[np.float64]
+) -> tuple[tuple[float, float, float], NDArray[np.float64], int, tuple[float, float, float]]:
+    """Moments and ω over exact powers of two (the squares of ω ~ 1e200 or of moments ~1e-200
+    would leave the double range; every quantity of the clock is a ratio of factors near 1),
+    the exponent of ω's scale, and the Δᵢ; refused on the separatrix or an axis."""
+    scale = pow2_below(moments[2])
+    J = (moments[0] / scale, moments[1] / scale, moments[2] / scale)
+    w_exp = math.frexp(float(np.max(np.abs(w))))[1] - 1
+    ws = np.ldexp(w, -w_exp)
+    d1, d2, d3 = _deltas(J, ws)
+    if d2 == 0.0:
+        raise ValueError(
+            "omega0 lies on the separatrix (G² = 2T I2 to double precision): the body flips "
+            "once and never again; change the azimuth of the tilt"
+        )
+    if d1 <= 0.0 or d3 >= 0.0:
+        raise ValueError(
+            f"omega0 = {w.tolist()} is a spin about a principal axis to double precision (its "
+            "other components are too small to count): it never flips; tilt it from e2"
+        )
+    return J, ws, w_exp, (d1, d2, d3)
+
+
+def _check_clock(theory: FlipTheory) -> None:
+    """Refuse a clock that does not fit in doubles in the caller's units."""
+    values = (
+        theory.K,
+        theory.frequency,
+        theory.time_between_flips,
+        theory.first_flip_time,
+        theory.growth_rate,
+    )
+    if all(map(math.isfinite, values)) and theory.time_between_flips > 0.0:
+        return
+    raise ValueError(
+        "the flip clock of this motion lies beyond the double-precision range in your units "
+        f"(K = {theory.K:g}, λ = {theory.frequency:g}, 2K/λ = {theory.time_between_flips:g}): "
+        "tilt ω0 further from e2, or use a time unit closer to 1/|ω0|"
+    )
 
 
 def measure_flips(
@@ -204,16 +252,19 @@ def measure_flips(
         step: the grid spacing [time] (> 0); it must be shorter than half the time between
             flips, which every default is.
     """
-    t_end = float(t_end)
-    if not (math.isfinite(t_end) and t_end > 0.0):
-        raise ValueError(f"t_end must be a positive finite time, got {t_end!r}")
-    if axis not in (0, 1, 2):
-        raise ValueError(f"axis must be 0, 1 or 2, got {axis!r}")
+    check_body(body, "measure_flips")
+    t_end = check_positive(t_end, "t_end")
+    axis = check_count(axis, "axis (0, 1 or 2)", 0, 2)
     if step is None:
-        step = 1.0 / (_STEPS_PER_RATE * _fastest_rate(body.inertia, body.omega0))
-    if not (math.isfinite(step) and step > 0.0):
-        raise ValueError(f"step must be a positive finite time, got {step!r}")
-    n = int(math.ceil(t_end / step))
+        rate = fastest_rate(body.inertia, body.omega0)
+        if rate == 0.0:  # at rest: nothing changes sign
+            return np.empty(0)
+        step = 1.0 / (STEPS_PER_RATE * rate)
+    else:
+        step = check_positive(step, "step")
+    n = grid_size(
+        t_end, step, "searching for flips up to t_end", "use a shorter t_end or a larger step"
+    )
     t = np.linspace(0.0, t_end, n + 1)
     w = body.omega(t)[:, axis]
     sign = np.sign(w)
@@ -230,79 +281,6 @@ def measure_flips(
     return np.sort(np.concatenate([exact, np.asarray(refined, dtype=float)]))
 
 
-@dataclass(frozen=True)
-class GrowthFit:
-    """A straight-line fit of ``ln |(ω1, ω3)|`` against t on the exponential stretch.
-
-    Attributes:
-        rate: the measured σ [1/time]. window: (t_start, t_stop) of the fit [time].
-        e_folds: ``σ (t_stop - t_start)``, how long the stretch is.
-        residual: the largest deviation of ``ln |(ω1, ω3)|`` from the line.
-    """
-
-    rate: float
-    window: tuple[float, float]
-    e_folds: float
-    residual: float
-
-
-def measure_growth_rate(
-    body: FreeRigidBody,
-    start_factor: float = math.exp(5.0),
-    stop_amplitude: float = 1e-3,
-    step: float | None = None,
-) -> GrowthFit:
-    """The growth rate of the perturbation off ``e2``, read from the motion (sorted moments).
-
-    ``p(t) = |(ω1, ω3)|/|ω|`` grows like ``cosh``-type mixtures of ``e^{±σt}`` at first and
-    bends over when it is no longer small. The fit window starts where ``p`` has grown by
-    ``start_factor`` (the decaying mode has died down: its weight ~1/start_factor²) and stops
-    where ``p`` reaches ``stop_amplitude`` (the nonlinear terms are O(p²) relative).
-
-    Raises:
-        ValueError: if there is less than two e-folds between the two (ω0 too far from e2 for
-            an exponential stretch: use ``ε`` below ``stop_amplitude / (start_factor e²)``).
-    """
-    w0 = np.asarray(body.omega0, dtype=float)
-    norm = float(np.linalg.norm(w0))
-    p0 = math.hypot(float(w0[0]), float(w0[2])) / norm
-    lo, hi = p0 * float(start_factor), float(stop_amplitude)
-    if not (p0 > 0.0 and lo * math.e**2 < hi < 1.0):
-        raise ValueError(
-            f"no exponential stretch: the perturbation starts at {p0:.3g} of |ω|, it must grow "
-            f"by {start_factor:.3g} and then by two e-folds before it reaches {hi:g}; "
-            "start closer to the intermediate axis"
-        )
-    if step is None:
-        step = 1.0 / (_STEPS_PER_RATE * _fastest_rate(body.inertia, w0))
-    # Walk the grid in chunks until p passes hi (p grows monotonically on this stretch).
-    chunk = 4096
-    times, amps = [], []
-    for start in range(0, _GROWTH_MAX_SAMPLES, chunk):
-        t = step * np.arange(start, start + chunk)
-        w = body.omega(t)
-        p = np.hypot(w[:, 0], w[:, 2]) / np.linalg.norm(w, axis=1)
-        times.append(t)
-        amps.append(p)
-        if p.max() >= hi:
-            break
-    else:
-        raise ValueError(
-            f"the perturbation did not reach {hi:g} of |ω| within {_GROWTH_MAX_SAMPLES} grid "
-            "steps: this motion does not leave the intermediate axis (is e2 the intermediate axis?)"
-        )
-    t, p = np.concatenate(times), np.concatenate(amps)
-    first_hi = int(np.argmax(p >= hi))
-    t, p = t[:first_hi], p[:first_hi]
-    inside = p >= lo
-    begin = int(np.argmax(inside))
-    t, logp = t[begin:], np.log(p[begin:])
-    rate, offset = np.polyfit(t, logp, 1)
-    residual = float(np.abs(logp - (rate * t + offset)).max())
-    window = (float(t[0]), float(t[-1]))
-    return GrowthFit(float(rate), window, float(rate) * (window[1] - window[0]), residual)
-
-
 def integrated_flip_times(
     inertia: ArrayLike, omega0: ArrayLike, t_end: float, rtol: float = 1e-12
 ) -> NDArray[np.float64]:
@@ -315,9 +293,26 @@ def integrated_flip_times(
     the flip times are wrong by O(1/σ) (the demo ``python -m poinsot.physics.flip`` prints it).
     """
     J = np.asarray(sorted_moments(inertia))
-    w0 = np.asarray(omega0, dtype=float)
-    if w0.shape != (3,) or not np.all(np.isfinite(w0)):
-        raise ValueError(f"omega0 must be three finite numbers, got {omega0!r}")
+    w0 = check_vector(omega0, "omega0")
+    t_end = check_positive(t_end, "t_end")
+    rtol = check_positive(rtol, "rtol")
+    if not _MIN_RTOL <= rtol <= _MAX_RTOL:
+        raise ValueError(
+            f"rtol must lie between {_MIN_RTOL:.3g} (scipy's floor) and {_MAX_RTOL:g}, got {rtol!r}"
+        )
+    w_max = float(np.max(np.abs(w0)))
+    if w_max == 0.0:  # at rest: ω2 stays 0
+        return np.empty(0)
+    # The same equations for ω/2^e in the time t·2^e (exact powers of two): ω ~ 1e200 would
+    # overflow in the products ω_j ω_k.
+    w_exp = math.frexp(w_max)[1] - 1
+    ws, tau_end = np.ldexp(w0, -w_exp), ldexp(t_end, w_exp)
+    radians = fastest_rate(J, ws) * tau_end
+    if not radians <= _MAX_RADIANS:
+        raise ValueError(
+            f"t_end spans {radians:.3g} radians of the fastest rotation, more than "
+            f"{_MAX_RADIANS:g} for an integration: use a shorter t_end"
+        )
     c = np.array([(J[1] - J[2]) / J[0], (J[2] - J[0]) / J[1], (J[0] - J[1]) / J[2]])
 
     def euler(_t: float, w: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -326,16 +321,20 @@ def integrated_flip_times(
     def omega2(_t: float, w: NDArray[np.float64]) -> float:
         return float(w[1])
 
-    sol = solve_ivp(
-        euler,
-        (0.0, float(t_end)),
-        w0,
-        method="DOP853",
-        rtol=rtol,
-        atol=rtol * float(np.abs(w0).max()),
-        events=omega2,
-    )
-    return np.asarray(sol.t_events[0], dtype=float)
+    with np.errstate(all="ignore"):  # a run that leaves the range is refused just below
+        sol = solve_ivp(
+            euler,
+            (0.0, tau_end),
+            ws,
+            method="DOP853",
+            rtol=rtol,
+            atol=rtol * float(np.abs(ws).max()),
+            events=omega2,
+        )
+    times = np.asarray(sol.t_events[0], dtype=float)
+    if sol.status < 0 or not (np.all(np.isfinite(sol.y)) and np.all(np.isfinite(times))):
+        raise ValueError(f"DOP853 failed ({sol.message}): use a smaller rtol or a shorter t_end")
+    return np.ldexp(times, -w_exp)
 
 
 def _demo() -> None:  # pragma: no cover - a printout for the report

@@ -41,11 +41,14 @@ from poinsot.physics.regime import Regime
 from poinsot.physics.relabelling import sorting_map
 from poinsot.physics.rotations import rotate, rotate_vector
 from poinsot.physics.validation import (
+    MAX_POINTS,
     check_attitude,
+    check_count,
     check_energy_parameter,
     check_inertia,
     check_moment_span,
     check_positive,
+    check_sign,
     check_vector,
 )
 
@@ -57,8 +60,10 @@ Vector = np.ndarray[tuple[int], np.dtype[np.float64]]
 Stack = np.ndarray[tuple[int, int], np.dtype[np.float64]]
 Array = NDArray[np.float64]
 
-_SLOWER = "use a longer time unit (ω0 and the times in smaller numbers)"
-_FASTER = "use a shorter time unit (ω0 and the times in larger numbers)"
+# Rate [1/time] and time are inverse: in a shorter time unit (ms for s) ω0 is a smaller number
+# and a time a larger one.
+_SLOWER = "use a shorter time unit (then ω0 and the rates are smaller numbers, the times larger)"
+_FASTER = "use a longer time unit (then ω0 and the rates are larger numbers, the times smaller)"
 _LARGER = "express the moments or ω0 in larger units"
 
 
@@ -134,19 +139,23 @@ class FreeRigidBody:
 
         Raises:
             ValueError: bad moments, D outside ``[min I, max I]``, a norm that is not positive
-                and finite (or both norms given), or an ``attitude0`` that is not one Rotation.
+                and finite (or both norms given), a ``pole_sign`` other than ±1, or an
+                ``attitude0`` that is not one Rotation (also as
+                :class:`~poinsot.physics.validation.InputTypeError` for an argument that is no
+                real number).
         """
         checked = check_inertia(inertia)
         check_moment_span(checked)
         d = check_energy_parameter(D, checked)
+        sign = check_sign(pole_sign, "pole_sign")
         if omega_norm is not None and momentum_norm is not None:
             raise ValueError("give |omega0| (omega_norm) or |L| (momentum_norm), not both")
         if momentum_norm is None:
             size = check_positive(1.0 if omega_norm is None else omega_norm, "|omega0|")
-            omega0 = omega_checked(checked, d, pole_sign, omega_norm=size)
+            omega0 = omega_checked(checked, d, sign, omega_norm=size)
         else:
             size = check_positive(momentum_norm, "|L|")
-            omega0 = omega_checked(checked, d, pole_sign, momentum_norm=size)
+            omega0 = omega_checked(checked, d, sign, momentum_norm=size)
         if attitude0 is None:
             rotation = attitude_checked(checked, omega0)
         else:
@@ -204,16 +213,19 @@ class FreeRigidBody:
         self._inertia_scaled = s.inertia
         if self.regime is Regime.REST:
             self.D = 0.0
-            self.plane_distance = 0.0
+            self._plane_distance_scaled = 0.0
             self.plane_normal = np.array([0.0, 0.0, 1.0])
             return
         # D = G²/2T lies in [min I, max I]; on the separatrix it is I2 exactly (Δ2 = 0).
         if self.regime is Regime.SEPARATRIX:
             scaled_D = float(s.J[1])
         else:
-            scaled_D = G * (G / two_T) if two_T > 0 else 0.0
+            # In [min J, max J] exactly, not just to rounding: one ulp above the largest
+            # moment 1.8e308 would read back as inf.
+            ratio = G * (G / two_T) if two_T > 0 else 0.0
+            scaled_D = min(max(ratio, float(s.J.min())), float(s.J.max()))
         self.D = scaled_D * self._I_ref
-        self.plane_distance = two_T / G * self._w_ref  # 2T/G <= |ω|
+        self._plane_distance_scaled = two_T / G  # 2T/G <= |ω|: may pass 1.8e308 with |ω|
         G_space = math.hypot(*self._L_scaled.tolist())  # no underflow of G² for moments ~1e-300
         self.plane_normal = self._L_scaled / G_space
 
@@ -280,10 +292,13 @@ class FreeRigidBody:
             frame, at the cost of one :meth:`attitude` call.
         """
         w, q = self._eval.evaluate(t)
+        # Rotated in the scaled units (an exact power of two): the products inside the
+        # rotation would overflow for ω ~ 1e308 and lose digits for a subnormal ω.
+        w_ref = self._eval.w_ref
         if q.ndim == 1:
-            contact = np.array(rotate_vector(q.tolist(), w.tolist()))
+            contact = np.array(rotate_vector(q.tolist(), (w / w_ref).tolist())) * w_ref
             return w, Rotation.from_quat(q), contact
-        return w, Rotation.from_quat(q), rotate(q, w)
+        return w, Rotation.from_quat(q), rotate(q, w / w_ref) * w_ref
 
     def polhode(self, n: int = 256) -> Stack:
         """The polhode: the closed curve ω traces in the body frame (caller's axes), (n, 3)
@@ -294,14 +309,21 @@ class FreeRigidBody:
         separatrix it is the arc between the two intermediate-axis poles, endpoints included;
         for a constant ω it is that one point repeated.
         """
-        if int(n) < 2:
-            raise ValueError(f"the polhode needs at least 2 points, got n={n}")
-        return self._eval.polhode(int(n))
+        points = check_count(n, "n, the number of polhode points,", 2, MAX_POINTS)
+        return self._eval.polhode(points)
 
     # -- properties in the caller's units ---------------------------------------------------
     # Each may exceed the double range for extreme units (ω0 ~ 1e200 with moments ~1e100 has an
     # energy ~1e500): it is computed when read, from its exact scaled value, and raises a
     # ValueError saying so rather than returning inf.
+
+    @property
+    def plane_distance(self) -> float:
+        """``2T/G`` [rad per time unit], the distance of the invariable plane ``x·L = 2T`` from
+        the fixed point [FM06 Eq. 7.55]."""
+        return _in_units(
+            self._plane_distance_scaled, self._w_exp, "the distance 2T/|L| of the plane", _SLOWER
+        )
 
     @property
     def energy(self) -> float:
@@ -343,12 +365,8 @@ class FreeRigidBody:
         num, rate = self._form.period_pair
         if rate == 0.0:
             return math.inf
-        return _in_units(
-            num / rate,
-            -self._w_exp,
-            "the period of ω",
-            _FASTER,
-            lambda: math.log10(num) - math.log10(rate),
+        return _time_in_units(
+            num / rate, -self._w_exp, "the period of ω", math.log10(num) - math.log10(rate)
         )
 
     @property
@@ -374,12 +392,11 @@ class FreeRigidBody:
         nu = self._form.nu
         if self._form.period_pair[1] == 0.0 or nu == 0.0:
             return math.inf
-        return _in_units(
+        return _time_in_units(
             2.0 * math.pi / nu,
             -self._w_exp,
             "the precession period",
-            _FASTER,
-            lambda: math.log10(2.0 * math.pi) - math.log10(abs(nu)),
+            math.log10(2.0 * math.pi) - math.log10(abs(nu)),
         )
 
     def __repr__(self) -> str:
@@ -409,6 +426,21 @@ def _in_units(
         return value
     size = math.log10(abs(scaled)) if log10_scaled is None else log10_scaled()
     raise _too_large(size, exp2, what, advice, units)
+
+
+def _time_in_units(scaled: float, exp2: int, what: str, log10_scaled: float) -> float:
+    """:func:`_in_units` for a period: refused also where it underflows to 0 (a spin ~1e306
+    about a body with moments 1e66 apart turns in 1e-372 time units), since a period of 0
+    would divide by zero wherever it is used."""
+    value = _in_units(scaled, exp2, what, _FASTER, lambda: log10_scaled)
+    if value != 0.0 or scaled == 0.0:
+        return value
+    decades = log10_scaled + exp2 * math.log10(2.0)
+    raise ValueError(
+        f"{what} of this body is about 1e{decades:.0f} in your units, below the smallest "
+        f"double-precision number (5e-324): {_SLOWER} (omega(t) and attitude(t) are still "
+        "available)"
+    )
 
 
 def _vector_in_units(scaled: Array, exp2: int, what: str) -> Vector:

@@ -40,6 +40,17 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics import rotations
+from poinsot.physics.validation import (
+    MAX_SAMPLES,
+    check_attitude,
+    check_count,
+    check_number,
+    check_positive,
+    check_time_array,
+    check_times,
+    check_vector,
+    grid_size,
+)
 
 __all__ = ["AttitudeRun", "DriftMeasurement", "Gyroscope"]
 
@@ -84,11 +95,8 @@ class DriftMeasurement:
     window: tuple[float, float]
 
 
-def _finite_positive(x: float, name: str) -> float:
-    value = float(x)
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"{name} must be a positive finite number, got {x!r}")
-    return value
+#: The most nutation periods measure_drift averages over.
+_MAX_PERIODS = 10_000
 
 
 class Gyroscope:
@@ -113,14 +121,10 @@ class Gyroscope:
         omega0: ArrayLike,
         attitude0: Rotation | None = None,
     ):
-        J = _finite_positive(transverse, "the transverse moment J")
-        J3 = _finite_positive(axial, "the axial moment J3")
-        M = float(torque)
-        if not math.isfinite(M):
-            raise ValueError(f"the torque M must be finite, got {torque!r}")
-        w = np.asarray(omega0, dtype=float)
-        if w.shape != (3,) or not np.all(np.isfinite(w)):
-            raise ValueError(f"omega0 must be three finite numbers, got {omega0!r}")
+        J = check_positive(transverse, "the transverse moment J")
+        J3 = check_positive(axial, "the axial moment J3")
+        M = check_number(torque, "the torque M")
+        w = check_vector(omega0, "omega0")
         if J3 == J:
             raise ValueError(
                 "J3 = J: with equal moments the torque meets no gyroscopic resistance "
@@ -131,14 +135,16 @@ class Gyroscope:
                 "ω3 = 0: a gyroscope must spin about its symmetry axis (ω1* = -M/((J3 - J) ω3) "
                 "is infinite); give omega0 a non-zero third component"
             )
-        if attitude0 is None:
-            attitude0 = Rotation.identity()
-        if not isinstance(attitude0, Rotation) or not attitude0.single:
-            raise ValueError("attitude0 must be one scipy Rotation (body -> space) or None")
+        attitude0 = check_attitude(attitude0)
         self.transverse, self.axial, self.torque = J, J3, M
         self.omega0 = w.copy()
         self.attitude0 = attitude0
         w3 = float(w[2])
+        if (J3 - J) * w3 == 0.0:  # (J3 - J) ω3 underflowed: ω1* is beyond the range
+            raise ValueError(
+                f"(J3 - J) ω3 = ({J3:g} - {J:g}) · {w3:g} underflows: ω1* = -M/((J3 - J) ω3) is "
+                "beyond the double-precision range; express the moments and ω0 in other units"
+            )
         self.nutation_center = -M / ((J3 - J) * w3)
         """ω1* [rad/time], the centre of the nutation circle [FM06 Eq. 7.91]."""
         self.nutation_rate = (J3 - J) / J * w3
@@ -149,8 +155,30 @@ class Gyroscope:
         """α [rad] [FM06 Eq. 7.95]."""
         self.drift_rate = M / ((J3 - J) * w3)
         """The mean rate [rad/time] of the axis towards the torque [FM06 Eq. 7.98]."""
-        self.nutation_period = 2.0 * math.pi / abs(self.nutation_rate)
+        self.nutation_period = (
+            2.0 * math.pi / abs(self.nutation_rate) if self.nutation_rate else math.inf
+        )
         """2π/|ν| [time]."""
+        self._check_range()
+
+    def _check_range(self) -> None:
+        """Refuse a gyroscope whose constants leave the double range (moments 1e-300 apart, a
+        torque of 1e300, a spin of 1e-300: ω1* or ν overflow or underflow)."""
+        values = (
+            self.nutation_center,
+            self.nutation_rate,
+            self.amplitude,
+            self.drift_rate,
+            self.nutation_period,
+            self._fastest_rate(),
+        )
+        if all(map(math.isfinite, values)) and self.nutation_rate != 0.0:
+            return
+        raise ValueError(
+            "the nutation of this gyroscope lies beyond the double-precision range "
+            f"(ω1* = {self.nutation_center:g}, ν = {self.nutation_rate:g} in your units): "
+            "express the moments, the torque and ω0 in units closer to each other"
+        )
 
     @property
     def inertia(self) -> NDArray[np.float64]:
@@ -159,10 +187,14 @@ class Gyroscope:
 
     def omega(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame ω(t) [rad/time] in closed form: (3,) for a number, (N, 3) for (N,)."""
-        tt = np.asarray(t, dtype=float)
-        if tt.ndim > 1 or not np.all(np.isfinite(tt)):
-            raise ValueError("t must be a finite number or a 1-D array of finite numbers")
-        angle = self.nutation_rate * tt + self.phase
+        tt = np.asarray(check_times(t, "t"), dtype=float)
+        with np.errstate(over="ignore"):
+            angle = self.nutation_rate * tt + self.phase
+        if not np.all(np.isfinite(angle)):
+            raise ValueError(
+                "t is too far for this gyroscope: its nutation phase ν t passes the "
+                "double-precision range (1.8e308 rad); use smaller times"
+            )
         w1 = self.nutation_center + self.amplitude * np.cos(angle)
         w2 = self.amplitude * np.sin(angle)
         return np.stack([w1, w2, np.full_like(w1, self.omega0[2])], axis=-1)
@@ -181,6 +213,8 @@ class Gyroscope:
         counts = np.ceil(np.diff(edges) / h - 1e-12).astype(np.int64)
         counts = np.maximum(counts, np.where(np.diff(edges) > 0.0, 1, 0))
         total = int(counts.sum())
+        if total == 0:  # every output time is t = 0
+            return np.tile(self.attitude0.as_quat(), (t_eval.size, 1)), 0
         # Every step's start and length, interval by interval (each interval cut evenly).
         interval = np.repeat(np.arange(counts.size), counts)
         first = np.cumsum(counts) - counts
@@ -189,9 +223,10 @@ class Gyroscope:
         start = edges[interval] + k * length
         wa = self.omega(start + (0.5 - _SQRT3 / 6.0) * length)
         wb = self.omega(start + (0.5 + _SQRT3 / 6.0) * length)
-        theta = 0.5 * length[:, None] * (wa + wb) + (_SQRT3 / 12.0 * length**2)[:, None] * np.cross(
-            wa, wb
-        )
+        # h ω_a × h ω_b rather than h² (ω_a × ω_b): the angles, not ω² (which overflows for
+        # ω ~ 1e200 however short the step).
+        ha, hb = length[:, None] * wa, length[:, None] * wb
+        theta = 0.5 * (ha + hb) + (_SQRT3 / 12.0) * np.cross(ha, hb)
         angle = np.linalg.norm(theta, axis=1)
         half_sinc = 0.5 * np.sinc(angle / (2.0 * math.pi))  # sin(a/2)/a, finite at a = 0
         steps = np.concatenate([theta * half_sinc[:, None], np.cos(0.5 * angle)[:, None]], axis=1)
@@ -208,12 +243,26 @@ class Gyroscope:
         """R(t) on the times ``t`` (N,) ``>= 0`` non-decreasing, by Magnus-4 with steps of at most
         ``step/2`` [time] (default: 1/512 of the fastest turn), with its error estimate from the
         run with steps of at most ``step``."""
-        tt = np.atleast_1d(np.asarray(t, dtype=float))
-        if tt.ndim != 1 or tt.size == 0 or not np.all(np.isfinite(tt)):
+        tt = check_time_array(t)
+        if tt.size == 0:
             raise ValueError("t must be a non-empty 1-D array of finite times")
-        if tt[0] < 0.0 or np.any(np.diff(tt) < 0.0):
+        if tt[0] < 0.0 or np.any(tt[1:] < tt[:-1]):
             raise ValueError("t must be non-negative and non-decreasing (the run starts at 0)")
-        h = self._default_step() if step is None else _finite_positive(step, "the step")
+        h = self._default_step() if step is None else check_positive(step, "the step")
+        turn = h * self._fastest_rate()
+        if not turn <= math.pi:
+            raise ValueError(
+                f"a step of {h:g} turns the body by up to {turn:.3g} rad, more than half a turn: "
+                f"too long for Magnus-4; use a step below {h * math.pi / turn:.3g}"
+            )
+        steps = grid_size(
+            float(tt[-1]), 0.5 * h, "the Magnus run up to t", "use a larger step or shorter t"
+        )
+        if steps + tt.size > MAX_SAMPLES:
+            raise ValueError(
+                f"{tt.size} output times need as many Magnus steps, with {steps} more to reach "
+                f"t: at most {MAX_SAMPLES:,} in all; ask for fewer times"
+            )
         coarse, _ = self._magnus(tt, h)
         fine, steps = self._magnus(tt, 0.5 * h)
         error = rotations.geodesic_angle(coarse, fine) / 15.0
@@ -237,13 +286,20 @@ class Gyroscope:
         ``R x2`` (and on ``R x1``), and averaged over the whole periods (a mean over a uniform
         grid of whole periods is exact for the periodic components of the velocity).
         """
+        count = check_count(periods, "periods", 1, _MAX_PERIODS)
         if samples is None:
             turns = self.nutation_period * self._fastest_rate() / (2.0 * math.pi)
-            samples = max(_DRIFT_SAMPLES, math.ceil(_DRIFT_SAMPLES_PER_TURN * turns))
-        n_per, count = int(samples), int(periods)
-        if n_per < 16 or count < 1:
-            raise ValueError(f"need periods >= 1 and samples >= 16, got {periods}, {samples}")
-        if not (math.isfinite(t_start) and t_start >= 0.0):
+            needed = max(_DRIFT_SAMPLES, _DRIFT_SAMPLES_PER_TURN * turns)
+            if not needed * count <= MAX_SAMPLES:
+                raise ValueError(
+                    f"this gyroscope turns {turns:.3g} times per nutation period: measuring its "
+                    f"drift over {count} periods would take more than {MAX_SAMPLES:,} samples; "
+                    "give fewer periods or a number of samples"
+                )
+            samples = math.ceil(needed)
+        n_per = check_count(samples, "samples (per period)", 16, MAX_SAMPLES // count)
+        t_start = check_number(t_start, "t_start")
+        if t_start < 0.0:
             raise ValueError(f"t_start must be a finite time >= 0, got {t_start!r}")
         dt = self.nutation_period / n_per
         n = count * n_per

@@ -21,7 +21,9 @@ from poinsot.physics.relabelling import sorting_map
 from poinsot.physics.validation import (
     check_energy_parameter,
     check_inertia,
+    check_moment_span,
     check_positive,
+    check_sign,
     check_vector,
 )
 
@@ -54,12 +56,15 @@ def omega_from_energy(
         (:meth:`~poinsot.physics.free_body.FreeRigidBody.from_energy` builds it exactly).
 
     Raises:
-        ValueError: if D lies outside ``[min I, max I]``, or omega_norm is not positive.
+        ValueError: if the moments are not positive and finite or span more than 300 decades,
+            D lies outside ``[min I, max I]``, omega_norm is not positive, or pole_sign is not
+            ±1.
     """
     checked = check_inertia(inertia)
+    check_moment_span(checked)
     d = check_energy_parameter(D, checked)
     size = check_positive(omega_norm, "|omega0|")
-    return omega_checked(checked, d, pole_sign, omega_norm=size)
+    return omega_checked(checked, d, check_sign(pole_sign, "pole_sign"), omega_norm=size)
 
 
 def omega_checked(
@@ -79,7 +84,7 @@ def omega_checked(
     J = np.sort(inertia) / scale
     J1, J2, J3 = J
     D = D / scale
-    sign = 1.0 if pole_sign >= 0 else -1.0
+    sign = 1.0 if pole_sign >= 0 else -1.0  # checked: ±1
     if J1 == J3:
         m = np.array([0.0, 0.0, 1.0])
     else:
@@ -95,8 +100,11 @@ def omega_checked(
         w_sorted *= omega_norm / np.linalg.norm(w_sorted)
     else:
         assert momentum_norm is not None
-        w_sorted *= (momentum_norm / np.linalg.norm(J * w_sorted)) / scale
-        if not np.all(np.isfinite(w_sorted)) or not np.any(w_sorted):
+        # |J ω| by hypot: its squares underflow for a smallest moment ~1e-300 of the largest.
+        factor = (momentum_norm / math.hypot(*(J * w_sorted).tolist())) / scale
+        with np.errstate(under="ignore"):
+            w_sorted *= factor if math.isfinite(factor) else 0.0
+        if not np.any(w_sorted):
             raise ValueError(
                 f"|L| = {momentum_norm:g} with moments up to {scale:g} gives an ω0 beyond the "
                 "double range: express |L| or the moments in other units"
@@ -118,7 +126,9 @@ def attitude_with_L_along_z(inertia: ArrayLike, omega0: ArrayLike) -> Rotation:
     Returns:
         A single Rotation, the smallest that takes L̂ to +z; the identity for a body at rest.
     """
-    return attitude_checked(check_inertia(inertia), check_vector(omega0, "omega0"))
+    checked = check_inertia(inertia)
+    check_moment_span(checked)
+    return attitude_checked(checked, check_vector(omega0, "omega0"))
 
 
 def attitude_checked(inertia: Array, omega0: Array) -> Rotation:

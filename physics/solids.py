@@ -9,10 +9,13 @@ homogeneous box with the same moments.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from poinsot.physics.validation import check_inertia
+from poinsot.physics.exact import pow2_below
+from poinsot.physics.validation import check_inertia, check_positive
 
 __all__ = ["check_real_body", "box_dimensions"]
 
@@ -31,17 +34,25 @@ def check_real_body(inertia: ArrayLike) -> None:
         ValueError: bad moments (as :class:`FreeRigidBody`), or a moment larger than the sum of
             the other two, with a message naming the offending axis.
     """
-    moments = check_inertia(inertia)
-    total = float(moments.sum())
+    _scaled_moments(check_inertia(inertia))
+
+
+def _scaled_moments(moments: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+    """``(moments / s, s)`` for ``s`` the power of two below the largest (exact: a sum of
+    moments ~1e308 would overflow), after the triangle inequality is checked."""
+    scale = pow2_below(float(moments.max()))
+    J = moments / scale
+    total = float(J.sum())
     for i in range(3):
-        others = total - moments[i]
-        if moments[i] > others * (1.0 + _TRIANGLE_RTOL):
+        others = total - float(J[i])
+        if J[i] > others * (1.0 + _TRIANGLE_RTOL):
             j, k = (x for x in range(3) if x != i)
             raise ValueError(
                 f"no real body has these moments: I{i + 1} = {moments[i]:g} is larger than "
-                f"I{j + 1} + I{k + 1} = {others:g} (every moment must be at most the sum of the "
-                "other two; equality is a flat plate)"
+                f"I{j + 1} + I{k + 1} = {others * scale:g} (every moment must be at most the sum "
+                "of the other two; equality is a flat plate)"
             )
+    return J, scale
 
 
 def box_dimensions(inertia: ArrayLike, mass: float = 1.0) -> NDArray[np.float64]:
@@ -58,12 +69,20 @@ def box_dimensions(inertia: ArrayLike, mass: float = 1.0) -> NDArray[np.float64]
         has a zero side.
 
     Raises:
-        ValueError: if no real body has these moments (see :func:`check_real_body`), or the
-            mass is not positive and finite.
+        ValueError: if no real body has these moments (see :func:`check_real_body`), the
+            mass is not positive and finite, or a side would leave the double range.
     """
-    check_real_body(inertia)
-    if not (np.isfinite(mass) and mass > 0.0):
-        raise ValueError(f"the mass must be positive and finite, got {mass}")
-    moments = np.asarray(inertia, dtype=float)
-    excess = moments.sum() - 2.0 * moments  # I_j + I_k - I_i, >= 0 up to rounding
-    return np.sqrt(6.0 * np.maximum(excess, 0.0) / mass)
+    J, scale = _scaled_moments(check_inertia(inertia))
+    m = check_positive(mass, "the mass")
+    excess = np.maximum(J.sum() - 2.0 * J, 0.0)  # (I_j + I_k - I_i)/scale, >= 0 up to rounding
+    with np.errstate(over="ignore", under="ignore"):
+        sides = np.sqrt(6.0 * excess * scale / m)
+        if not np.all(np.isfinite(sides) & ((sides > 0.0) | (excess == 0.0))):
+            # sqrt(6 excess scale/m) factored, where the quotient itself leaves the range.
+            sides = np.sqrt(6.0 * excess) * (math.sqrt(scale) / math.sqrt(m))
+    if not np.all(np.isfinite(sides)):
+        raise ValueError(
+            f"a box of mass {m:g} with moments up to {scale:g} has sides beyond the "
+            "double-precision range (1.8e308): express the mass or the moments in other units"
+        )
+    return sides

@@ -33,7 +33,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics import FreeRigidBody
+from poinsot.physics.exact import ldexp, pow2_below
+from poinsot.physics.flip import check_body
+from poinsot.physics.free_body import FreeRigidBody
+from poinsot.physics.validation import (
+    check_attitude,
+    check_count,
+    check_moment_span,
+    check_positive,
+    check_vector,
+    grid_size,
+)
 
 __all__ = [
     "SymmetricTop",
@@ -106,20 +116,24 @@ class SymmetricTop:
 
     def space_cone(self, n: int = 64, length: float | None = None) -> NDArray[np.float64]:
         """(n, 3) rim of the space cone (space frame): the cone swept by ω about ``L``."""
-        axis = self.angular_momentum / np.linalg.norm(self.angular_momentum)
+        # L̂ from the scaled I ω0 (exact powers of two): L itself may be subnormal.
+        m = _scaled(self.inertia) * _scaled(self.omega0)
+        axis = self.attitude0.apply(m / math.hypot(*m.tolist()))
         return _cone(axis, self.space_cone_half_angle, self._length(length), self._n(n))
 
     def _length(self, length: float | None) -> float:
-        x = self.omega_norm if length is None else float(length)
-        if not (math.isfinite(x) and x > 0.0):
-            raise ValueError(f"the cone length must be positive and finite, got {length!r}")
-        return x
+        if length is None:
+            return self.omega_norm
+        return check_positive(length, "the cone length")
 
     @staticmethod
     def _n(n: int) -> int:
-        if int(n) < 3:
-            raise ValueError(f"a cone needs at least 3 generators, got n={n}")
-        return int(n)
+        return check_count(n, "n, the number of generators of a cone,", 3)
+
+
+def _scaled(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``x`` over the power of two below its largest magnitude (exact)."""
+    return x / pow2_below(float(np.max(np.abs(x))))
 
 
 def symmetric_top(
@@ -131,52 +145,61 @@ def symmetric_top(
         ValueError: moments not positive and finite, ``I = J`` (a sphere: no cone, every axis
             is principal), ω0 not three finite numbers or zero.
     """
-    It, J = float(transverse), float(axial)
-    if not (math.isfinite(It) and math.isfinite(J) and It > 0.0 and J > 0.0):
-        raise ValueError(f"the moments must be positive and finite, got I={It!r}, J={J!r}")
+    It = check_positive(transverse, "the transverse moment I")
+    J = check_positive(axial, "the axial moment J")
     if It == J:
         raise ValueError(
             "I = J is a sphere: every axis is principal and ω is constant; a symmetric top "
             "needs an axial moment J different from the transverse I"
         )
-    w = np.asarray(omega0, dtype=float)
-    if w.shape != (3,) or not np.all(np.isfinite(w)):
-        raise ValueError(f"omega0 must be three finite numbers, got {omega0!r}")
+    check_moment_span(np.array([It, J, J]))
+    w = check_vector(omega0, "omega0")
     if not np.any(w):
         raise ValueError("omega0 is zero: a body at rest has no precession and no spin")
-    if attitude0 is None:
-        attitude0 = Rotation.identity()
-    w_perp = math.hypot(float(w[0]), float(w[1]))
-    w3 = float(w[2])
-    G = math.hypot(It * w_perp, J * w3)
-    return SymmetricTop(
+    attitude0 = check_attitude(attitude0)
+    # Moments and ω over exact powers of two: I ω and ω² would leave the double range for
+    # ω ~ 1e200 or moments ~1e-200; the angles are ratios and the rates scale back exactly.
+    i_exp = math.frexp(max(It, J))[1] - 1
+    w_exp = math.frexp(float(np.max(np.abs(w))))[1] - 1
+    i_s, j_s, ws = math.ldexp(It, -i_exp), math.ldexp(J, -i_exp), np.ldexp(w, -w_exp)
+    w_perp = math.hypot(float(ws[0]), float(ws[1]))
+    w3 = float(ws[2])
+    G = math.hypot(i_s * w_perp, j_s * w3)
+    L = attitude0.apply(np.array([i_s * ws[0], i_s * ws[1], j_s * w3]))
+    top = SymmetricTop(
         transverse=It,
         axial=J,
         omega0=w.copy(),
         attitude0=attitude0,
         shape="oblate" if J > It else "prolate",
-        precession_rate=G / It,
-        spin_rate=(It - J) / It * w3,
+        precession_rate=ldexp(G / i_s, w_exp),
+        spin_rate=ldexp((i_s - j_s) / i_s * w3, w_exp),
         body_cone_half_angle=math.atan2(w_perp, w3),
         # angle between ω and m = (It ω⊥, J ω3): |ω × m| = |J - It| |ω⊥ ω3|
         space_cone_half_angle=math.atan2(
-            abs(J - It) * w_perp * abs(w3), It * w_perp**2 + J * w3**2
+            abs(j_s - i_s) * w_perp * abs(w3), i_s * w_perp**2 + j_s * w3**2
         ),
-        nutation_angle=math.atan2(It * w_perp, J * w3),
-        angular_momentum=attitude0.apply(np.array([It * w[0], It * w[1], J * w3])),
-        omega_norm=float(np.linalg.norm(w)),
+        nutation_angle=math.atan2(i_s * w_perp, j_s * w3),
+        angular_momentum=np.array([ldexp(x, i_exp + w_exp) for x in L.tolist()]),
+        omega_norm=ldexp(math.hypot(*ws.tolist()), w_exp),
     )
+    rates = (top.precession_rate, top.spin_rate, top.omega_norm, *L.tolist())
+    if not all(math.isfinite(x) for x in (*rates, *top.angular_momentum.tolist())):
+        raise ValueError(
+            "the rates or the angular momentum of this top lie beyond the double-precision "
+            "range (1.8e308) in your units: express the moments or ω0 in other units"
+        )
+    return top
 
 
 def _grid(body: FreeRigidBody, t_end: float) -> NDArray[np.float64]:
     """A time grid on ``[0, t_end]`` fine enough to unwrap every angle of a symmetric motion:
     the rates p = G/I and |s| are at most ``|ω| max(1, J/I, |I - J|/I)``."""
-    t_end = float(t_end)
-    if not (math.isfinite(t_end) and t_end > 0.0):
-        raise ValueError(f"t_end must be a positive finite time, got {t_end!r}")
-    J = np.asarray(body.inertia, dtype=float)
-    rate = float(np.linalg.norm(body.omega0)) * max(1.0, float(J.max() / J.min()))
-    n = int(math.ceil(t_end * rate * _STEPS_PER_RATE)) + 1
+    t_end = check_positive(t_end, "t_end")
+    J = body.inertia
+    rate = math.hypot(*body.omega0.tolist()) * max(1.0, float(J.max()) / float(J.min()))
+    step = 1.0 / (rate * _STEPS_PER_RATE) if rate > 0.0 else t_end
+    n = grid_size(t_end, step, "measuring up to t_end", "use a shorter t_end") + 1
     return np.linspace(0.0, t_end, max(n, 2))
 
 
@@ -203,13 +226,12 @@ def measure_precession_rate(body: FreeRigidBody, t_end: float) -> float:
     Raises:
         ValueError: the body is not symmetric, or its axis lies along L (nothing precesses).
     """
-    k = _symmetry_axis(body)
+    k = _symmetry_axis(check_body(body, "measure_precession_rate"))
     t = _grid(body, t_end)
     e = np.zeros(3)
     e[k] = 1.0
     axis = body.attitude(t).apply(e)
-    L = np.asarray(body.angular_momentum, dtype=float)
-    Lhat = L / np.linalg.norm(L)
+    Lhat = body.plane_normal  # L̂, computed without over- or underflow of L
     helper = np.array([1.0, 0.0, 0.0]) if abs(Lhat[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
     u = helper - (helper @ Lhat) * Lhat
     u /= np.linalg.norm(u)
@@ -227,7 +249,7 @@ def measure_spin_rate(body: FreeRigidBody, t_end: float) -> float:
     Raises:
         ValueError: the body is not symmetric, or ω lies along its axis (ω⊥ = 0).
     """
-    k = _symmetry_axis(body)
+    k = _symmetry_axis(check_body(body, "measure_spin_rate"))
     i, j = (k + 1) % 3, (k + 2) % 3  # (i, j, k) cyclic: the azimuth from e_i towards e_j
     t = _grid(body, t_end)
     w = body.omega(t)

@@ -151,3 +151,53 @@ def wait_readouts(probe: Probe, names, timeout: float = 10.0) -> dict[str, tuple
         probe
     )
     return readout_table(probe)
+
+
+def construction_nodes() -> dict:
+    """The nodes each element of the Poinsot construction creates, read off a bare
+    :class:`PoinsotScene` on a server of its own (so that the scene tests follow whatever
+    nodes the construction draws for an element)."""
+    import viser
+
+    from poinsot.app.elements import Element
+    from poinsot.app.parameters import Parameters
+    from poinsot.app.presets import DEFAULT_PRESET
+    from poinsot.app.scene.construction import PoinsotScene
+
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    try:
+        probe = Probe(server.get_port())
+        scene = PoinsotScene(server.scene, frozenset())
+        scene.load(Parameters.from_preset(DEFAULT_PRESET).build(), DEFAULT_PRESET.solid)
+        base = _settled_names(probe, scene, frozenset())
+        nodes = {}
+        for element in Element:
+            names = _settled_names(probe, scene, frozenset({element}))
+            nodes[element] = {n for n in names - base if not _is_chunk(n)}
+        probe.close()
+        return nodes
+    finally:
+        server.stop()
+
+
+def _is_chunk(name: str) -> bool:
+    tail = name.rsplit("/", 1)[-1]
+    return tail.startswith("c") and tail[1:].isdigit()
+
+
+def _settled_names(probe: Probe, scene, elements) -> set[str]:
+    """Declare ``elements``, draw a frame, and return the node names once they stop changing."""
+    import time
+
+    scene.declare(elements)
+    scene.advance(0.5)
+    scene.flush_trails()
+    previous: set[str] = set()
+    for _ in range(50):
+        time.sleep(0.1)
+        nodes, _ = probe.snapshot()
+        current = set(nodes)
+        if current == previous:
+            return current
+        previous = current
+    return previous

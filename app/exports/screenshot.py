@@ -225,8 +225,9 @@ def headless_chromium(executable: str) -> Iterator[Browser]:
         from playwright.sync_api import sync_playwright
     except ImportError as exc:
         raise BrowserMissing(
-            "the playwright Python package is missing: pip install playwright "
-            "(no `playwright install` needed; it drives the system Chromium)"
+            "the Python package playwright is missing: make install (or pip install "
+            "'poinsot[lecture]') installs it; it drives the system's Chromium, no browser "
+            "download needed"
         ) from exc
     with sync_playwright() as pw:
         browser = pw.chromium.launch(
@@ -399,6 +400,10 @@ def screenshot_command(
             if isinstance(scene, SceneSpec) and view == "default":
                 camera = scene.view
             stage.set_initial_camera(camera)
+            if isinstance(stage, Stage):  # the labels laid out for this camera and window
+                stage.lay_out_labels(
+                    camera, (round(WINDOW_HEIGHT * size[0] / size[1]), WINDOW_HEIGHT)
+                )
             ground = None if background == "transparent" else THEME_BACKGROUND[background == "dark"]
             shot = capture(stage, camera, size, chromium=chromium, background=ground, fit=fit)
         except BrowserMissing as exc:

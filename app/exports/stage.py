@@ -20,8 +20,10 @@ import viser
 from poinsot.app.elements import Element, Solid
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import Preset
+from poinsot.app.scene import palette
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
+from poinsot.app.scene.labels import Camera
 from poinsot.app.scene.view import View, apply_lighting, configure_theme
 
 #: Largest step of simulation time between two trail updates while seeking [time units]. The
@@ -63,6 +65,7 @@ class Stage:
             self.scene = PoinsotScene(
                 self.server.scene, elements, trail_points, atomic=self.server.atomic
             )
+            self.scene.restyle(palette.look(dark_mode))  # the theme's colours, as in the app
             self.frame: Frame = self.scene.load(body, solid, t=0.0)
         except BaseException:
             self.stop()
@@ -115,6 +118,20 @@ class Stage:
         return self.frame
 
     # -- camera --------------------------------------------------------------------------
+    def lay_out_labels(self, view: View, size: tuple[int, int]) -> None:
+        """Place the labels for a picture of ``size`` (width, height) from ``view``."""
+        width, height = size
+        camera = Camera(
+            np.asarray(view.position, float),
+            np.asarray(view.look_at, float),
+            np.asarray(view.up, float),
+            math.radians(view.fov_degrees),
+            float(width),
+            float(height),
+        )
+        with self.server.atomic():
+            self.scene.lay_out_labels(camera)
+
     def set_initial_camera(self, view: View) -> None:
         """The camera every browser opening the stage (or a recording of it) starts with."""
         camera = self.server.initial_camera

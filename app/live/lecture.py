@@ -1,6 +1,7 @@
 """Lecture comfort and exports in one session's panel: screenshot, CSV and GLB downloads, camera
-presets (along L, side, ride-along in the body frame), dark/light theme, projector-sized text
-and keyboard shortcuts.
+views (default, along-L, side, ride-along: the same names as ``poinsot screenshot --view``),
+dark/light theme, large text, the projector mode, the two views (space and body frame) and
+keyboard shortcuts. How the picture looks is :mod:`poinsot.app.live.display`'s.
 
 A session mounts everything with one call, :func:`add_lecture_controls`, and calls
 :meth:`LectureControls.on_frame` after drawing each frame (the ride-along camera follows the
@@ -8,8 +9,8 @@ attitude there).
 
 Keyboard shortcuts use viser 1.1's command palette (``GuiApi.add_command(hotkey=...)``): the
 browser fires them while the page has focus and no text field is being edited. Space
-plays/pauses, 1-4 choose the camera views. The commands are also listed in the palette
-(Ctrl/Cmd+K).
+plays/pauses, 1-4 choose the camera views, P switches the projector mode, V the two views.
+The commands are also listed in the palette (Ctrl/Cmd+K).
 
 Threads: button callbacks run on viser's thread pool. A screenshot waits there for the
 browser's render, bounded by ``render_timeout``; one render at a time per session, and every
@@ -30,21 +31,24 @@ from poinsot.app.exports.glb import scene_glb
 from poinsot.app.exports.run_csv import run_csv, run_span
 from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
 from poinsot.app.live.clock import SimClock
+from poinsot.app.live.display import LARGE_TEXT_PERCENT, Display
+from poinsot.app.live.motion_window import MotionWindow
+from poinsot.app.live.widgets import set_value
 from poinsot.app.presets import Preset
 from poinsot.app.scene.batch import Frame
-from poinsot.app.scene.cameras import BODY_VIEW, CAMERA_LABELS, ride_along, space_view
+from poinsot.app.scene.cameras import BODY_VIEW, CAMERA_NAMES, RIDE_ALONG, ride_along, space_view
 from poinsot.app.scene.construction import PoinsotScene
-from poinsot.app.scene.view import View, configure_theme
+from poinsot.app.scene.view import View
 from poinsot.physics import FreeRigidBody
 
 #: Seconds a screenshot waits for the browser's render. A GPU browser answers a 4K render in
 #: about a second; software WebGL on a loaded machine has been measured at up to 30 s.
 RENDER_TIMEOUT = 60.0
-#: Root font size of the "large text" mode: every panel size is in rem, so all text scales.
-LARGE_TEXT_PERCENT = 130
+__all__ = ["LARGE_TEXT_PERCENT", "LectureControls", "add_lecture_controls"]
+
 #: Order of the lecture folder in the panel (after the session's own groups).
 FOLDER_ORDER = 70.0
-#: Hotkeys of the camera views, in CAMERA_LABELS order.
+#: Hotkeys of the camera views, in CAMERA_NAMES order.
 CAMERA_HOTKEYS: tuple[Literal["1", "2", "3", "4"], ...] = ("1", "2", "3", "4")
 
 
@@ -58,14 +62,14 @@ class LectureSession(Protocol):
     frame: Frame | None
     scene: PoinsotScene
 
+    @property
+    def panel(self) -> HasMotion: ...
+
     def toggle_pause(self) -> None: ...
 
 
-def large_text_css(enabled: bool) -> str:
-    """A style element that scales the page's root font size (empty when disabled)."""
-    if not enabled:
-        return ""
-    return f"<style>html {{ font-size: {LARGE_TEXT_PERCENT}% !important; }}</style>"
+class HasMotion(Protocol):
+    motion: MotionWindow
 
 
 class LectureControls:
@@ -79,8 +83,6 @@ class LectureControls:
         self.session = session
         self.client = session.client
         self.render_timeout = float(render_timeout)
-        self.dark_mode = True
-        self.large_text = False
         self.camera = "default"
         self._render_lock = threading.Lock()
         self.last_download: str = ""  # name of the last file handed to the browser
@@ -90,15 +92,19 @@ class LectureControls:
         self.screenshot.on_click(lambda _: self._discard(self.take_screenshot()))
         self.csv.on_click(lambda _: self._discard(self.download_csv()))
         self.glb.on_click(lambda _: self._discard(self.download_glb()))
+        self.display = Display(session, session.panel.motion, self.style)
         self.dark.on_update(lambda event: self.set_theme(dark=bool(event.target.value)))
         self.large.on_update(lambda event: self.set_theme(large=bool(event.target.value)))
+        self.projector.on_update(lambda e: self.display.request(projector=bool(e.target.value)))
+        self.two_views.on_update(lambda e: self.display.request(two_views=bool(e.target.value)))
         self.commands = self._add_hotkeys(self.client.gui)
 
     def _add_widgets(self, gui: viser.GuiApi) -> None:
         self.views = gui.add_button_group(
             "Camera",
-            list(CAMERA_LABELS.values()),
-            hint="¾ view, along L (top), side, or riding on the body. Keys 1-4.",
+            list(CAMERA_NAMES),
+            hint="The default view, along L (from above), from the side, or riding on the body. "
+            "Keys 1-4; the same names as `poinsot screenshot --view`.",
         )
         self.size = gui.add_dropdown(
             "Picture size",
@@ -121,23 +127,54 @@ class LectureControls:
             hint="For Blender or any glTF viewer.",
         )
         self.dark = gui.add_checkbox("Dark theme", True)
-        self.large = gui.add_checkbox(
-            "Large text (projector)", False, hint="Scales every text of the panel."
+        self.large = gui.add_checkbox("Large text", False, hint="Scales every text of the panel.")
+        self.projector = gui.add_checkbox(
+            "Projector mode",
+            False,
+            hint="Large text, thick lines, high-contrast colours, the panels folded to slim "
+            "strips (click a strip to open it). Key P.",
+        )
+        self.two_views = gui.add_checkbox(
+            "Two views: space | body",
+            False,
+            hint="Beside the construction (space frame: the herpolhode stays on the plane), the "
+            "body frame (the polhode stays on the ellipsoid, ω's tip runs along it). Key V.",
         )
         self.message = gui.add_markdown("")
-        gui.add_markdown("<small>Keys: **space** play/pause · **1-4** camera views</small>")
+        gui.add_markdown(
+            "<small>Keys: **space** play/pause · **1-4** camera views · **P** projector · "
+            "**V** two views</small>"
+        )
         self.style = gui.add_html("")
 
     def _add_hotkeys(self, gui: viser.GuiApi) -> list[viser.CommandHandle]:
-        """Space plays/pauses; 1-4 choose the camera views (also in the command palette)."""
+        """Space plays/pauses; 1-4 choose the camera views; P and V switch the projector mode
+        and the two views (also in the command palette)."""
         play = gui.add_command("Play / pause", hotkey="space", icon=viser.Icon.PLAYER_PLAY)
         play.on_trigger(lambda _: self.session.toggle_pause())
         commands = [play]
-        for key, (name, label) in zip(CAMERA_HOTKEYS, CAMERA_LABELS.items(), strict=True):
-            command = gui.add_command(f"Camera: {label}", hotkey=key, icon=viser.Icon.CAMERA)
+        for key, name in zip(CAMERA_HOTKEYS, CAMERA_NAMES, strict=True):
+            command = gui.add_command(f"Camera: {name}", hotkey=key, icon=viser.Icon.CAMERA)
             command.on_trigger(self._camera_callback(name))
             commands.append(command)
-        return commands
+        projector = gui.add_command("Projector mode", hotkey="P", icon=viser.Icon.DEVICE_TV)
+        projector.on_trigger(self._toggle_callback(self.projector))
+        two = gui.add_command("Two views", hotkey="V", icon=viser.Icon.LAYOUT_COLUMNS)
+        two.on_trigger(self._toggle_callback(self.two_views))
+        return [*commands, projector, two]
+
+    def _toggle_callback(self, box: viser.GuiCheckboxHandle) -> Callable[[object], None]:
+        """Flip ``box`` and ask the display (the box's own callback asks too: no harm)."""
+
+        def toggle(_: object) -> None:
+            on = not box.value
+            set_value(box, on)
+            if box is self.projector:
+                self.display.request(projector=on)
+            else:
+                self.display.request(two_views=on)
+
+        return toggle
 
     def _camera_callback(self, name: str) -> Callable[[object], None]:
         return lambda _: self.set_camera(name)
@@ -152,16 +189,15 @@ class LectureControls:
 
     # -- camera --------------------------------------------------------------------------
     def _on_view(self, event: viser.GuiEvent[viser.GuiButtonGroupHandle]) -> None:
-        for name, label in CAMERA_LABELS.items():
-            if label == event.target.value:
-                self.set_camera(name)
+        if event.target.value in CAMERA_NAMES:
+            self.set_camera(event.target.value)
 
     def set_camera(self, name: str) -> None:
-        """Move this browser's camera to a preset; "body" rides along from now on."""
-        if name not in CAMERA_LABELS:
+        """Move this browser's camera to a view; "ride-along" rides along from now on."""
+        if name not in CAMERA_NAMES:
             raise ValueError(f"no camera view {name!r}")
         self.camera = name
-        if name == "body":
+        if name == RIDE_ALONG:
             frame = self.session.frame
             if frame is not None:
                 self._apply(ride_along(BODY_VIEW, frame.wxyz))
@@ -173,18 +209,23 @@ class LectureControls:
             view.apply(self.client.camera)
 
     def on_frame(self, frame: Frame) -> None:
-        """Per frame (the session's frame thread): carry the ride-along camera."""
-        if self.camera == "body":
+        """Per frame (the session's frame thread): carry the ride-along camera, and the
+        display's work (a style asked for, the body-frame view, the labels' layout)."""
+        if self.camera == RIDE_ALONG:
             self._apply(ride_along(BODY_VIEW, frame.wxyz))
+        self.display.on_frame(frame, time.monotonic())
 
     # -- theme ---------------------------------------------------------------------------
+    @property
+    def dark_mode(self) -> bool:
+        return self.display.wanted.dark
+
     def set_theme(self, dark: bool | None = None, large: bool | None = None) -> None:
+        """Ask for the dark or light theme, or large text (applied by the next frame)."""
         if dark is not None:
-            self.dark_mode = dark
+            self.display.request(dark=dark)
         if large is not None:
-            self.large_text = large
-        configure_theme(self.client.gui, dark_mode=self.dark_mode, large_controls=self.large_text)
-        self.style.content = large_text_css(self.large_text)
+            self.display.request(large_text=large)
 
     # -- exports -------------------------------------------------------------------------
     def _now(self) -> tuple[FreeRigidBody, float, str]:

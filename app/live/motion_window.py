@@ -1,11 +1,13 @@
-"""The floating "Motion" window of a session: the time, the readouts of the motion's constants,
-and the live plot of ω in the body frame.
+"""The left column of a session ("What you see"): the caption and the legend
+(:mod:`poinsot.app.live.legend`), the time, the readouts of the motion's constants, and the live
+plot of ω in the body frame.
 
-It floats at the bottom left of the 3D view, so that a lecture sees the numbers beside the
-scene without scrolling the control panel. The plot exists only while the preset declares it
-(:class:`~poinsot.app.elements.Plot`); the session records a sample and sends the window of the
-last PLOT_SAMPLES at the plot's refresh rate. For an uploaded toss the plot also shows the
-measured ω (:mod:`poinsot.app.live.overlay`).
+It is docked on the left edge and the control panel on the right one, so that neither covers
+the 3D view (which takes the width between them, its picture centred there) and a lecture sees
+the names, colours and numbers beside the scene without scrolling the control panel. The plot
+exists only while the preset declares it (:class:`~poinsot.app.elements.Plot`); the session
+records a sample and sends the window of the last PLOT_SAMPLES at the plot's refresh rate. For
+an uploaded toss the plot also shows the measured ω (:mod:`poinsot.app.live.overlay`).
 """
 
 from __future__ import annotations
@@ -15,13 +17,14 @@ import viser
 import viser.uplot
 
 from poinsot.app.live import readouts
+from poinsot.app.live.legend import Legend
 from poinsot.app.live.overlay import LEGEND, Measured, measured_series, merge
 from poinsot.app.scene import palette
 
 #: Number of plot samples kept (one per plot refresh, 10 per second: the last 30 s).
 PLOT_SAMPLES = 300
-#: Width of the floating window [CSS px].
-WINDOW_WIDTH = 360
+#: Width of the left column [CSS px]: the 3D view keeps about half of a 1280 px screen.
+WINDOW_WIDTH = 300
 
 
 class MotionWindow:
@@ -29,12 +32,18 @@ class MotionWindow:
 
     def __init__(self, gui: viser.GuiApi, order: float) -> None:
         self.gui = gui
-        window = gui.add_panel(order=order)
-        self.tab = window.add_tab("Motion", viser.Icon.CHART_LINE)
+        self.window = window = gui.add_panel(order=order)
+        self.tab = window.add_tab("What you see", viser.Icon.EYE)
         with self.tab:
+            self.legend = Legend(gui, order=-2.0)
             self.time = gui.add_markdown(readouts.time_markdown(0.0, False), order=0.0)
             self.readouts = gui.add_markdown("", order=1.0)
-        window.float(x=16, y=-16, width=WINDOW_WIDTH)
+            #: The text size's style element (:mod:`poinsot.app.live.display`; the control
+            #: panel has one too: a folded column's content, and its style, is not on the page).
+            self.style = gui.add_html("", order=100.0)
+        gui.main_panel.dock_right()
+        window.dock_left()
+        window.set_width(WINDOW_WIDTH)
         self.plot: viser.GuiUplotHandle | None = None
         self._t: list[float] = []
         self._omega: list[np.ndarray] = []

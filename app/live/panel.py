@@ -23,6 +23,7 @@ from typing import Any, Protocol, TypeVar
 import viser
 
 from poinsot.app.elements import Control, Element, Plot
+from poinsot.app.live.legend import caption
 from poinsot.app.live.motion_window import MotionWindow
 from poinsot.app.live.widgets import Removable, Retirement, Shelf, set_marks, set_value
 from poinsot.app.parameters import (
@@ -230,6 +231,7 @@ class ControlPanel:
         if Control.VISIBILITY in self._groups:
             self._show_boxes(elements, visible)
         self._prune_folders()
+        self.motion.legend.show(elements)
         if taken:  # widgets taken back show the values of now
             self.show_parameters(params)
             if self.widgets.speed is not None:
@@ -445,6 +447,7 @@ class ControlPanel:
     def show_preset(self, preset: Preset) -> None:
         set_value(self.preset, preset.label)
         self.source.content = self._source_text(preset)
+        self.motion.legend.show_caption(caption(preset))
 
     @staticmethod
     def _source_text(preset: Preset) -> str:

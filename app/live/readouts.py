@@ -35,9 +35,11 @@ def rows(body: FreeRigidBody) -> list[tuple[str, str]]:
         precession_text = f"{_num(precession)} rad ({math.degrees(precession):.1f}°)"
     else:
         precession_text = "— (no period)"
+    # A sphere has no elliptic motion, so no parameter k² to show (it would read "0").
+    k2 = [] if body.regime is Regime.SPHERE else [("k²", _num(body.parameter, 6))]
     return [
         ("regime", REGIME_TEXT.get(body.regime, str(body.regime))),
-        ("k²", _num(body.parameter, 6)),
+        *k2,
         ("period of ω", _num(body.period)),
         ("precession / period", precession_text),
         ("D = |L|²/2T", _num(body.D, 6)),

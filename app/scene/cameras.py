@@ -1,5 +1,7 @@
-"""Camera presets for lectures: the three-quarter default, the view along L, the side view, and
-the ride-along view fixed in the body frame.
+"""Camera views for lectures: the default view (38 degrees above the invariable plane), the view
+along L, the side view, and the ride-along view fixed in the body frame. One vocabulary: the
+buttons in the browser and ``--view`` on the command line use the same names,
+:data:`CAMERA_NAMES`.
 
 The space-frame views are :data:`poinsot.app.scene.view.VIEWS`. The ride-along view is a
 :class:`View` in *body* coordinates: every frame the attitude R(t) carries its position, look-at
@@ -21,27 +23,32 @@ from poinsot.app.scene.view import DEFAULT_VIEW, VIEWS, View
 #: three-quarter view onto the body's centre with body axis 3 up.
 BODY_VIEW = View(position=(2.7, -3.3, 1.9), look_at=(0.0, 0.0, 0.0), up=(0.0, 0.0, 1.0))
 
-#: Preset name -> button label, in the order the panel shows them.
-CAMERA_LABELS: dict[str, str] = {
-    "default": "¾ view",
-    "top": "Along L",
-    "side": "Side",
-    "body": "Ride along",
-}
-#: Names accepted by ``--view`` and :func:`space_view`.
-CAMERA_NAMES: tuple[str, ...] = tuple(CAMERA_LABELS)
+#: The riding camera's name.
+RIDE_ALONG = "ride-along"
+#: The views' names, in the order of the panel's buttons and the hotkeys 1-4 (``--view`` takes
+#: the same words).
+CAMERA_NAMES: tuple[str, ...] = ("default", "along-L", "side", RIDE_ALONG)
+#: Older names still accepted on the command line.
+ALIASES: dict[str, str] = {"top": "along-L", "body": RIDE_ALONG}
+
+
+def canonical(name: str) -> str:
+    """The view's name in :data:`CAMERA_NAMES` (an older alias is translated)."""
+    name = ALIASES.get(name, name)
+    if name not in CAMERA_NAMES:
+        raise ValueError(f"no camera view {name!r}; choose from {', '.join(CAMERA_NAMES)}")
+    return name
 
 
 def space_view(name: str, attitude_wxyz: np.ndarray | None = None) -> View:
-    """The camera preset ``name`` in space coordinates; ``"body"`` needs the attitude."""
-    if name == "body":
+    """The camera view ``name`` in space coordinates; ``"ride-along"`` needs the attitude."""
+    name = canonical(name)
+    if name == RIDE_ALONG:
         if attitude_wxyz is None:
             raise ValueError("the ride-along view needs the body's attitude")
         return ride_along(BODY_VIEW, attitude_wxyz)
     if name == "default":
         return DEFAULT_VIEW
-    if name not in VIEWS:
-        raise ValueError(f"no camera view {name!r}; choose from {list(CAMERA_NAMES)}")
     return VIEWS[name]
 
 

@@ -34,9 +34,13 @@ import numpy as np
 import viser
 
 from poinsot.app.elements import Element, Solid
+from poinsot.app.scene import palette
 from poinsot.app.scene.batch import Frame, FrameBatch
-from poinsot.app.scene.geometry import Geometry
+from poinsot.app.scene.frames import rotation_from_wxyz
+from poinsot.app.scene.geometry import L_OVERSHOOT, Geometry
+from poinsot.app.scene.labels import Camera, Placement, Pose, lay_out
 from poinsot.app.scene.nodes import Drawing, OmegaArrow, Trace, draw
+from poinsot.app.scene.palette import Look
 from poinsot.app.scene.sampling import FIRST_BATCH, MotionSampler
 from poinsot.app.scene.trail import Trail
 from poinsot.physics import FreeRigidBody
@@ -54,6 +58,12 @@ MAX_SAMPLES_PER_FRAME = 64
 TRAIL_EVERY = 2
 
 ROOT = "/space"
+#: The labels' order of importance: earlier ones choose their place first.
+LABEL_ORDER = (Element.L, Element.OMEGA, Element.AXES, Element.POLHODE, Element.HERPOLHODE)
+#: The contact point's marker as the labels keep clear of it [CSS px].
+MARKER_RADIUS_PX = 9.0
+#: ... and of the omega and L arrows' shafts [CSS px].
+ARROW_HALF_WIDTH_PX = 3.0
 
 
 class PoinsotScene:
@@ -89,6 +99,7 @@ class PoinsotScene:
         # Rows drawn since the last trail flush: (batch, first row, end row, force last row).
         self._pending: list[tuple[FrameBatch, int, int, bool]] = []
         self._frames_since_flush = 0
+        self._look: Look = palette.DARK
         self.space = api.add_frame(root, show_axes=False)
         self.body_frame = api.add_frame(f"{root}/body", show_axes=False)
         self.tip = api.add_frame(f"{root}/tip", show_axes=False)
@@ -142,10 +153,46 @@ class PoinsotScene:
 
     def _create(self, element: Element) -> Drawing:
         drawing = draw(element, self.api, self.root, self._trail_points)
+        if self._look is not palette.DARK:  # drawn in the dark theme's colours
+            drawing.restyle(self._look)
         if element in self._hidden:
             drawing.set_visible(False)
         self._drawings[element] = drawing
         return drawing
+
+    # -- look and labels -------------------------------------------------------------------
+    @property
+    def look(self) -> Look:
+        return self._look
+
+    def restyle(self, look: Look) -> None:
+        """Draw in the colours, widths and label sizes of ``look`` (theme, projector)."""
+        self._look = look
+        for drawing in self._drawings.values():
+            drawing.restyle(look)
+
+    def lay_out_labels(self, camera: Camera) -> dict[str, Placement]:
+        """Place the labels of the shown elements for ``camera`` (see
+        :mod:`poinsot.app.scene.labels`) and send what changed; returns the placements."""
+        frame, geometry = self._frame, self._geometry
+        if frame is None or geometry is None:
+            return {}
+        pose = Pose(rotation_from_wxyz(frame.wxyz), np.asarray(frame.contact), camera)
+        shown = [self._drawings[e] for e in LABEL_ORDER if self.is_visible(e)]
+        slots = [slot for drawing in shown for slot in drawing.slots(pose)]
+        markers = [(pose.contact, MARKER_RADIUS_PX)] if self.is_visible(Element.CONTACT) else []
+        arrows = [
+            (np.zeros(3), end, ARROW_HALF_WIDTH_PX)
+            for element, end in (
+                (Element.OMEGA, pose.contact),
+                (Element.L, np.array([0.0, 0.0, geometry.plane_height + L_OVERSHOOT])),
+            )
+            if self.is_visible(element)
+        ]
+        placements = lay_out(slots, camera, markers, arrows)
+        for drawing in shown:
+            drawing.place(placements)
+        return placements
 
     def _index(self) -> None:
         drawings = self._drawings

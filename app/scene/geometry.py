@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike
 
 from poinsot.app.elements import Solid
 from poinsot.app.scene import meshes
-from poinsot.app.scene.sampling import trace_speed
+from poinsot.app.scene.sampling import survey
 from poinsot.physics import FreeRigidBody, Regime
 
 #: Largest semi-axis of the ellipsoid on screen [display units].
@@ -48,8 +48,11 @@ class ArrowShape:
     head_length: float
 
 
-OMEGA_ARROW = ArrowShape(shaft_radius=0.014, head_radius=0.04, head_length=0.11)
-L_ARROW = ArrowShape(shaft_radius=0.016, head_radius=0.05, head_length=0.14)
+#: omega is the thicker arrow and L the thinner one with the larger head: where they are
+#: parallel (a sphere, a permanent rotation) omega shows round L up to the plane and L goes on
+#: above it, instead of omega hiding inside L.
+OMEGA_ARROW = ArrowShape(shaft_radius=0.024, head_radius=0.05, head_length=0.12)
+L_ARROW = ArrowShape(shaft_radius=0.011, head_radius=0.055, head_length=0.16)
 
 
 class SceneDataError(ValueError):
@@ -84,6 +87,7 @@ class Geometry:
     solid_base: trimesh.Trimesh | None  # the mesh sent for the solid (a unit cube for boxes)
     solid_scale: np.ndarray | None  # node scale (3,) that makes solid_base the displayed solid
     trace_speed: float  # fastest trace point [display units per time unit]
+    herpolhode_radius: float = 0.0  # the herpolhode's largest distance from L's axis
 
     @classmethod
     def from_body(cls, body: FreeRigidBody, solid: Solid | None) -> Geometry:
@@ -102,9 +106,18 @@ class Geometry:
             vertices = np.asarray(mesh.vertices) * shape_scale
             solid_scale = shape_scale * meshes.fit_scale(vertices, semi * scale)
         closed = body.regime is not Regime.SEPARATRIX
-        speed = finite("the trace speed", trace_speed(body, scale))
+        speed, radius = finite("the trace survey", survey(body, scale))
         return cls(
-            scale, semi * scale, h * scale, polhode, closed, key, mesh, solid_scale, float(speed)
+            scale,
+            semi * scale,
+            h * scale,
+            polhode,
+            closed,
+            key,
+            mesh,
+            solid_scale,
+            float(speed),
+            float(radius),
         )
 
     @property

@@ -5,7 +5,9 @@ changes with the body in :meth:`Drawing.fit` (sizes, static curves: once per par
 change), and is shown, hidden or removed as a whole. What changes per frame (the body's pose,
 the contact point, the omega arrow, the traces' increments) is sent by
 :class:`~poinsot.app.scene.construction.PoinsotScene`, through :attr:`OmegaArrow.arrow` and
-:attr:`Trace.trail`.
+:attr:`Trace.trail`. A drawing takes a :class:`~poinsot.app.scene.palette.Look` in
+:meth:`Drawing.restyle` (theme, projector), and offers its labels to the layout
+(:mod:`poinsot.app.scene.labels`) in :meth:`Drawing.slots` and :meth:`Drawing.place`.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from collections.abc import Callable
 
 import numpy as np
 import viser
+from scipy.spatial.transform import Rotation
 
 from poinsot.app.elements import Element
 from poinsot.app.scene import meshes, palette
@@ -29,10 +32,20 @@ from poinsot.app.scene.geometry import (
     Geometry,
     triple,
 )
+from poinsot.app.scene.labels import LabelNode, Placement, Pose, Slot
+from poinsot.app.scene.palette import Look
 from poinsot.app.scene.trail import Trail
 
 #: Radius of the marker at the fixed point (the origin) [display units].
 ORIGIN_RADIUS = 0.03
+#: How far a label's point lies beyond the tip it names [display units].
+BEYOND = 0.05
+#: Screen distance [CSS px] a label keeps from the contact point's marker and from L's head.
+MARKER_CLEARANCE = 14.0
+HEAD_CLEARANCE = 6.0
+#: How far the labels on the body (axes, polhode) may be pushed beyond their tips [CSS px]:
+#: far enough to step round the contact point's marker where the tips crowd together.
+BODY_CLEARANCE = 10.0
 #: An arrow's points before its first fit: along +z, unit length.
 _UNIT_ARROW = np.array([[[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]], np.float32)
 #: A line-segments node's points before its first fit: one degenerate segment.
@@ -48,6 +61,16 @@ class Drawing:
 
     def fit(self, geometry: Geometry) -> None:
         """Send what changes with the body (sizes, static curves); nothing by default."""
+
+    def restyle(self, look: Look) -> None:
+        """Take the colours, widths and label size of ``look``; nothing by default."""
+
+    def slots(self, pose: Pose) -> list[Slot]:
+        """The drawing's labels for the layout (world points at ``pose``); none by default."""
+        return []
+
+    def place(self, placements: dict[str, Placement]) -> None:
+        """Send what the layout chose for the drawing's labels; nothing by default."""
 
     def set_visible(self, visible: bool) -> None:
         self.visible = visible
@@ -83,6 +106,9 @@ class Ellipsoid(Drawing):
     def fit(self, geometry: Geometry) -> None:
         self.mesh.scale = triple(geometry.semi_axes)
 
+    def restyle(self, look: Look) -> None:
+        self.mesh.color, self.mesh.opacity = look.ellipsoid, look.ellipsoid_opacity
+
 
 class PrincipalAxes(Drawing):
     """The three principal axes, their labels 1, 2, 3, and the fixed point."""
@@ -104,21 +130,49 @@ class PrincipalAxes(Drawing):
             api.add_label(
                 f"{root}/body/axis{i + 1}/label",
                 f"{i + 1}",
-                anchor="center-center",
+                anchor="bottom-left",
                 font_screen_scale=1.3,
             )
             for i in range(3)
         ]
-        origin = api.add_icosphere(
+        self.nodes = [
+            LabelNode(h, f"axis{i + 1}", f"{i + 1}", 1.3) for i, h in enumerate(self.labels)
+        ]
+        self.origin = api.add_icosphere(
             f"{root}/origin", radius=ORIGIN_RADIUS, color=palette.ORIGIN, cast_shadow=False
         )
-        super().__init__([*self.lines, *self.labels, origin])
+        self.ends = np.zeros((3, 3))
+        self._rotation: Rotation | None = None  # the body's attitude at the last layout
+        super().__init__([*self.lines, *self.labels, self.origin])
 
     def fit(self, geometry: Geometry) -> None:
-        ends = geometry.axis_ends()
-        for line, label, end in zip(self.lines, self.labels, ends, strict=True):
+        self.ends = geometry.axis_ends()
+        for line, node, end in zip(self.lines, self.nodes, self.ends, strict=True):
             line.points = np.array([[-end, end]], dtype=np.float32)
-            label.position = end * 1.08
+            node.position = end * (1.0 + BEYOND)  # beyond the axis's tip, on the axis
+            node.handle.position = node.position
+
+    def restyle(self, look: Look) -> None:
+        for line, color in zip(self.lines, look.axes, strict=True):
+            line.colors = np.array(color, dtype=np.uint8)
+            line.thickness = look.axis_width
+        for node in self.nodes:
+            node.restyle(look.label_scale)
+        self.origin.color = look.origin
+
+    def slots(self, pose: Pose) -> list[Slot]:
+        self._rotation = pose.rotation
+        tips = pose.rotation.apply(self.ends)
+        return [
+            node.slot(
+                tip * (1.0 + BEYOND), tip, np.zeros(3), movable=True, clearance=BODY_CLEARANCE
+            )
+            for node, tip in zip(self.nodes, tips, strict=True)
+        ]
+
+    def place(self, placements: dict[str, Placement]) -> None:
+        for node, end in zip(self.nodes, self.ends, strict=True):
+            node.place(placements.get(node.key), end * (1.0 + BEYOND), self._rotation)
 
 
 class InvariablePlane(Drawing):
@@ -137,14 +191,15 @@ class InvariablePlane(Drawing):
             cast_shadow=False,
             receive_shadow=False,
         )
-        grid = api.add_line_segments(
+        self.disc = disc
+        self.grid = grid = api.add_line_segments(
             f"{root}/plane/grid",
             meshes.disc_grid_segments(PLANE_RADIUS, GRID_SPACING),
             palette.PLANE_GRID,
             thickness=palette.GRID_WIDTH_PX,
             thickness_units="screen",
         )
-        rim = api.add_line_segments(
+        self.rim = rim = api.add_line_segments(
             f"{root}/plane/rim",
             meshes.circle_segments(PLANE_RADIUS),
             palette.PLANE_RIM,
@@ -156,15 +211,25 @@ class InvariablePlane(Drawing):
     def fit(self, geometry: Geometry) -> None:
         self.frame.position = (0.0, 0.0, geometry.plane_height)
 
+    def restyle(self, look: Look) -> None:
+        self.disc.color, self.disc.opacity = look.plane, look.plane_opacity
+        self.grid.colors = np.array(look.plane_grid, dtype=np.uint8)
+        self.grid.thickness = look.grid_width
+        self.rim.colors = np.array(look.plane_rim, dtype=np.uint8)
+        self.rim.thickness = look.rim_width
+
 
 class ContactPoint(Drawing):
     """A marker at the contact point; it rides on the scene's tip frame (no message of its own)."""
 
     def __init__(self, api: viser.SceneApi, root: str) -> None:
-        marker = api.add_icosphere(
+        self.marker = api.add_icosphere(
             f"{root}/tip/contact", radius=CONTACT_RADIUS, color=palette.CONTACT, cast_shadow=False
         )
-        super().__init__([marker])
+        super().__init__([self.marker])
+
+    def restyle(self, look: Look) -> None:
+        self.marker.color = look.contact
 
 
 class OmegaArrow(Drawing):
@@ -179,15 +244,34 @@ class OmegaArrow(Drawing):
             head_radius=OMEGA_ARROW.head_radius,
             head_length=OMEGA_ARROW.head_length,
         )
-        # The label rides on the tip frame, posed at the contact point: no message of its own.
+        # The label rides on the tip frame, posed at the contact point: its own messages only
+        # when the layout moves it (beyond the tip, clear of the contact point's marker).
         label = api.add_label(
             f"{root}/tip/omega_label",
             "ω",
-            anchor="bottom-right",
+            anchor="bottom-left",
             font_screen_scale=1.4,
-            position=(-0.03, 0.0, -0.04),
+            position=(0.0, 0.0, BEYOND),
         )
+        self.node = LabelNode(label, "omega", "ω", 1.4)
+        self._beyond = np.array([0.0, 0.0, BEYOND])
         super().__init__([self.arrow, label])
+
+    def restyle(self, look: Look) -> None:
+        self.arrow.colors = np.array(look.omega, dtype=np.uint8)
+        self.node.restyle(look.label_scale)
+
+    def slots(self, pose: Pose) -> list[Slot]:
+        tip = np.asarray(pose.contact, float)
+        norm = float(np.linalg.norm(tip))
+        self._beyond = BEYOND * tip / norm if norm > 0 else np.array([0.0, 0.0, BEYOND])
+        slot = self.node.slot(
+            tip + self._beyond, tip, np.zeros(3), movable=True, clearance=MARKER_CLEARANCE
+        )
+        return [slot]
+
+    def place(self, placements: dict[str, Placement]) -> None:
+        self.node.place(placements.get("omega"), self._beyond)
 
 
 class MomentumArrow(Drawing):
@@ -203,14 +287,29 @@ class MomentumArrow(Drawing):
             head_length=L_ARROW.head_length,
         )
         self.label = api.add_label(
-            f"{root}/L_label", "L", anchor="bottom-left", font_screen_scale=1.4
+            f"{root}/L_label", "L", anchor="bottom-center", font_screen_scale=1.4
         )
+        self.node = LabelNode(self.label, "L", "L", 1.4)
+        self.top = 1.0
         super().__init__([self.arrow, self.label])
 
     def fit(self, geometry: Geometry) -> None:
-        top = geometry.plane_height + L_OVERSHOOT
+        self.top = top = geometry.plane_height + L_OVERSHOOT
         self.arrow.points = np.array([[[0.0, 0.0, 0.0], [0.0, 0.0, top]]], np.float32)
-        self.label.position = (0.04, 0.0, top - 0.05)
+        self.node.position = np.array([0.0, 0.0, top + BEYOND])
+        self.label.position = self.node.position  # beyond the tip, on the axis
+
+    def restyle(self, look: Look) -> None:
+        self.arrow.colors = np.array(look.angular_momentum, dtype=np.uint8)
+        self.node.restyle(look.label_scale)
+
+    def slots(self, pose: Pose) -> list[Slot]:
+        tip = np.array([0.0, 0.0, self.top])
+        point = tip + (0.0, 0.0, BEYOND)
+        return [self.node.slot(point, tip, np.zeros(3), movable=True, clearance=HEAD_CLEARANCE)]
+
+    def place(self, placements: dict[str, Placement]) -> None:
+        self.node.place(placements.get("L"), np.array([0.0, 0.0, self.top + BEYOND]))
 
 
 class FullPolhode(Drawing):
@@ -230,6 +329,10 @@ class FullPolhode(Drawing):
     def fit(self, geometry: Geometry) -> None:
         self.curve.points = geometry.polhode_segments()
 
+    def restyle(self, look: Look) -> None:
+        self.curve.colors = np.array(look.polhode_full, dtype=np.uint8)
+        self.curve.thickness = look.full_polhode_width
+
 
 class SolidBody(Drawing):
     """The solid inside the ellipsoid. Its mesh changes with the body, so it is made in
@@ -239,7 +342,13 @@ class SolidBody(Drawing):
         super().__init__()
         self._api, self._name = api, f"{root}/body/solid"
         self._key: tuple | None = None
+        self._color = palette.SOLID
         self.mesh: viser.MeshHandle | None = None
+
+    def restyle(self, look: Look) -> None:
+        self._color = look.solid
+        if self.mesh is not None:
+            self.mesh.color = look.solid
 
     def fit(self, geometry: Geometry) -> None:
         if self.mesh is not None and (
@@ -253,7 +362,7 @@ class SolidBody(Drawing):
                 self._name,
                 geometry.solid_base.vertices,
                 geometry.solid_base.faces,
-                color=palette.SOLID,
+                color=self._color,
                 material="standard",
                 flat_shading=True,
                 cast_shadow=False,
@@ -270,45 +379,116 @@ class SolidBody(Drawing):
 
 
 class Trace(Drawing):
-    """A live trace (polhode or herpolhode): a :class:`Trail` the scene extends per frame."""
+    """A live trace (polhode or herpolhode): a :class:`Trail` the scene extends per frame, and
+    the label that names it."""
 
-    def __init__(self, trail: Trail) -> None:
-        super().__init__()
-        self.trail = trail
+    def __init__(self, trail: Trail, label: viser.LabelHandle, element: Element) -> None:
+        super().__init__([label])
+        self.trail, self.element = trail, element
+        self.node = LabelNode(label, element.value, label.text, LABEL_SCALE)
+        self.point = np.zeros(3)  # the named point: on the polhode (body), on the ring (space)
+        self.ring = (0.0, 0.0)  # herpolhode: the radius of its ring and the plane's height
+        self._base = np.zeros(3)  # herpolhode: the label's point before the layout's push
+        self._rotation: Rotation | None = None  # polhode: the body's attitude at the layout
+
+    def fit(self, geometry: Geometry) -> None:
+        if self.element is Element.POLHODE:  # a point of the curve, on the body
+            self.point = geometry.polhode[int(np.argmax(geometry.polhode[:, 0]))]
+            radius = float(np.linalg.norm(self.point))
+            outward = self.point / radius if radius > 0 else np.zeros(3)
+            self.node.position = self.point * POLHODE_INFLATE + BEYOND * outward
+            self.node.handle.position = self.node.position
+        else:  # the ring's near side in the default view, until the layout turns it
+            self.ring = (geometry.herpolhode_radius, geometry.plane_height)
+            self.node.position = self._on_ring(np.array([0.93, 0.37]), BEYOND)
+            self.node.handle.position = self.node.position
+
+    def _on_ring(self, direction: np.ndarray, beyond: float = 0.0) -> np.ndarray:
+        radius, height = self.ring
+        return np.array([*((radius + beyond) * direction), height + HERPOLHODE_LIFT])
+
+    def restyle(self, look: Look) -> None:
+        polhode = self.element is Element.POLHODE
+        self.trail.restyle(look.polhode if polhode else look.herpolhode, look.trace_width)
+        self.node.restyle(look.label_scale)
+
+    def slots(self, pose: Pose) -> list[Slot]:
+        if self.element is Element.POLHODE:
+            self._rotation = pose.rotation
+            tip = pose.rotation.apply(self.point)
+            radius = float(np.linalg.norm(tip))
+            point = tip * (1.0 + BEYOND / radius) if radius > 0 else tip
+            return [self.node.slot(point, tip, np.zeros(3), movable=True, clearance=BODY_CLEARANCE)]
+        toward = _screen_right(pose)
+        tip, centre = self._on_ring(toward), np.array([0.0, 0.0, self.ring[1]])
+        self._base = self._on_ring(toward, BEYOND)
+        return [self.node.slot(self._base, tip, centre, movable=True, clearance=HEAD_CLEARANCE)]
+
+    def place(self, placements: dict[str, Placement]) -> None:
+        placement = placements.get(self.node.key)
+        if self.element is Element.POLHODE:
+            radius = float(np.linalg.norm(self.point))
+            base = self.point * (POLHODE_INFLATE + BEYOND / radius) if radius > 0 else self.point
+            self.node.place(placement, base, self._rotation)
+        else:
+            self.node.place(placement, self._base)
 
     def set_visible(self, visible: bool) -> None:
-        self.visible = visible
+        super().set_visible(visible)
         self.trail.visible = visible
 
     def remove(self) -> None:
+        super().remove()
         self.trail.clear()
         self.trail.group.remove()
+
+
+def _screen_right(pose: Pose) -> np.ndarray:
+    """The direction in the plane (x, y) that points right on the screen (the herpolhode's
+    label goes on that side of its ring: below it on screen runs ω's arrow)."""
+    _, right, _ = pose.camera.axes()
+    norm = float(np.linalg.norm(right[:2]))
+    return right[:2] / norm if norm > 1e-6 else np.array([1.0, 0.0])
+
+
+#: Font scale of the curves' labels.
+LABEL_SCALE = 1.1
 
 
 def draw(element: Element, api: viser.SceneApi, root: str, trail_points: int) -> Drawing:
     """Create the nodes of ``element`` under the scene root ``root``."""
     if element is Element.POLHODE:
-        return Trace(
-            Trail(
-                api,
-                f"{root}/body/polhode",
-                palette.POLHODE,
-                palette.TRACE_WIDTH_PX,
-                trail_points,
-                scale=POLHODE_INFLATE,
-            )
+        trail = Trail(
+            api,
+            f"{root}/body/polhode",
+            palette.POLHODE,
+            palette.TRACE_WIDTH_PX,
+            trail_points,
+            scale=POLHODE_INFLATE,
         )
+        label = api.add_label(
+            f"{root}/body/polhode_label",
+            "polhode",
+            anchor="top-left",
+            font_screen_scale=LABEL_SCALE,
+        )
+        return Trace(trail, label, element)
     if element is Element.HERPOLHODE:
-        return Trace(
-            Trail(
-                api,
-                f"{root}/herpolhode",
-                palette.HERPOLHODE,
-                palette.TRACE_WIDTH_PX,
-                trail_points,
-                position=(0.0, 0.0, HERPOLHODE_LIFT),
-            )
+        trail = Trail(
+            api,
+            f"{root}/herpolhode",
+            palette.HERPOLHODE,
+            palette.TRACE_WIDTH_PX,
+            trail_points,
+            position=(0.0, 0.0, HERPOLHODE_LIFT),
         )
+        label = api.add_label(
+            f"{root}/herpolhode_label",
+            "herpolhode",
+            anchor="center-left",
+            font_screen_scale=LABEL_SCALE,
+        )
+        return Trace(trail, label, element)
     return _DRAWINGS[element](api, root)
 
 

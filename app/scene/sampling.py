@@ -53,9 +53,16 @@ def evaluate(body: FreeRigidBody, t: np.ndarray) -> tuple[np.ndarray, np.ndarray
 def trace_speed(body: FreeRigidBody, scale: float) -> float:
     """Largest speed [display units per time unit] of the polhode and herpolhode points over one
     period (or, without a period, over ten turns), measured on the exact solution."""
+    return survey(body, scale)[0]
+
+
+def survey(body: FreeRigidBody, scale: float) -> tuple[float, float]:
+    """The traces' largest speed (see :func:`trace_speed`) and the herpolhode's largest distance
+    from L's axis [display units], from one survey of a period of the exact solution (the
+    distance varies with |ω|, whose period it is)."""
     norm = float(np.linalg.norm(body.omega0))
     if norm == 0.0:
-        return 0.0
+        return 0.0, 0.0
     span = body.period if math.isfinite(body.period) else 20.0 * math.pi / norm
     t = np.linspace(0.0, span, SURVEY_SAMPLES + 1)
     omega, _, contact = evaluate(body, t)
@@ -64,7 +71,9 @@ def trace_speed(body: FreeRigidBody, scale: float) -> float:
         float(np.max(np.linalg.norm(np.diff(omega, axis=0), axis=1))),
         float(np.max(np.linalg.norm(np.diff(contact, axis=0), axis=1))),
     )
-    return 1.2 * scale * chords / dt  # margin: the survey's own chords are under-estimates
+    radius = float(np.max(np.hypot(contact[:, 0], contact[:, 1])))
+    # margin: the survey's own chords are under-estimates
+    return 1.2 * scale * chords / dt, scale * radius
 
 
 class MotionSampler:

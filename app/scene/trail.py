@@ -99,6 +99,15 @@ class Trail:
         self._n = 0
         self._last = None
 
+    def restyle(self, color: tuple[int, int, int], width_px: float) -> None:
+        """New colour and width, for the pieces drawn already and those to come."""
+        self._color = np.asarray(color, dtype=np.uint8)
+        self._width = float(width_px)
+        handles = [h for h, _ in self._frozen] + ([self._head] if self._head is not None else [])
+        for handle in handles:
+            handle.colors = self._color
+            handle.thickness = self._width
+
     def lift(self) -> None:
         """Lift the pen: the next :meth:`append` starts a new piece of the polyline, joined to
         nothing drawn before (after a gap in time, never a straight chord across it)."""

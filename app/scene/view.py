@@ -25,12 +25,15 @@ class View:
         camera.fov = self.fov_degrees * 3.141592653589793 / 180.0
 
 
-#: Slightly above the plane, three-quarter view: the ellipsoid under the plane, the plane's
-#: herpolhode and the L arrow all in frame on a 16:9 projector.
-DEFAULT_VIEW = View(position=(2.55, -3.1, 1.55), look_at=(0.0, 0.0, 0.22))
+#: From 38 degrees above the invariable plane (a grazing view squashed the herpolhode into a
+#: sliver): the herpolhode's ring reads as a ring, the polhode is seen on the ellipsoid's cap
+#: through the translucent plane, and the whole rolling ellipsoid and the L arrow are in frame
+#: in the 3D view between the two docked columns, at 1280 x 800 as at 1920 x 1080. The
+#: camera looks mostly along +y, so that body axis 1 and the x direction run across the view.
+DEFAULT_VIEW = View(position=(1.06, -2.63, 2.42), look_at=(0.0, 0.0, 0.2))
 VIEWS: dict[str, View] = {
     "default": DEFAULT_VIEW,
-    "top": View(position=(0.0, -0.01, 6.0), look_at=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0)),
+    "along-L": View(position=(0.0, -0.01, 5.4), look_at=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0)),
     "side": View(position=(0.0, -5.6, 0.9), look_at=(0.0, 0.0, 0.3)),
 }
 

@@ -189,7 +189,13 @@ def _kind(regime: Regime) -> str:
 
 
 def build(settings: Settings) -> SinkModel:
-    kappa = float(settings["kappa"])
+    return sink_model(float(settings["kappa"]))
+
+
+@functools.lru_cache(maxsize=len(KAPPAS))
+def sink_model(kappa: float) -> SinkModel:
+    """The model for one κ, built once per server (the energy sink's windows take a good part
+    of a second; every browser that picks that κ shares the same read-only model)."""
     J = moments()
     w0 = SPIN * np.array([math.cos(TILT), 0.6 * math.sin(TILT), 0.8 * math.sin(TILT)])
     crossing = EnergySink(J, w0, kappa, 1.0).crossing_time  # the law only: one window

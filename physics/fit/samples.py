@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics import FreeRigidBody
+from poinsot.physics.validation import real_array
 
 #: Fewest samples a fit accepts: 5 to 11 parameters need several times as many data.
 MIN_SAMPLES = 20
@@ -31,11 +32,8 @@ def check_samples(
     Checks the shapes ``(N,)`` and ``(N, 3)``, at least :data:`MIN_SAMPLES` rows, finite values,
     strictly increasing times and a body that turns (median |ω| at least :data:`MIN_RATE`).
     """
-    try:
-        t_arr = np.asarray(t, dtype=float)
-        w_arr = np.asarray(omega, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"t and omega must be arrays of numbers ({exc})") from None
+    t_arr = real_array(t, "t", "an array of times in seconds")
+    w_arr = real_array(omega, "omega", "an array of angular velocities in rad/s")
     if t_arr.ndim != 1:
         raise ValueError(f"t must be a 1-D array of N times in seconds; got shape {t_arr.shape}")
     if w_arr.ndim != 2 or w_arr.shape[1] != 3:

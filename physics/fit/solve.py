@@ -32,6 +32,7 @@ from poinsot.physics.fit.samples import (
     smooth,
 )
 from poinsot.physics.fit.start import Start, euler_estimate, family_starts
+from poinsot.physics.validation import check_flag
 
 #: ω must vary by at least this fraction of |ω| during the segment: a steady spin about one
 #: principal axis reveals nothing of the moments.
@@ -189,7 +190,9 @@ def fit_angular_velocity(
     Raises:
         ValueError: wrong shapes, too few samples, NaN or infinite values, times that do not
             increase, a body that hardly turns, or a ω that stays constant (a steady spin about
-            a principal axis, which does not reveal the moments).
+            a principal axis, which does not reveal the moments); also (as
+            :class:`~poinsot.physics.validation.InputTypeError`) values that are not real
+            numbers, or flags that are not True or False.
 
     Method: Euler's equations, linear in the moments once ω and dω/dt are smoothed out of the
     data, give a first estimate (:mod:`poinsot.physics.fit.start`); nonlinear least squares
@@ -197,6 +200,8 @@ def fit_angular_velocity(
     other assignment of the moments to the axes in both families. The candidates whose
     components change sign where the data's do are preferred, the smallest residual wins.
     """
+    fit_rotation = check_flag(fit_rotation, "fit_rotation")
+    fit_bias = check_flag(fit_bias, "fit_bias")
     problem = _problem(t, omega, fit_rotation, fit_bias)
     inertia0, matrix0 = euler_estimate(
         problem.smoothed.value, problem.smoothed.derivative, fit_rotation

@@ -10,8 +10,9 @@ import numpy as np
 from scipy.integrate import DOP853, RK45, OdeSolver
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics.integrators.registry import validated
+from poinsot.physics.integrators.registry import MAX_STEPS, Scaled, validated
 from poinsot.physics.integrators.runge_kutta import euler_quaternion_rhs, scipy_atol
+from poinsot.physics.validation import check_count, check_number
 
 __all__ = ["Propagation", "State"]
 
@@ -73,24 +74,35 @@ class Propagation:
         integrator, inertia, omega0, attitude0, value = validated(
             method, inertia, omega0, attitude0, setting
         )
-        if not math.isfinite(t0):
-            raise ValueError(f"t0 must be finite, got {t0!r}")
-        self.integrator, self.setting, self.t0 = integrator, value, float(t0)
-        self._inertia = inertia
-        self._omega, self._attitude = omega0.copy(), attitude0
+        t0 = check_number(t0, "t0")
+        self.integrator, self.setting, self.t0 = integrator, value, t0
+        # The run is carried in the scaled units of the registry (exact powers of two).
+        self._units = units = Scaled.of(integrator, inertia, omega0)
+        self._h = units.setting(integrator, value)
+        if not (math.isfinite(self._h) and self._h > 0.0):
+            raise ValueError(
+                f"the step {value:g} leaves the double-precision range in the units of this "
+                "motion (ω0 in your units times the step): use a step closer to 1/|ω0|"
+            )
+        self._inertia = units.inertia
+        self._omega, self._attitude = units.omega0.copy(), attitude0
         self._steps = 0  # fixed-step: grid steps taken, the carried state is at t0 + steps h
         self._cost = 0
         self._stepper: OdeSolver | None = None
         self._dense: Callable[[float], np.ndarray] | None = None
         if integrator.kind == "adaptive":
-            self._stepper = _SCIPY_STEPPERS[method](
-                euler_quaternion_rhs(inertia),
-                self.t0,
-                np.concatenate((omega0, attitude0.as_quat())),
-                t_bound=math.inf,
-                rtol=value,
-                atol=scipy_atol(omega0, value),
-            )
+            tau0 = float(units.time(np.array(t0)))
+            if not math.isfinite(tau0):
+                raise ValueError(f"t0 = {t0:g} is too far for this motion in double precision")
+            with np.errstate(all="ignore"):
+                self._stepper = _SCIPY_STEPPERS[method](
+                    euler_quaternion_rhs(units.inertia),
+                    tau0,
+                    np.concatenate((units.omega0, attitude0.as_quat())),
+                    t_bound=math.inf,
+                    rtol=value,
+                    atol=scipy_atol(units.omega0, value),
+                )
 
     @property
     def method(self) -> str:
@@ -100,8 +112,11 @@ class Propagation:
     def t(self) -> float:
         """Time of the carried state: the last step's end (adaptive), the grid time (fixed)."""
         if self._stepper is not None:
-            return float(self._stepper.t)
+            return self._caller_time(float(self._stepper.t))
         return self.t0 + self._steps * self.setting
+
+    def _caller_time(self, tau: float) -> float:
+        return math.ldexp(tau, -self._units.w_exp)
 
     @property
     def cost(self) -> int:
@@ -111,11 +126,9 @@ class Propagation:
         """The solution at time ``t``, or at the furthest time reached when ``max_cost``
         (RHS evaluations or steps in this call) runs out first. ``t`` may not lie before the
         start of the last step taken (ValueError): the past is not kept."""
-        t = float(t)
-        if not math.isfinite(t):
-            raise ValueError(f"t must be finite, got {t!r}")
-        if max_cost is not None and max_cost < 1:
-            raise ValueError(f"max_cost must be at least 1, got {max_cost!r}")
+        t = check_number(t, "t")
+        if max_cost is not None:
+            max_cost = check_count(max_cost, "max_cost", 1, 1 << 62)
         if self._stepper is not None:
             return self._advance_adaptive(t, max_cost)
         return self._advance_fixed(t, max_cost)
@@ -123,46 +136,59 @@ class Propagation:
     def _advance_adaptive(self, t: float, max_cost: int | None) -> State:
         stepper = self._stepper
         assert stepper is not None
-        start = self.t0 if self._dense is None else float(stepper.t_old)
+        start = self.t0 if self._dense is None else self._caller_time(float(stepper.t_old))
         if t < start:
             raise ValueError(f"t = {t:g} lies before this propagation's last step ({start:g})")
+        tau = float(self._units.time(np.array(t)))
+        self._units.check_cost(self.integrator, tau - float(stepper.t), 0.0, 0)
         nfev0 = stepper.nfev
         stepped = False
-        while stepper.t < t and (max_cost is None or stepper.nfev - nfev0 < max_cost):
-            message = stepper.step()
-            if stepper.status == "failed":
-                raise RuntimeError(f"{self.method} failed: {message}")
-            stepped = True
-        if stepped:
-            self._dense = stepper.dense_output()
+        with np.errstate(all="ignore"):  # a run that leaves the range is refused below
+            while stepper.t < tau and (max_cost is None or stepper.nfev - nfev0 < max_cost):
+                message = stepper.step()
+                if stepper.status == "failed":
+                    raise ValueError(f"{self.method} failed ({message}): use a smaller tolerance")
+                stepped = True
+            if stepped:
+                self._dense = stepper.dense_output()
         self._cost = int(stepper.nfev)
-        reached = min(t, float(stepper.t))
+        reached = min(tau, float(stepper.t))
         if reached == stepper.t or self._dense is None:
             y = np.asarray(stepper.y, dtype=float)
         else:
             y = np.asarray(self._dense(reached), dtype=float)
+        if not np.all(np.isfinite(y)):
+            raise ValueError(f"{self.method} diverged: use a smaller tolerance")
         # The quaternion's norm drifts like any other error; from_quat normalises it.
-        return State(reached, y[:3].copy(), Rotation.from_quat(y[3:]), self._cost)
+        when = t if reached == tau else self._caller_time(reached)
+        return State(when, self._units.omega(y[:3]), Rotation.from_quat(y[3:]), self._cost)
 
     def _advance_fixed(self, t: float, max_cost: int | None) -> State:
         h, grid = self.setting, self.t
         if t < grid - _GRID_SLACK * h:
             raise ValueError(f"t = {t:g} lies before this propagation's grid time {grid:g}")
-        whole = max(int(math.floor((t - grid) / h + _GRID_SLACK)), 0)
-        if max_cost is not None and whole >= max_cost:
+        steps = (t - grid) / h + _GRID_SLACK
+        if max_cost is not None and not steps < max_cost:
             whole, rest = max_cost, 0.0
         else:
+            whole = max(int(math.floor(steps)), 0) if math.isfinite(steps) else MAX_STEPS + 1
             rest = max(t - (grid + whole * h), 0.0)
+        if whole > MAX_STEPS:
+            raise ValueError(
+                f"t = {t:g} lies {steps:.3g} steps of {h:g} ahead, more than {MAX_STEPS:,} in one "
+                "call: advance in smaller pieces or give max_cost"
+            )
         if whole == 0 and rest == 0.0:
-            return State(grid, self._omega.copy(), self._attitude, self._cost)
+            return State(grid, self._units.omega(self._omega), self._attitude, self._cost)
         # Two outputs from the carried grid state: after ``whole`` steps of exactly h (the new
-        # grid state) and one shorter step further (the requested time, not carried).
-        run = self.integrator.run(
-            self._inertia, self._omega, self._attitude, np.array([whole * h, whole * h + rest]), h
-        )
+        # grid state) and one shorter step further (the requested time, not carried). In the
+        # scaled units: h and the times times 2^w, exactly.
+        hs, rest_s = self._h, float(self._units.time(np.array(rest)))
+        times = np.array([whole * hs, whole * hs + rest_s])
+        run = self.integrator.run(self._inertia, self._omega, self._attitude, times, hs)
         self._omega, self._attitude = run.omega[0].copy(), run.attitude[0]
         self._steps += whole
         self._cost += whole
         if rest == 0.0:
-            return State(self.t, self._omega.copy(), self._attitude, self._cost)
-        return State(t, run.omega[1].copy(), run.attitude[1], self._cost + 1)
+            return State(self.t, self._units.omega(self._omega), self._attitude, self._cost)
+        return State(t, self._units.omega(run.omega[1]), run.attitude[1], self._cost + 1)

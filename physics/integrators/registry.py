@@ -1,8 +1,18 @@
-"""The registry of numerical methods and the one entry point, :func:`integrate`."""
+"""The registry of numerical methods and the one entry point, :func:`integrate`.
+
+Every method runs in units where the largest moment and the largest ``|ω0|`` component are
+powers of two near 1 (:class:`Scaled`): exact scalings, so that ω ~ 1e200 (whose products
+ω_j ω_k would overflow) or ~1e-200 (which would underflow) stays in range. The fixed-step
+methods take the same steps bit for bit in any units. scipy's first step of the adaptive
+pairs mixes the scales of ω and of its derivative, so their time is rescaled only where it
+must be (``|ω0|`` outside ``[1e-100, 1e100]``): elsewhere they run exactly as in the caller's
+units.
+"""
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -11,8 +21,25 @@ from poinsot.physics.integrators.interface import Integrator, Trajectory
 from poinsot.physics.integrators.midpoint import run_midpoint
 from poinsot.physics.integrators.runge_kutta import run_scipy
 from poinsot.physics.integrators.splitting import run_splitting
+from poinsot.physics.validation import (
+    InputTypeError,
+    check_attitude,
+    check_inertia,
+    check_moment_span,
+    check_positive,
+    check_time_array,
+    check_vector,
+)
 
-__all__ = ["INTEGRATORS", "integrate", "validated"]
+__all__ = ["INTEGRATORS", "Scaled", "integrate", "validated"]
+
+#: The most steps a fixed-step run may take (the report's longest run takes ~10⁷).
+MAX_STEPS = 50_000_000
+#: The most radians of the fastest rotation an adaptive run may cover (a few steps each).
+MAX_RADIANS = 1e8
+#: scipy raises a smaller relative tolerance to 100 eps with a warning; above the largest the
+#: steps are so long that the solution may run off to infinity.
+MIN_RTOL, MAX_RTOL = 100.0 * float(np.finfo(float).eps), 1e-2
 
 INTEGRATORS: dict[str, Integrator] = {
     "RK45": Integrator(
@@ -92,12 +119,16 @@ def integrate(
     integrator, inertia, omega0, attitude0, value = validated(
         method, inertia, omega0, attitude0, setting
     )
-    t_eval = np.atleast_1d(np.asarray(t_eval, dtype=float))
-    if t_eval.ndim != 1 or len(t_eval) == 0 or not np.all(np.isfinite(t_eval)):
+    t_eval = check_time_array(t_eval, "t_eval")
+    if t_eval.size == 0:
         raise ValueError("t_eval must be a non-empty 1-D array of finite times")
-    if t_eval[0] < 0.0 or np.any(np.diff(t_eval) < 0.0):
+    if t_eval[0] < 0.0 or np.any(t_eval[1:] < t_eval[:-1]):
         raise ValueError("t_eval must be non-negative and non-decreasing")
-    return integrator.run(inertia, omega0, attitude0, t_eval, value)
+    units = Scaled.of(integrator, inertia, omega0)
+    tau, h = units.time(t_eval), units.setting(integrator, value)
+    units.check_cost(integrator, float(tau[-1]) if tau.size else 0.0, h, tau.size)
+    run = integrator.run(units.inertia, units.omega0, attitude0, tau, h)
+    return Trajectory(units.omega(run.omega), run.attitude, run.cost)
 
 
 def validated(
@@ -108,20 +139,93 @@ def validated(
     setting: float | None,
 ) -> tuple[Integrator, np.ndarray, np.ndarray, Rotation, float]:
     """The checks shared by :func:`integrate` and :class:`Propagation` (readable ValueErrors)."""
+    if not isinstance(method, str):
+        raise InputTypeError(f"method must be a name, one of {sorted(INTEGRATORS)}; got {method!r}")
     if method not in INTEGRATORS:
         raise ValueError(f"unknown method {method!r}; choose one of {sorted(INTEGRATORS)}")
     integrator = INTEGRATORS[method]
-    inertia = np.asarray(inertia, dtype=float)
-    omega0 = np.asarray(omega0, dtype=float)
-    if inertia.shape != (3,) or not np.all(np.isfinite(inertia)) or np.any(inertia <= 0.0):
-        raise ValueError(f"inertia must be three positive finite numbers, got {inertia!r}")
-    if omega0.shape != (3,) or not np.all(np.isfinite(omega0)):
-        raise ValueError(f"omega0 must be three finite numbers, got {omega0!r}")
-    if attitude0 is None:
-        attitude0 = Rotation.identity()
-    elif not isinstance(attitude0, Rotation) or not attitude0.single:
-        raise ValueError("attitude0 must be a single scipy Rotation or None")
-    value = integrator.default_setting if setting is None else float(setting)
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"setting must be a positive finite number, got {setting!r}")
+    inertia = check_inertia(inertia)
+    check_moment_span(inertia)
+    omega0 = check_vector(omega0, "omega0")
+    attitude0 = check_attitude(attitude0)
+    if setting is None:
+        value = integrator.default_setting
+    else:
+        value = check_positive(setting, "setting")
+    if integrator.kind == "adaptive" and not MIN_RTOL <= value <= MAX_RTOL:
+        raise ValueError(
+            f"setting, the relative tolerance of {method}, must lie between {MIN_RTOL:.3g} "
+            f"(scipy's floor) and {MAX_RTOL:g}; got {setting!r}"
+        )
     return integrator, inertia, omega0, attitude0, value
+
+
+class Scaled(NamedTuple):
+    """A problem in units where the largest moment and the largest ``|ω0|`` component are
+    powers of two near 1: ``inertia = I/2^i``, ``omega0 = ω0/2^w``, times ``τ = t·2^w``.
+
+    Euler's equations and the attitude kinematics keep their form (ω in rad per unit of τ);
+    the moments enter only through their ratios.
+    """
+
+    inertia: np.ndarray
+    omega0: np.ndarray
+    w_exp: int
+
+    @classmethod
+    def of(cls, integrator: Integrator, inertia: np.ndarray, omega0: np.ndarray) -> Scaled:
+        i_exp = math.frexp(float(inertia.max()))[1] - 1
+        w_max = float(np.max(np.abs(omega0)))
+        w_exp = math.frexp(w_max)[1] - 1 if w_max > 0.0 else 0
+        if integrator.kind == "adaptive" and _SAFE_OMEGA[0] <= w_max <= _SAFE_OMEGA[1]:
+            w_exp = 0  # see the module docstring
+        return cls(np.ldexp(inertia, -i_exp), np.ldexp(omega0, -w_exp), w_exp)
+
+    def time(self, t: np.ndarray) -> np.ndarray:
+        """Caller's times -> τ (inf where beyond the range: refused by :meth:`check_cost`)."""
+        with np.errstate(over="ignore"):
+            return np.ldexp(t, self.w_exp)
+
+    def setting(self, integrator: Integrator, value: float) -> float:
+        """A fixed step in units of τ; a tolerance unchanged."""
+        if integrator.kind == "adaptive":
+            return value
+        with np.errstate(over="ignore", under="ignore"):
+            return float(np.ldexp(value, self.w_exp))
+
+    def omega(self, w: np.ndarray) -> np.ndarray:
+        """Scaled ω -> the caller's units."""
+        with np.errstate(over="ignore"):
+            out = np.ldexp(w, self.w_exp)
+        if not np.all(np.isfinite(out)):
+            raise ValueError(
+                "the computed ω leaves the double-precision range in your units (the method "
+                "diverged or ω grew beyond 1.8e308): use a smaller step or tolerance"
+            )
+        return out
+
+    def check_cost(self, integrator: Integrator, span: float, h: float, outputs: int) -> None:
+        """Refuse a run that would never end: more than :data:`MAX_STEPS` fixed steps (one at
+        least per output time), or more than :data:`MAX_RADIANS` for an adaptive method."""
+        if integrator.kind == "fixed":
+            steps = span / h + outputs if h > 0.0 else math.inf
+            if not steps <= MAX_STEPS:
+                raise ValueError(
+                    f"{integrator.name} would take {steps:.3g} steps (one at least per output "
+                    f"time), more than {MAX_STEPS:,}: {_ADVICE}"
+                )
+            return
+        i = self.inertia
+        spread = max(1.0, (float(i.max()) - float(i.min())) / float(i.min()))
+        radians = math.hypot(*self.omega0.tolist()) * spread * span
+        if not radians <= MAX_RADIANS:
+            raise ValueError(
+                f"the times span {radians:.3g} radians of the fastest rotation, more than "
+                f"{MAX_RADIANS:g} for {integrator.name} (several steps each): "
+                "use fewer or earlier times"
+            )
+
+
+_ADVICE = "use a larger step or fewer, earlier output times"
+#: Where the adaptive pairs keep the caller's time unit.
+_SAFE_OMEGA = (1e-100, 1e100)

@@ -69,17 +69,20 @@ def run_scipy(
         else:
             # solve_ivp wants strictly increasing output times; repeated ones are copied back.
             times, where = np.unique(t_eval, return_inverse=True)
-            sol = solve_ivp(
-                rhs,
-                (0.0, float(times[-1])),
-                y0,
-                method=method,
-                t_eval=times,
-                rtol=rtol,
-                atol=atol,
-            )
-            if sol.status != 0:
-                raise RuntimeError(f"{method} failed: {sol.message}")
+            with np.errstate(all="ignore"):  # a run that leaves the range is refused below
+                sol = solve_ivp(
+                    rhs,
+                    (0.0, float(times[-1])),
+                    y0,
+                    method=method,
+                    t_eval=times,
+                    rtol=rtol,
+                    atol=atol,
+                )
+            if sol.status != 0 or not np.all(np.isfinite(sol.y)):
+                raise ValueError(
+                    f"{method} failed ({sol.message}): use a smaller tolerance or earlier times"
+                )
             ys, nfev = sol.y[:, where], int(sol.nfev)
         # The quaternion's norm drifts like any other error; from_quat normalises it.
         return Trajectory(ys[:3].T.copy(), Rotation.from_quat(ys[3:].T), nfev)

@@ -126,9 +126,11 @@ def test_hotkeys_and_views_are_registered(live):
     hotkeys = {c.hotkey: c.label for c in lecture.commands}
     assert hotkeys == {
         "space": "Play / pause",
-        "1": "Camera: ¾ view",
-        "2": "Camera: Along L",
-        "3": "Camera: Side",
-        "4": "Camera: Ride along",
+        "1": "Camera: default",
+        "2": "Camera: along-L",
+        "3": "Camera: side",
+        "4": "Camera: ride-along",
+        "P": "Projector mode",
+        "V": "Two views",
     }
     assert probe.has_widget("Camera") and probe.has_widget("Dark theme")

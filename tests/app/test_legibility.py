@@ -155,3 +155,127 @@ def test_after_a_stall_no_trace_segment_cuts_through_the_body(stall):
     assert _off_surface(polhode, semi) < POLHODE_INFLATE - 1.0
     chords = np.linalg.norm(herpolhode[:, 1] - herpolhode[:, 0], axis=1)
     assert chords.max() < 2 * MAX_CHORD
+
+
+# -- labels laid out for a camera -----------------------------------------------------------
+def _camera(position, look_at=(0.0, 0.0, 0.0), up=(0.0, 0.0, 1.0)):
+    from poinsot.app.scene.labels import Camera
+
+    return Camera(
+        np.array(position, float),
+        np.array(look_at, float),
+        np.array(up, float),
+        0.785,
+        652.0,
+        800.0,
+    )
+
+
+def test_labels_whose_points_meet_on_screen_get_boxes_apart():
+    """Seen along L, the tips of L and ω and the end of axis 3 fall on one spot: their boxes
+    still do not overlap, nor cover the contact point's marker."""
+    from poinsot.app.scene.labels import Slot, lay_out, overlapping
+
+    camera = _camera((0.0, -0.01, 5.4), up=(0.0, 1.0, 0.0))
+    top, contact = np.array([0.0, 0.0, 1.3]), np.array([0.05, 0.0, 0.65])
+    slots = [
+        Slot("L", "L", 1.4, top + (0, 0, 0.05), top, np.zeros(3), movable=True, clearance=6),
+        Slot("omega", "ω", 1.4, contact * 1.05, contact, np.zeros(3), True, 14.0),
+        Slot(
+            "axis3",
+            "3",
+            1.3,
+            np.array([0.02, 0.01, 0.85]),
+            np.array([0.02, 0.01, 0.8]),
+            np.zeros(3),
+            movable=True,
+            clearance=10.0,
+        ),
+        Slot(
+            "polhode",
+            "polhode",
+            1.1,
+            np.array([0.3, 0.1, 0.6]),
+            np.array([0.28, 0.1, 0.58]),
+            np.zeros(3),
+        ),
+    ]
+    placed = lay_out(slots, camera, markers=[(contact, 9.0)])
+    assert set(placed) == {"L", "omega", "axis3", "polhode"}
+    assert overlapping([p.box for p in placed.values()]) == []
+    assert all(p.overlap == 0.0 for p in placed.values()), placed
+    # The ω label was pushed off the marker, in the screen plane.
+    assert np.linalg.norm(placed["omega"].offset) > 0.0
+
+
+def test_a_label_goes_beyond_its_tip():
+    """An axis pointing right on screen: its label's box lies right of its point."""
+    from poinsot.app.scene.labels import Slot, lay_out
+
+    camera = _camera((0.0, -5.0, 0.0))
+    tip = np.array([1.0, 0.0, 0.0])
+    placed = lay_out([Slot("axis1", "1", 1.3, tip * 1.05, tip, np.zeros(3))], camera)
+    (x0, _, x1, _), (px, _) = placed["axis1"].box, camera.project(tip * 1.05)[0][0]
+    assert x0 >= px - 1e-6 and x1 > x0
+
+
+# -- the legend and the caption --------------------------------------------------------------
+def test_the_legend_lists_the_declared_elements_in_the_looks_colours():
+    from poinsot.app.elements import ALL_ELEMENTS, TRACE_ELEMENTS
+    from poinsot.app.live.legend import entries, legend_html
+    from poinsot.app.scene import palette
+
+    for look in (palette.DARK, palette.LIGHT, palette.PROJECTOR_DARK):
+        items = entries(ALL_ELEMENTS, look)
+        names = [e.name for e in items]
+        assert names[:2] == ["polhode (body)", "herpolhode (plane)"]
+        assert items[1].colors == (look.herpolhode,)
+        html = legend_html(items)
+        assert palette.css(look.polhode) in html and "herpolhode" in html
+    sphere = [e.name for e in entries(ALL_ELEMENTS - TRACE_ELEMENTS, palette.DARK)]
+    assert not any("polhode" in name for name in sphere)
+
+
+def test_every_preset_has_a_caption_and_a_scene_can_set_its_own():
+    import dataclasses
+
+    from poinsot.app.live.legend import CAPTIONS, caption
+    from poinsot.app.presets import MENU, PRESETS
+
+    for preset in PRESETS:
+        assert caption(preset) == CAPTIONS[preset.key]
+    for preset in MENU:
+        assert caption(preset)
+    own = dataclasses.replace(PRESETS[0], key="scene", caption="What the scene shows.")
+    assert caption(own) == "What the scene shows."
+
+
+# -- one vocabulary for views; --help shows the defaults -----------------------------------
+def test_the_views_have_one_name_in_the_browser_and_on_the_command_line():
+    from poinsot.app.cli import build_parser
+    from poinsot.app.scene.cameras import CAMERA_NAMES, canonical
+
+    assert CAMERA_NAMES == ("default", "along-L", "side", "ride-along")
+    parser = build_parser()
+    for name in CAMERA_NAMES:
+        assert parser.parse_args(["screenshot", "--out", "x.png", "--view", name]).view == name
+    assert canonical("top") == "along-L" and canonical("body") == "ride-along"
+    with pytest.raises(SystemExit):
+        parser.parse_args(["export-html", "--out", "x.html", "--view", "ride-along"])
+
+
+@pytest.mark.parametrize(
+    "command", [[], ["serve"], ["report"], ["screenshot"], ["export-html"], ["benchmark"], ["fit"]]
+)
+def test_help_shows_the_defaults_and_no_backticks(command, capsys):
+    from poinsot.app.cli import build_parser
+
+    with pytest.raises(SystemExit):
+        build_parser().parse_args([*command, "--help"])
+    text = capsys.readouterr().out
+    assert "`" not in text
+    if command in ([], ["serve"]):
+        assert "(default: 8080)" in text and "(default: major)" in text
+    if command == ["screenshot"]:
+        assert "(default: 1920x1080)" in text and "(default: default)" in text
+        assert "Preset(" not in text

@@ -12,6 +12,7 @@ from conftest import session_of, wait_until
 from scene_probing import (
     ALWAYS,
     CONSTRUCTION_TRAILS,
+    construction_nodes,
     plot_titles,
     scene_node_names,
     start,
@@ -24,21 +25,6 @@ from poinsot.app.presets import preset_by_key
 from poinsot.app.scenes import SCENES, scene_by_name
 from poinsot.app.scenes.spec import SceneSpec
 
-#: Nodes of each element of the Poinsot construction (as in test_server).
-ELEMENT_NODES: dict[Element, set[str]] = {
-    Element.ELLIPSOID: {"/space/body/ellipsoid"},
-    Element.AXES: {f"/space/body/axis{i}" for i in (1, 2, 3)}
-    | {f"/space/body/axis{i}/label" for i in (1, 2, 3)}
-    | {"/space/origin"},
-    Element.PLANE: {"/space/plane", "/space/plane/disc", "/space/plane/grid", "/space/plane/rim"},
-    Element.CONTACT: {"/space/tip/contact"},
-    Element.OMEGA: {"/space/omega", "/space/tip/omega_label"},
-    Element.L: {"/space/L", "/space/L_label"},
-    Element.POLHODE: {"/space/body/polhode"},
-    Element.POLHODE_FULL: {"/space/body/polhode_full"},
-    Element.HERPOLHODE: {"/space/herpolhode"},
-    Element.SOLID: {"/space/body/solid"},
-}
 #: The panel's shared groups: their widgets' labels and the folder they go in.
 SHARED_LABELS: dict[Control, set[str]] = {
     Control.SPEED: {"Speed", "Playback"},
@@ -49,10 +35,16 @@ SHARED_LABELS: dict[Control, set[str]] = {
 IDS = [s.name for s in SCENES]
 
 
-def expected_nodes(spec: SceneSpec) -> set[str]:
+@pytest.fixture(scope="module")
+def element_nodes() -> dict[Element, set[str]]:
+    """The nodes each element of the construction creates (read off the construction)."""
+    return construction_nodes()
+
+
+def expected_nodes(spec: SceneSpec, element_nodes: dict[Element, set[str]]) -> set[str]:
     names = set(ALWAYS) | set(spec.node_names())
     for element in spec.elements:
-        names |= ELEMENT_NODES[element]
+        names |= element_nodes[element]
     return names
 
 
@@ -86,10 +78,10 @@ def common_labels(make_app, make_probe) -> set[str]:
 
 
 @pytest.mark.parametrize("spec", SCENES, ids=IDS)
-def test_each_scene_creates_only_what_it_declares(spec, make_app, make_probe):
+def test_each_scene_creates_only_what_it_declares(spec, make_app, make_probe, element_nodes):
     common = common_labels(make_app, make_probe)
     _, session, probe = start(make_app, make_probe, spec)
-    expected = expected_nodes(spec)
+    expected = expected_nodes(spec, element_nodes)
     trails = trails_of(spec)
     assert probe.wait_for(lambda p: scene_node_names(p, trails) == expected, 15), (
         scene_node_names(probe, trails) ^ expected
@@ -102,7 +94,7 @@ def test_each_scene_creates_only_what_it_declares(spec, make_app, make_probe):
     assert session.stats.errors == 0, session.stats.last_error
 
 
-def test_the_menu_switches_scenes_and_presets_exactly(make_app, make_probe):
+def test_the_menu_switches_scenes_and_presets_exactly(make_app, make_probe, element_nodes):
     app = make_app()
     probe = make_probe(app)
     session = session_of(app)
@@ -119,7 +111,7 @@ def test_the_menu_switches_scenes_and_presets_exactly(make_app, make_probe):
             ),
             15,
         )
-        expected, trails = expected_nodes(spec), trails_of(spec)
+        expected, trails = expected_nodes(spec, element_nodes), trails_of(spec)
         assert probe.wait_for(lambda p, e=expected, t=trails: scene_node_names(p, t) == e, 15), (
             scene_node_names(probe, trails) ^ expected
         )
@@ -129,7 +121,7 @@ def test_the_menu_switches_scenes_and_presets_exactly(make_app, make_probe):
     assert wait_until(lambda: session.showcase is None and session.preset is preset, 15)
     names = set(ALWAYS)
     for element in preset.elements:
-        names |= ELEMENT_NODES[element]
+        names |= element_nodes[element]
     assert probe.wait_for(lambda p: scene_node_names(p, CONSTRUCTION_TRAILS) == names, 15), (
         scene_node_names(probe, CONSTRUCTION_TRAILS) ^ names
     )

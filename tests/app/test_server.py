@@ -13,6 +13,7 @@ from conftest import session_of, wait_until
 from test_scene_geometry import check_finite
 
 from poinsot.app.elements import Control, Element, Plot
+from poinsot.app.live.display import LABEL_HZ
 from poinsot.app.live.panel import ELEMENT_LABELS
 from poinsot.app.live.session import MAX_FPS, STEP_SECONDS
 from poinsot.app.parameters import Parameters
@@ -29,9 +30,9 @@ ELEMENT_NODES: dict[Element, set[str]] = {
     Element.CONTACT: {"/space/tip/contact"},
     Element.OMEGA: {"/space/omega", "/space/tip/omega_label"},
     Element.L: {"/space/L", "/space/L_label"},
-    Element.POLHODE: {"/space/body/polhode"},
+    Element.POLHODE: {"/space/body/polhode", "/space/body/polhode_label"},
     Element.POLHODE_FULL: {"/space/body/polhode_full"},
-    Element.HERPOLHODE: {"/space/herpolhode"},
+    Element.HERPOLHODE: {"/space/herpolhode", "/space/herpolhode_label"},
     Element.SOLID: {"/space/body/solid"},
 }
 ALWAYS = {"/WorldAxes", "/space", "/space/body", "/space/tip", "/lights", "/lights/fill"}
@@ -147,10 +148,13 @@ def test_per_frame_only_poses_and_trail_increments_are_sent(poinsot_app, probe):
     batches = frame_traffic(probe, 1.5)
     frames = session.stats.frames - frames_before
     assert frames > 30
+    labels = 0  # the labels' layout: an anchor or a push, a few times a second at most
     for batch in batches:
         for kind, name in zip(batch.types, batch.names, strict=True):
             assert kind in PER_FRAME_TYPES, (kind, name)
-            if kind in ("LineSegmentsMessage", "RemoveSceneNodeMessage"):
+            if name.endswith("label") and kind in ("SetPositionMessage", "SceneNodeUpdateMessage"):
+                labels += 1
+            elif kind in ("LineSegmentsMessage", "RemoveSceneNodeMessage"):
                 assert name.startswith(TRAIL_GROUPS), name  # trail chunks only
             elif kind == "SetOrientationMessage":
                 assert name == "/space/body" or name.startswith(TRAIL_GROUPS), name
@@ -158,6 +162,7 @@ def test_per_frame_only_poses_and_trail_increments_are_sent(poinsot_app, probe):
                 assert name == "/space/tip" or name.startswith(TRAIL_GROUPS), name
             elif kind == "SceneNodeUpdateMessage":
                 assert name == "/space/omega" or name.startswith(TRAIL_GROUPS), name
+    assert labels <= 2 * 7 * LABEL_HZ * 1.5 + 7, labels
     # Bytes: poses plus at most a chunk of trail per trace per frame (the plot, at 10 Hz,
     # resends its 300-sample window; it is counted separately).
     scene_bytes = sum(b.nbytes for b in batches if "GuiUpdateMessage" not in b.types)

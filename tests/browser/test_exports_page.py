@@ -266,7 +266,8 @@ def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_p
     # Current view: the 3D view's size, opaque on the dark theme's background.
     name, image = download_png(page)
     width, height = session.client.camera.image_width, session.client.camera.image_height
-    assert (width, height) == (960, 540)
+    view = page.canvas_box()  # the 3D view, between the docked columns
+    assert (width, height) == (round(view["width"]), round(view["height"]))
     assert re.fullmatch(r"poinsot_major_t\d+\.\d\d\.png", name), name
     t_name = float(name[len("poinsot_major_t") : -4])
     assert 0.0 < t_name <= session.clock.now()
@@ -308,7 +309,7 @@ def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     assert wait_until(lambda: not session.clock.paused, 5), "space did not resume"
     # 2: view along L. The browser reports its camera back to the server.
     page.page.keyboard.press("2")
-    top = VIEWS["top"]
+    top = VIEWS["along-L"]
     # The browser reports its camera while the view animates: wait for the settled state
     # (position and look-at both at the view's), not the first report that passes one.
     assert wait_until(
@@ -340,7 +341,7 @@ def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     # Large text: the root font size (all panel text is in rem) grows.
     root = "parseFloat(getComputedStyle(document.documentElement).fontSize)"
     before = page.page.evaluate(root)
-    page.set_checkbox("Large text (projector)", True)
+    page.set_checkbox("Large text", True)
     grown = before * LARGE_TEXT_PERCENT / 100
     assert wait_until(lambda: page.page.evaluate(root) >= grown - 0.5, 10), before
     label = (

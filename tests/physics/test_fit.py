@@ -252,8 +252,13 @@ def test_shape_errors(t_shape, w_shape, message):
 
 
 def test_not_numbers():
-    with pytest.raises(ValueError, match="arrays of numbers"):
+    """Text, complex numbers and flags that are no bools are refused, not converted."""
+    with pytest.raises(TypeError, match="t must be an array of times"):
         fit_angular_velocity(["a"] * 30, np.ones((30, 3)))
+    with pytest.raises(TypeError, match="omega must be an array of angular velocities"):
+        fit_angular_velocity(np.arange(30.0), np.ones((30, 3)) * (1 + 1j))
+    with pytest.raises(TypeError, match="fit_bias must be True or False"):
+        fit_angular_velocity(np.arange(30.0), np.ones((30, 3)), fit_bias="yes")
 
 
 # -- the pieces ---------------------------------------------------------------------------------

@@ -98,7 +98,7 @@ def test_scalar_time_zero_returns_the_initial_state(key: str) -> None:
 
 
 @pytest.mark.parametrize(
-    "t", [5, np.float64(5.0), np.float32(5.0), np.int64(5), np.array(5.0), True], ids=repr
+    "t", [5, np.float64(5.0), np.float32(5.0), np.int64(5), np.array(5.0)], ids=repr
 )
 def test_scalar_time_types(t) -> None:
     body = FreeRigidBody((1.0, 2.0, 3.0), (1.0, 0.3, 0.5))
@@ -115,6 +115,16 @@ def test_scalar_time_must_be_finite(t) -> None:
     body = FreeRigidBody((1.0, 2.0, 3.0), (1.0, 0.3, 0.5))
     for call in (body.omega, body.attitude, body.state, body.sample, body.contact_point):
         with pytest.raises(ValueError, match="finite"):
+            call(t)
+
+
+@pytest.mark.parametrize("t", [True, np.bool_(False), 1j, np.complex128(2.0), "1.5", None])
+def test_scalar_time_must_be_a_real_number(t) -> None:
+    """A bool, a complex number or a text is refused (a TypeError, also a ValueError), not
+    read as 1.0, cut to its real part or parsed."""
+    body = FreeRigidBody((1.0, 2.0, 3.0), (1.0, 0.3, 0.5))
+    for call in (body.omega, body.attitude, body.state, body.sample, body.contact_point):
+        with pytest.raises(TypeError, match="time must be a number or a 1-D array of numbers"):
             call(t)
 
 

@@ -1,0 +1,201 @@
+"""How one session's picture looks: the theme, the projector mode, the second (body-frame)
+view, and the labels' layout for the browser's camera.
+
+- Theme: dark or light (:func:`poinsot.app.scene.view.configure_theme`), and the scene's colours
+  for it (:func:`poinsot.app.scene.palette.look`), which the legend follows.
+- Projector mode, one switch: large text, thick curves and lines, the high-contrast colours, and
+  both docked columns minimized to slim strips so that the 3D view takes the screen.
+- Two views: the body frame's picture beside the space frame's
+  (:class:`~poinsot.app.scene.body_view.BodyView`), the camera stepped back to frame both and
+  the left column folded (its strip opens it again) for a wide picture.
+- Labels: a few times a second the scene's labels are laid out for the camera the browser
+  reports (:meth:`~poinsot.app.scene.construction.PoinsotScene.lay_out_labels`).
+
+Frame thread only, except :meth:`Display.request`, which records a wish for the frame thread.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import threading
+from typing import Protocol
+
+import numpy as np
+import viser
+
+from poinsot.app.live.motion_window import MotionWindow
+from poinsot.app.scene import palette
+from poinsot.app.scene.batch import Frame
+from poinsot.app.scene.body_view import OFFSET, BodyView
+from poinsot.app.scene.construction import PoinsotScene
+from poinsot.app.scene.frames import wxyz
+from poinsot.app.scene.labels import Camera
+from poinsot.app.scene.view import DEFAULT_VIEW, View, configure_theme
+
+#: Root font size of the large-text mode: every panel size is in rem, so all text scales.
+LARGE_TEXT_PERCENT = 130
+#: ... and of the projector mode.
+PROJECTOR_TEXT_PERCENT = 150
+#: Labels are laid out this often [Hz] (their boxes ride on their frames in between; a
+#: layout costs about a millisecond), and only when the camera or the time has changed.
+LABEL_HZ = 6.0
+#: The two-view camera: from the front (x runs across the screen, the body frame's picture on
+#: the right), this high above the plane [degrees] and this far from the middle between the
+#: pictures [display units].
+TWO_VIEW_ELEVATION = 28.0
+TWO_VIEW_DISTANCE = 6.6
+
+
+@dataclasses.dataclass(frozen=True)
+class Style:
+    """What the lecturer chose: theme, text size, projector mode, two views."""
+
+    dark: bool = True
+    large_text: bool = False
+    projector: bool = False
+    two_views: bool = False
+
+
+class DisplaySession(Protocol):
+    """What the display uses of a session."""
+
+    client: viser.ClientHandle
+    scene: PoinsotScene
+
+
+def two_view_camera() -> View:
+    """From the front, stepped back to frame the space and the body pictures side by side."""
+    target = np.array([0.5 * OFFSET[0], 0.0, 0.1])
+    elevation = math.radians(TWO_VIEW_ELEVATION)
+    step = TWO_VIEW_DISTANCE * np.array([0.0, -math.cos(elevation), math.sin(elevation)])
+    x, y, z = (float(v) for v in target + step)
+    tx, ty, tz = (float(v) for v in target)
+    return View(position=(x, y, z), look_at=(tx, ty, tz))
+
+
+def text_css(style: Style) -> str:
+    """A style element that scales the page's root font size (empty at the normal size)."""
+    if style.projector:
+        percent = PROJECTOR_TEXT_PERCENT
+    elif style.large_text:
+        percent = LARGE_TEXT_PERCENT
+    else:
+        return ""
+    return f"<style>html {{ font-size: {percent}% !important; }}</style>"
+
+
+def browser_camera(client: viser.ClientHandle) -> Camera | None:
+    """The camera the browser reports, or None before it has reported its view's size."""
+    camera = client.camera
+    try:
+        width, height = float(camera.image_width), float(camera.image_height)
+    except AssertionError:
+        return None
+    if width <= 0 or height <= 0:
+        return None
+    return Camera(
+        np.asarray(camera.position, float),
+        np.asarray(camera.look_at, float),
+        np.asarray(camera.up_direction, float),
+        float(camera.fov),
+        width,
+        height,
+    )
+
+
+class Display:
+    """The look of one session's picture (see the module's docstring)."""
+
+    def __init__(
+        self, session: DisplaySession, motion: MotionWindow, style_html: viser.GuiHtmlHandle
+    ):
+        self.session = session
+        self.client = session.client
+        self.motion = motion
+        self.style_html = style_html
+        self.style = Style()
+        self._wanted = Style()
+        self._lock = threading.Lock()
+        self.body_view: BodyView | None = None
+        self._next_layout = 0.0
+        self._laid_out: tuple | None = None  # (camera, time) of the last layout
+
+    # -- wishes (any thread) ---------------------------------------------------------------
+    def request(self, **changes: bool) -> None:
+        """Ask for a change of style (any thread); the frame thread applies it."""
+        with self._lock:
+            self._wanted = dataclasses.replace(self._wanted, **changes)
+
+    @property
+    def wanted(self) -> Style:
+        with self._lock:
+            return self._wanted
+
+    # -- frame thread ----------------------------------------------------------------------
+    def on_frame(self, frame: Frame | None, now: float) -> None:
+        """Apply a wished style, carry the body-frame picture, lay out the labels."""
+        wanted = self.wanted
+        if wanted != self.style:
+            self.apply(wanted)
+        view = self.body_view
+        scene = self.session.scene
+        if view is not None and frame is not None and scene.geometry is not None:
+            if view.geometry is not scene.geometry:
+                view.fit(scene.geometry, self._attitude0(frame))
+            view.advance(frame)
+        if now >= self._next_layout:
+            self._next_layout = now + 1.0 / LABEL_HZ
+            self.lay_out_labels(None if frame is None else frame.t)
+
+    def lay_out_labels(self, t: float | None = None) -> dict:
+        """Lay the labels out for the browser's camera (not again for the same camera and
+        time ``t``, when given: a paused, unmoved picture)."""
+        camera = browser_camera(self.client)
+        if camera is None or not all(math.isfinite(v) for v in camera.position):
+            return {}
+        key = (*camera.position, *camera.look_at, *camera.up, camera.fov, camera.width, t)
+        if t is not None and key == self._laid_out:
+            return {}
+        self._laid_out = key
+        return self.session.scene.lay_out_labels(camera)
+
+    def _attitude0(self, frame: Frame) -> np.ndarray:
+        """The attitude at t = 0 (the body-frame picture is the body as it was then)."""
+        body = self.session.scene.body
+        return np.asarray(frame.wxyz) if body is None else wxyz(body.attitude(0.0))
+
+    def apply(self, style: Style) -> None:
+        """Show ``style``: theme, text size, the scene's look, the columns, the second view."""
+        old, self.style = self.style, style
+        gui = self.client.gui
+        configure_theme(
+            gui, dark_mode=style.dark, large_controls=style.large_text or style.projector
+        )
+        for html in (self.style_html, self.motion.style):  # whichever column is open
+            html.content = text_css(style)
+        look = palette.look(style.dark, style.projector)
+        self.session.scene.restyle(look)
+        self.motion.legend.restyle(look)
+        if self.body_view is not None:
+            self.body_view.restyle(look)
+        # Projector: both columns folded; two views: the left one, for a wide picture.
+        if style.projector != old.projector or style.two_views != old.two_views:
+            folded = {"main": style.projector, "left": style.projector or style.two_views}
+            for key, panel in (("main", gui.main_panel), ("left", self.motion.window)):
+                if folded[key]:
+                    panel.minimize()
+                else:
+                    panel.expand()
+        if style.two_views != old.two_views:
+            self._two_views(style.two_views, look)
+
+    def _two_views(self, on: bool, look: palette.Look) -> None:
+        if on and self.body_view is None:
+            self.body_view = BodyView(self.client.scene, look)
+        elif not on and self.body_view is not None:
+            self.body_view.remove()
+            self.body_view = None
+        view = two_view_camera() if on else DEFAULT_VIEW
+        with self.client.atomic():
+            view.apply(self.client.camera)

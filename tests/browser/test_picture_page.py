@@ -1,0 +1,496 @@
+"""What a lecture sees, in a real browser (Debian's Chromium, software WebGL) at a projector's
+1280 x 800 and at 1920 x 1080, dark and light: the legend and the caption, the herpolhode's size
+on screen and nothing covering it, the D slider's marks, the separatrix at the I₂ mark, what a
+symmetric body leaves out, labels that do not pile up, readable plots and buttons on the light
+theme, no console error when the sphere and a custom body alternate, the projector mode and the
+two views. Each test checks pixels or the DOM, not only the server's state."""
+
+from __future__ import annotations
+
+import colorsys
+import re
+
+import numpy as np
+import pytest
+from conftest import session_of, wait_until
+from scipy import ndimage
+
+from poinsot.app.elements import Element
+from poinsot.app.live.display import PROJECTOR_TEXT_PERCENT, browser_camera
+from poinsot.app.live.legend import CAPTIONS
+from poinsot.app.presets import CUSTOM, preset_by_key
+from poinsot.app.scene import palette
+from poinsot.physics import Regime
+
+pytestmark = pytest.mark.browser
+
+SIZES = [(1280, 800), (1920, 1080)]
+THEMES = ["dark", "light"]
+#: The herpolhode of the default preset, seen in the default view after two periods, spans at
+#: least these fractions of the 3D view's width and height (measured at 1280 x 800: 0.17 and
+#: 0.075 of a 652 x 800 view, a ring of 109 x 60 px; at 1920 x 1080 about 0.11 and 0.075; the
+#: grazing view of before gave a sliver a few pixels high).
+HERPOLHODE_MIN_WIDTH = 0.10
+HERPOLHODE_MIN_HEIGHT = 0.06
+
+
+# -- helpers -----------------------------------------------------------------------------------
+def started(app, frames: int = 20):
+    session = session_of(app)
+    assert wait_until(lambda: session.stats.frames >= frames, 20), "the scene is not animating"
+    return session
+
+
+def set_theme(page, session, theme: str) -> None:
+    if theme == "light":
+        page.set_checkbox("Dark theme", False)
+        assert wait_until(lambda: session.lecture.display.style.dark is False, 10)
+        page.page.wait_for_timeout(800)
+
+
+def pause(page, session) -> None:
+    page.click_button("Pause")
+    assert wait_until(lambda: session.clock.paused, 5)
+
+
+def near(rgb: np.ndarray, color: tuple[int, int, int], tolerance: float = 60.0) -> np.ndarray:
+    """Pixels within ``tolerance`` (Euclidean, 0-255) of ``color``."""
+    return np.linalg.norm(rgb.astype(float) - np.array(color, float), axis=2) < tolerance
+
+
+def hue_mask(
+    rgb: np.ndarray,
+    colour,
+    tolerance: float = 10.0,
+    saturation: float = 0.25,
+    brightness: float = 0.45,
+):
+    """Pixels of ``colour``'s hue (within ``tolerance`` degrees), saturated and bright: a line
+    drawn in that colour as it comes out on screen (lit, blended, anti-aliased)."""
+    target = colorsys.rgb_to_hsv(*(c / 255.0 for c in colour))[0] * 360.0
+    view = rgb.astype(float) / 255.0
+    mx, mn = view.max(axis=2), view.min(axis=2)
+    chroma = np.maximum(mx - mn, 1e-9)
+    r, g, b = view[..., 0], view[..., 1], view[..., 2]
+    hue = (
+        np.where(
+            mx == r,
+            ((g - b) / chroma) % 6,
+            np.where(mx == g, (b - r) / chroma + 2, (r - g) / chroma + 4),
+        )
+        * 60.0
+    )
+    distance = np.abs((hue - target + 180.0) % 360.0 - 180.0)
+    sat = np.where(mx > 0, (mx - mn) / np.maximum(mx, 1e-9), 0.0)
+    return (distance < tolerance) & (sat > saturation) & (mx > brightness)
+
+
+def canvas_slice(page) -> tuple[np.ndarray, dict]:
+    """The page's pixels and the 3D view's box (between the docked columns)."""
+    return page.screenshot_rgb(), page.canvas_box()
+
+
+def bounding_box(mask: np.ndarray, min_patch: int = 0) -> tuple[int, int, int, int] | None:
+    """The box round ``mask``'s pixels (only those in patches of at least ``min_patch``
+    pixels: a stray anti-aliased pixel of another line is not the curve)."""
+    if min_patch:
+        patches, count = ndimage.label(ndimage.binary_dilation(mask, iterations=2))
+        sizes = ndimage.sum(mask, patches, range(1, count + 1))
+        mask = mask & np.isin(patches, 1 + np.flatnonzero(sizes >= min_patch))
+    ys, xs = np.nonzero(mask)
+    if len(xs) == 0:
+        return None
+    return int(xs.min()), int(ys.min()), int(xs.max()), int(ys.max())
+
+
+def contrast(a: tuple[float, ...], b: tuple[float, ...]) -> float:
+    """WCAG contrast ratio of two sRGB colours (0-255)."""
+
+    def luminance(rgb):
+        def channel(v):
+            v /= 255.0
+            return v / 12.92 if v <= 0.03928 else ((v + 0.055) / 1.055) ** 2.4
+
+        r, g, b = (channel(float(c)) for c in rgb[:3])
+        return 0.2126 * r + 0.7152 * g + 0.0722 * b
+
+    hi, lo = sorted((luminance(a), luminance(b)), reverse=True)
+    return (hi + 0.05) / (lo + 0.05)
+
+
+def css_rgb(text: str) -> tuple[float, ...]:
+    return tuple(float(v) for v in re.findall(r"[\d.]+", text)[:3])
+
+
+# -- 1. the legend and the caption -----------------------------------------------------------
+@pytest.mark.parametrize("theme", THEMES)
+@pytest.mark.parametrize("size", SIZES, ids=["1280x800", "1920x1080"])
+def test_the_legend_names_and_colours_every_element_on_the_first_screen(
+    poinsot_app, open_page, size, theme
+):
+    page = open_page(poinsot_app.url, width=size[0], height=size[1])
+    session = started(poinsot_app)
+    set_theme(page, session, theme)
+    look = session.scene.look
+    assert look is palette.look(theme == "dark")
+    colours = {
+        "polhode (body)": look.polhode,
+        "herpolhode (plane)": look.herpolhode,
+        "ω ang. velocity": look.omega,
+        "L ang. momentum": look.angular_momentum,
+        "contact point": look.contact,
+        "invariable plane": look.plane,
+    }
+    rgb = page.screenshot_rgb()
+    for name, colour in colours.items():
+        entry = page.page.locator(f"[data-legend='{name}']")
+        assert wait_until(lambda e=entry: e.count() == 1, 10), name
+        box = entry.bounding_box()
+        assert box is not None and box["y"] + box["height"] <= size[1], (name, box)
+        assert box["x"] >= 0 and box["x"] + box["width"] <= size[0], (name, box)
+        # The swatch (the entry's first 2 em) shows the element's colour.
+        x0, y0 = int(box["x"]), int(box["y"])
+        swatch = rgb[y0 : y0 + int(box["height"]), x0 : x0 + 26]
+        assert near(swatch, colour, 40).sum() >= 6, (name, colour)
+    # The words are on the first screen, in the caption too.
+    caption = page.page.get_by_text(CAPTIONS["major"][:40])
+    assert caption.count() == 1 and caption.bounding_box()["y"] < size[1] / 2
+    assert page.errors == []
+
+
+def test_the_caption_follows_the_preset(poinsot_app, open_page):
+    page = open_page(poinsot_app.url, width=1280, height=800)
+    session = started(poinsot_app)
+    page.choose("Preset", preset_by_key("oblate").label)
+    assert wait_until(lambda: session.preset.key == "oblate", 10)
+    assert wait_until(lambda: page.page.get_by_text(CAPTIONS["oblate"][:30]).count() == 1, 10)
+    assert page.page.get_by_text(CAPTIONS["major"][:30]).count() == 0
+    assert page.errors == []
+
+
+# -- 2. the herpolhode is legible and nothing covers it ----------------------------------------
+@pytest.mark.parametrize("theme", THEMES)
+@pytest.mark.parametrize("size", SIZES, ids=["1280x800", "1920x1080"])
+def test_the_herpolhode_is_legible_in_the_default_view(poinsot_app, open_page, size, theme):
+    page = open_page(poinsot_app.url, width=size[0], height=size[1])
+    session = started(poinsot_app)
+    set_theme(page, session, theme)
+    session.set_speed(4.0)  # two periods of ω in about five seconds
+    assert wait_until(lambda: session.frame is not None and session.frame.t > 2.2 * 8.921, 30)
+    pause(page, session)
+    page.page.wait_for_timeout(1000)
+    rgb, box = canvas_slice(page)
+    x0, x1 = int(box["x"]), int(box["x"] + box["width"])
+    # The 3D view lies between the two docked columns: no panel over it.
+    left = page.page.get_by_text("What you see", exact=True).bounding_box()
+    preset = page.page.locator("label").filter(has_text=re.compile("^Preset$")).bounding_box()
+    assert left["x"] + left["width"] <= x0 + 1 and preset["x"] >= x1 - 1, (left, preset, box)
+    assert box["width"] >= 0.45 * size[0]
+    herpolhode = hue_mask(rgb, session.scene.look.herpolhode)
+    herpolhode[:, :x0] = herpolhode[:, x1:] = False
+    found = bounding_box(herpolhode, min_patch=30)
+    assert found is not None, "no herpolhode on screen"
+    width, height = (found[2] - found[0]) / box["width"], (found[3] - found[1]) / box["height"]
+    assert width > HERPOLHODE_MIN_WIDTH and height > HERPOLHODE_MIN_HEIGHT, (width, height)
+    assert page.errors == []
+
+
+# -- 3. the D slider's marks -------------------------------------------------------------------
+MARKS_JS = """(label) => {
+  const l = [...document.querySelectorAll('label')].find(e => e.textContent === label);
+  const root = document.getElementById(l.getAttribute('for'));
+  const thumb = root.querySelector('[role=slider]');
+  return {min: +thumb.getAttribute('aria-valuemin'), max: +thumb.getAttribute('aria-valuemax'),
+    marks: [...root.querySelectorAll('.mantine-Slider-markWrapper')].map(
+      w => [parseFloat(w.style.getPropertyValue('--mark-offset')), w.textContent])};
+}"""
+
+
+def slider_marks(page, label: str = "D = |L|²/2T") -> dict:
+    return page.page.evaluate(MARKS_JS, label)
+
+
+def test_the_D_marks_follow_the_body(poinsot_app, open_page):
+    page = open_page(poinsot_app.url, width=1280, height=800)
+    session = started(poinsot_app)
+    for key in ("t_handle", "oblate", "prolate"):
+        preset = preset_by_key(key)
+        page.choose("Preset", preset.label)
+        assert wait_until(lambda p=preset: session.params.inertia == p.inertia, 10)
+        lo, hi = min(preset.inertia), max(preset.inertia)
+        assert wait_until(lambda lo=lo, hi=hi: slider_marks(page)["max"] == pytest.approx(hi), 10)
+    marks = slider_marks(page)
+    assert marks["min"] == pytest.approx(0.16829) and marks["max"] == pytest.approx(1.0)
+    # A rod is symmetric: min I and max I only, both inside the slider's range.
+    assert [label for _, label in marks["marks"]] == ["min I", "max I"]
+    assert all(0.0 <= offset <= 100.0 for offset, _ in marks["marks"]), marks
+    # A triaxial body has the I₂ mark, and it moves with I₂.
+    page.choose("Preset", preset_by_key("major").label)
+    assert wait_until(lambda: [m[1] for m in slider_marks(page)["marks"]][1:2] == ["I₂"], 10)
+    before = slider_marks(page)["marks"][1][0]
+    assert before == pytest.approx(62.5)  # (2 - 1) / (2.6 - 1)
+    page.press_slider("I₂", "ArrowRight", times=20)  # I2: 2.00 -> 2.20
+    assert wait_until(lambda: session.params.inertia[1] == pytest.approx(2.2), 10)
+    assert wait_until(lambda: slider_marks(page)["marks"][1][0] == pytest.approx(75.0), 10)
+    assert page.errors == []
+
+
+# -- 4. the I₂ mark is the separatrix ---------------------------------------------------------
+def test_D_at_the_I2_mark_is_the_exact_separatrix(poinsot_app, open_page):
+    """I = (1, 2, 2.6): a click on the D slider's I₂ mark, then the arrow keys until the slider
+    shows 2.000: D is I₂ exactly and the readout says separatrix (it said 'polhode around the
+    minor axis, period 151')."""
+    page = open_page(poinsot_app.url, width=1280, height=800)
+    session = started(poinsot_app)
+    label = "D = |L|²/2T"
+    root = page.page.locator(f"[id='{page.widget_id(label)}']")
+    mark = root.locator(".mantine-Slider-markWrapper").nth(1)
+    assert mark.text_content() == "I₂"
+    track = root.locator(".mantine-Slider-track").bounding_box()
+    offset = float(mark.evaluate("w => parseFloat(w.style.getPropertyValue('--mark-offset'))"))
+    x = track["x"] + track["width"] * offset / 100.0
+    page.page.mouse.click(x, track["y"] + track["height"] / 2)
+    assert wait_until(lambda: abs(page.slider_value(label) - 2.0) < 0.05, 10)
+    steps = round((2.0 - page.slider_value(label)) / 0.001)
+    if steps:
+        page.press_slider(label, "ArrowRight" if steps > 0 else "ArrowLeft", times=abs(steps))
+    assert wait_until(lambda: page.slider_value(label) == 2.0, 10)
+    assert wait_until(lambda: session.params.D == 2.0, 10), session.params
+    assert session.body.regime is Regime.SEPARATRIX and session.body.D == 2.0
+    readout = page.page.get_by_text("on the separatrix (unstable)")
+    assert wait_until(lambda: readout.count() == 1, 10)
+    assert page.errors == []
+
+
+# -- 6. what a symmetric body or a sphere leaves out -----------------------------------------
+def test_a_symmetric_body_offers_no_separatrix_and_the_sphere_no_k2(poinsot_app, open_page):
+    page = open_page(poinsot_app.url, width=1280, height=800)
+    session = started(poinsot_app)
+    assert page.control_count("Side of separatrix") == 1
+    for key in ("oblate", "prolate"):
+        page.choose("Preset", preset_by_key(key).label)
+        assert wait_until(lambda k=key: session.preset.key == k, 10)
+        assert wait_until(lambda: page.control_count("Side of separatrix") == 0, 10), key
+        assert page.control_count("Polhode") == 1  # which of the two polhodes: still a choice
+        labels = [label for _, label in slider_marks(page)["marks"]]
+        assert "I₂" not in labels, labels
+    page.choose("Preset", preset_by_key("sphere").label)
+    assert wait_until(lambda: session.preset.key == "sphere" and session.body is not None, 10)
+    column = page.page.locator("table").first
+    assert wait_until(lambda: "sphere: ω constant" in column.inner_text(), 10)
+    assert "k²" not in column.inner_text()
+    assert page.errors == []
+
+
+def test_the_sphere_shows_omega_and_L_apart(poinsot_app, open_page):
+    """ω is parallel to L: the thicker ω arrow shows up to the plane round the thinner L, L
+    goes on above it, and their labels stand apart."""
+    page = open_page(poinsot_app.url, width=1280, height=800)
+    session = started(poinsot_app)
+    page.choose("Preset", preset_by_key("sphere").label)
+    assert wait_until(lambda: session.preset.key == "sphere" and session.body is not None, 10)
+    page.page.wait_for_timeout(1500)
+    rgb, box = canvas_slice(page)
+    view = rgb[:, int(box["x"]) : int(box["x"] + box["width"])]
+    look = session.scene.look
+    omega, momentum = hue_mask(view, look.omega), hue_mask(view, look.angular_momentum)
+    assert omega.sum() > 150 and momentum.sum() > 150, (omega.sum(), momentum.sum())
+    # L's colour reaches higher on screen than ω's (L goes on above the plane).
+    assert bounding_box(momentum)[1] < bounding_box(omega)[1] - 20
+    placed = session.lecture.display.lay_out_labels()
+    assert {"omega", "L"} <= placed.keys()
+    assert not boxes_overlap(placed["omega"].box, placed["L"].box)
+    assert page.errors == []
+
+
+def boxes_overlap(a, b) -> bool:
+    return min(a[2], b[2]) > max(a[0], b[0]) and min(a[3], b[3]) > max(a[1], b[1])
+
+
+# -- 8. labels do not pile up ----------------------------------------------------------------
+LABEL_ELEMENTS = (Element.L, Element.OMEGA, Element.AXES, Element.POLHODE, Element.HERPOLHODE)
+
+
+def label_handles(session):
+    drawings = session.scene._drawings
+    handles = []
+    for element in LABEL_ELEMENTS:
+        for handle in drawings[element].handles:
+            if type(handle).__name__ == "LabelHandle":
+                handles.append(handle)
+    return handles
+
+
+@pytest.mark.parametrize("view", ["default", "along-L", "side"])
+def test_labels_stand_apart_and_off_the_contact_point(poinsot_app, open_page, view):
+    """The labels' pixels (a picture with them against one without) fall into one patch per
+    label, none of them on the contact point's marker."""
+    page = open_page(poinsot_app.url, width=1280, height=800)
+    session = started(poinsot_app, frames=40)
+    pause(page, session)
+    page.click_button(view)
+    page.page.wait_for_timeout(1500)
+    session.lecture.display.lay_out_labels()
+    page.page.wait_for_timeout(800)
+    shown = page.screenshot_rgb().astype(int)
+    handles = label_handles(session)
+    assert len(handles) == 7
+    for handle in handles:
+        handle.visible = False
+    page.page.wait_for_timeout(800)
+    hidden = page.screenshot_rgb().astype(int)
+    for handle in handles:
+        handle.visible = True
+    box = page.canvas_box()
+    mask = np.abs(shown - hidden).sum(axis=2) > 60
+    mask[:, : int(box["x"])] = mask[:, int(box["x"] + box["width"]) :] = False
+    patches, count = ndimage.label(mask)  # a label's box is solid: one patch per box
+    sizes = ndimage.sum(mask, patches, range(1, count + 1))
+    patches_seen = int(np.sum(sizes > 40))
+    camera = browser_camera(session.client)
+    on_screen = 0
+    for handle in handles:
+        xy, depth = camera.project(np.asarray(handle_world(session, handle)))
+        x, y = xy[0]
+        on_screen += int(depth[0] > 0 and 0 <= x < camera.width and 0 <= y < camera.height)
+    assert patches_seen >= on_screen, (patches_seen, on_screen)
+    # The contact point's marker is not under a label.
+    xy, _ = camera.project(np.asarray(session.frame.contact))
+    cx, cy = xy[0]
+    cx, cy = int(round(cx + box["x"])), int(round(cy + box["y"]))
+    assert not mask[cy - 4 : cy + 5, cx - 4 : cx + 5].any(), "a label covers the contact point"
+    assert page.errors == []
+
+
+def handle_world(session, handle) -> np.ndarray:
+    """A label's point in world coordinates (its parent frame's pose applied)."""
+    from poinsot.app.scene.frames import rotation_from_wxyz
+
+    position = np.asarray(handle.position, float)
+    if "/body/" in handle.name:
+        return rotation_from_wxyz(session.frame.wxyz).apply(position)
+    if "/tip/" in handle.name:
+        return np.asarray(session.frame.contact) + position
+    return position
+
+
+# -- 9. the light theme is readable ----------------------------------------------------------
+@pytest.mark.parametrize("theme", THEMES)
+def test_plot_ticks_and_button_text_are_readable(poinsot_app, open_page, theme):
+    from PIL import Image
+
+    page = open_page(poinsot_app.url, width=1280, height=800)
+    session = started(poinsot_app)
+    set_theme(page, session, theme)
+    # The outlined buttons of a button group: their text against the panel.
+    style = page.page.get_by_role("button", name="minor axis", exact=True).evaluate(
+        "b => { const s = getComputedStyle(b); let e = b, bg = 'rgba(0, 0, 0, 0)';"
+        " while (e && (bg === 'rgba(0, 0, 0, 0)' || bg === 'transparent'))"
+        " { bg = getComputedStyle(e).backgroundColor; e = e.parentElement; }"
+        " return [s.color, bg]; }"
+    )
+    text, ground = css_rgb(style[0]), css_rgb(style[1])
+    assert contrast(text, ground) >= 4.5, (theme, style)
+    # The plot's y tick labels (drawn on its canvas, in the column left of the curves): their
+    # ink stands out from the plot's background by 4.5 : 1 at least.
+    plot = page.page.locator(".uplot-container").first
+    plot.wait_for(state="visible", timeout=20000)
+    page.page.wait_for_timeout(1500)
+    import io
+
+    image = np.asarray(Image.open(io.BytesIO(plot.screenshot())).convert("RGB")).astype(float)
+    height, width = image.shape[:2]
+    background = tuple(np.median(image.reshape(-1, 3), axis=0))
+    ticks = image[int(0.15 * height) : int(0.7 * height), : int(0.15 * width)].reshape(-1, 3)
+    inked = [px for px in ticks if contrast(tuple(px), background) >= 4.5]
+    assert len(inked) >= 15, (theme, len(inked), background)
+    assert page.errors == []
+
+
+# -- 10. no console error when widgets come and go --------------------------------------------
+STALL_JS = "(ms) => { const t = Date.now(); while (Date.now() - t < ms) {} }"
+
+
+def test_sphere_and_custom_alternate_without_console_errors(poinsot_app, open_page):
+    """Switched back and forth by the dropdown, some switches made while the browser's main
+    thread is blocked for longer than a retired widget's delay (as software WebGL compiling a
+    new scene's shaders does): no update ever reaches a widget the browser no longer has."""
+    import threading
+
+    page = open_page(poinsot_app.url, width=1280, height=800)
+    session = started(poinsot_app)
+    sphere = preset_by_key("sphere")
+    for n in range(8):
+        for preset in (sphere, CUSTOM):
+            if n % 2:  # the server switches while the page is frozen
+                timer = threading.Timer(0.3, lambda p=preset: session.choose_preset(p))
+                timer.start()
+                page.page.evaluate(STALL_JS, 2500)
+                timer.join()
+            else:
+                page.choose("Preset", preset.label)
+            assert wait_until(lambda p=preset: session.preset is p, 10)
+            page.page.wait_for_timeout(300)
+    page.page.wait_for_timeout(2500)
+    assert page.errors == []
+    assert session.stats.errors == 0, session.stats.last_error
+
+
+# -- projector mode and the two views ---------------------------------------------------------
+def test_projector_mode_folds_the_panels_and_thickens_the_picture(poinsot_app, open_page):
+    page = open_page(poinsot_app.url, width=1280, height=800)
+    session = started(poinsot_app, frames=40)
+    pause(page, session)
+    page.page.wait_for_timeout(800)
+    before_box = page.canvas_box()
+    before = hue_mask(page.screenshot_rgb(), session.scene.look.herpolhode).sum()
+    root = "parseFloat(getComputedStyle(document.documentElement).fontSize)"
+    base_font = page.page.evaluate(root)
+    page.set_checkbox("Projector mode", True)
+    assert wait_until(lambda: session.lecture.display.style.projector, 10)
+    look = session.scene.look
+    assert look is palette.look(True, projector=True)
+    assert wait_until(lambda: page.canvas_box()["width"] > 0.85 * 1280, 10), page.canvas_box()
+    page.page.wait_for_timeout(1500)
+    after = hue_mask(page.screenshot_rgb(), look.herpolhode).sum()
+    assert after > 1.6 * before, (before, after)
+    assert before_box["width"] < 0.6 * 1280
+    # A column opened from its strip shows its text large.
+    session.client.gui.main_panel.expand()
+    assert wait_until(lambda: page.page.evaluate(root) >= base_font * 1.45, 10)
+    session.client.gui.main_panel.minimize()
+    # Key P switches it off again: the columns are back.
+    page.page.mouse.click(640, 790)
+    page.page.keyboard.press("p")
+    assert wait_until(lambda: not session.lecture.display.style.projector, 10)
+    assert wait_until(lambda: page.canvas_box()["width"] < 0.6 * 1280, 10)
+    assert PROJECTOR_TEXT_PERCENT >= 140
+    assert page.errors == []
+
+
+def test_two_views_show_the_body_frame_beside_the_space_frame(poinsot_app, open_page):
+    """The space frame (left: the herpolhode on the plane) and the body frame (right: the
+    ellipsoid with its polhode, no herpolhode), side by side."""
+    page = open_page(poinsot_app.url, width=1280, height=800)
+    session = started(poinsot_app, frames=40)
+    page.set_checkbox("Two views: space | body", True)
+    assert wait_until(lambda: session.lecture.display.body_view is not None, 10)
+    page.page.wait_for_timeout(2500)
+    pause(page, session)
+    page.page.wait_for_timeout(800)
+    rgb, box = canvas_slice(page)
+    x0, x1 = int(box["x"]), int(box["x"] + box["width"])
+    middle = (x0 + x1) // 2
+    look = session.scene.look
+    herpolhode, polhode = hue_mask(rgb, look.herpolhode), hue_mask(rgb, look.polhode)
+    # The translucent ellipsoid comes out a dim amber on the dark background.
+    ellipsoid = hue_mask(rgb, look.ellipsoid, tolerance=12.0, saturation=0.4, brightness=0.12)
+    left, right = slice(x0, middle), slice(middle, x1)
+    assert herpolhode[:, left].sum() > 100 and herpolhode[:, right].sum() < 20
+    assert polhode[:, left].sum() > 50 and polhode[:, right].sum() > 50
+    assert ellipsoid[:, right].sum() > 2000, ellipsoid[:, right].sum()
+    # The pictures' titles say which frame is which.
+    assert session.lecture.display.body_view.titles[1].text.startswith("body frame")
+    page.page.keyboard.press("v")  # key V: back to one view
+    assert wait_until(lambda: session.lecture.display.body_view is None, 10)
+    assert page.errors == []
