@@ -25,7 +25,15 @@ import viser
 from poinsot.app.elements import Control, Element, Plot
 from poinsot.app.live.legend import caption
 from poinsot.app.live.motion_window import MotionWindow
-from poinsot.app.live.widgets import Removable, Retirement, Shelf, set_marks, set_value
+from poinsot.app.live.widgets import (
+    Removable,
+    Retirement,
+    Sent,
+    Shelf,
+    on_user,
+    set_marks,
+    set_value,
+)
 from poinsot.app.parameters import (
     INERTIA_RANGE,
     OMEGA_NORM_RANGE,
@@ -165,25 +173,11 @@ class ControlPanel:
         self.motion = MotionWindow(gui, order=_ORDER["readouts"])
         self._on_user(self.preset, self._choose_preset)
 
-    def _on_user(self, handle: H, callback: Callable[[H], None]) -> H:
-        """Run ``callback(handle)`` for changes made in the browser only (a value set by the
-        server fires the same callbacks, with no client); never let it raise into viser."""
+    def _on_user(self, handle: H, callback: Callable[[Sent], None]) -> H:
+        """Run ``callback(sent)`` for changes made in the browser only (:func:`on_user`)."""
+        return on_user(handle, callback, self.actions.report)
 
-        def wrapped(event: viser.GuiEvent[Any]) -> None:
-            if event.client is None:
-                return
-            try:
-                callback(handle)
-            except Exception as exc:
-                self.actions.report(exc)
-
-        if isinstance(handle, viser.GuiButtonHandle | viser.GuiButtonGroupHandle):
-            handle.on_click(wrapped)
-        else:
-            handle.on_update(wrapped)
-        return handle
-
-    def _choose_preset(self, handle: viser.GuiDropdownHandle[str]) -> None:
+    def _choose_preset(self, handle: Sent) -> None:
         for p in MENU:
             if p.label == handle.value:
                 self.actions.choose_preset(p)
@@ -307,8 +301,8 @@ class ControlPanel:
         self.widgets.inertia = tuple(sliders)
         return list(sliders)
 
-    def _inertia_callback(self, index: int) -> Callable[[viser.GuiSliderHandle[float]], None]:
-        def callback(handle: viser.GuiSliderHandle[float]) -> None:
+    def _inertia_callback(self, index: int) -> Callable[[Sent], None]:
+        def callback(handle: Sent) -> None:
             value = float(handle.value)
             self.actions.edit(lambda p: p.with_inertia(index, value))
 
@@ -328,7 +322,7 @@ class ControlPanel:
                 hint="Energy parameter in [I_min, I_max]; D = I₂ (its mark) is the separatrix.",
             )
 
-        def move(handle: viser.GuiSliderHandle[float]) -> None:
+        def move(handle: Sent) -> None:
             value = float(handle.value)
             self.actions.edit(lambda p: p.with_D(value, snap=D_STEP / 2))
 
@@ -349,11 +343,11 @@ class ControlPanel:
             side = self.gui.add_button_group("Side of separatrix", SIDE_OPTIONS, order=1.0)
             pole = self.gui.add_button_group("Polhode", POLE_OPTIONS, order=2.0)
 
-        def choose_side(handle: viser.GuiButtonGroupHandle) -> None:
+        def choose_side(handle: Sent) -> None:
             choice = "major" if handle.value == SIDE_OPTIONS[1] else "minor"
             self.actions.edit(lambda p: p.mirrored(choice))
 
-        def choose_pole(handle: viser.GuiButtonGroupHandle) -> None:
+        def choose_pole(handle: Sent) -> None:
             sign = 1 if handle.value == POLE_OPTIONS[0] else -1
             self.actions.edit(lambda p: p.with_pole(sign))
 
@@ -371,7 +365,7 @@ class ControlPanel:
                 hint="Initial angular speed (rad per time unit).",
             )
 
-        def move(handle: viser.GuiSliderHandle[float]) -> None:
+        def move(handle: Sent) -> None:
             value = float(handle.value)
             self.actions.edit(lambda p: p.with_omega_norm(value))
 
@@ -440,7 +434,7 @@ class ControlPanel:
             if element in elements:
                 set_value(box, visible(element))
 
-    def _visibility_callback(self, element: Element) -> Callable[[viser.GuiCheckboxHandle], None]:
+    def _visibility_callback(self, element: Element) -> Callable[[Sent], None]:
         return lambda handle: self.actions.set_visible(element, bool(handle.value))
 
     # -- mirroring the session's state ---------------------------------------------------

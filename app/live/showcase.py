@@ -19,7 +19,7 @@ import viser
 import viser.uplot
 
 from poinsot.app.live.motion_window import MotionWindow
-from poinsot.app.live.widgets import Removable, Retirement
+from poinsot.app.live.widgets import Removable, Retirement, Sent, on_user
 from poinsot.app.scene import palette
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
@@ -81,20 +81,9 @@ class LiveShowcase:
         self.widgets.extend(self.plots.values())
 
     # -- widgets (callbacks run on viser's threads) --------------------------------------
-    def _on_user(self, handle: Any, callback: Callable[[Any], None]) -> Any:
-        def wrapped(event: viser.GuiEvent[Any]) -> None:
-            if event.client is None:  # a value set by the server
-                return
-            try:
-                callback(handle)
-            except Exception as exc:  # never raise into viser
-                self.actions.report(exc)
-
-        if isinstance(handle, viser.GuiButtonGroupHandle):
-            handle.on_click(wrapped)
-        else:
-            handle.on_update(wrapped)
-        return handle
+    def _on_user(self, handle: Any, callback: Callable[[Sent], None]) -> Any:
+        """Run ``callback(sent)`` for changes made in the browser only (:func:`on_user`)."""
+        return on_user(handle, callback, self.actions.report)
 
     def _add_control(self, control: SceneControl, order: float) -> Removable:
         gui = self.gui
@@ -123,7 +112,7 @@ class LiveShowcase:
         return self._on_user(dropdown, self._choice_callback(control))
 
     def _slider_callback(self, control: Slider) -> Callable[[Any], None]:
-        def callback(handle: viser.GuiSliderHandle[float]) -> None:
+        def callback(handle: Sent) -> None:
             self.actions.configure_scene(control.key, float(handle.value))
 
         return callback
@@ -138,7 +127,7 @@ class LiveShowcase:
 
         return callback
 
-    def _part_callback(self, part: str) -> Callable[[viser.GuiCheckboxHandle], None]:
+    def _part_callback(self, part: str) -> Callable[[Sent], None]:
         return lambda handle: self.actions.set_part_visible(part, bool(handle.value))
 
     # -- frame thread --------------------------------------------------------------------

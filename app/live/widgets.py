@@ -18,8 +18,9 @@ against every stall, so:
 
 from __future__ import annotations
 
+import asyncio
 import time
-from collections.abc import Hashable, Iterable
+from collections.abc import Callable, Hashable, Iterable
 from typing import Any, Protocol, TypeVar
 
 import viser
@@ -107,3 +108,44 @@ def set_marks(slider: viser.GuiSliderHandle[Any], marks: Iterable[tuple[float, s
     """Move a slider's labelled marks. viser 1.1 takes marks only as an argument of
     ``add_slider``; a handle's ``marks`` attribute is not sent, the ``_marks`` property is."""
     slider._marks = tuple(GuiSliderMark(value=float(v), label=label) for v, label in marks)
+
+
+class Sent:
+    """The value a browser last sent for one widget, recorded on viser's event loop as its
+    message arrives. A callback runs later on a worker thread; by then the server may have
+    written the widget again (a preset shown, a slider snapped), and ``handle.value`` would
+    hand it the server's stale value instead of the user's choice. ``Sent`` never does."""
+
+    __slots__ = ("value",)
+
+    def __init__(self, value: Any) -> None:
+        self.value = value
+
+
+def on_user(
+    handle: Any, callback: Callable[[Sent], None], report: Callable[[Exception], None]
+) -> Any:
+    """Run ``callback(sent)`` for changes made in a browser only (a value set by the server
+    fires the same viser callbacks, with no client). The callback runs on a worker thread,
+    never raises into viser (``report`` gets the exception) and reads, as ``sent.value``, the
+    value the browser sent last: two quick changes may run out of order, both read the later."""
+    sent = Sent(getattr(handle, "value", None))
+
+    def run() -> None:
+        try:
+            callback(sent)
+        except Exception as exc:
+            report(exc)
+
+    async def received(event: viser.GuiEvent[Any]) -> None:
+        if event.client is None:
+            return
+        if hasattr(handle, "value"):
+            sent.value = handle.value
+        asyncio.get_running_loop().run_in_executor(None, run)  # never waits on the callback
+
+    if isinstance(handle, viser.GuiButtonHandle | viser.GuiButtonGroupHandle):
+        handle.on_click(received)
+    else:
+        handle.on_update(received)
+    return handle

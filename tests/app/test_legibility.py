@@ -122,6 +122,41 @@ def test_switching_sphere_and_custom_deletes_no_panel_widget(poinsot_app, probe)
     assert session.stats.errors == 0, session.stats.last_error
 
 
+def test_a_callback_reads_the_users_value_not_a_later_server_write(make_probe):
+    """viser runs a widget's callback on a worker thread, after the browser's message has set
+    the value. If the server writes the widget in between (a preset being shown), the callback
+    must still act on what the user chose; reading ``handle.value`` it chose the stale preset
+    again, and the session never reached the user's."""
+    import threading
+
+    import viser
+
+    from poinsot.app.live.probe import Probe
+    from poinsot.app.live.widgets import on_user
+
+    server = viser.ViserServer("127.0.0.1", 0, verbose=False)
+    try:
+        dropdown = server.gui.add_dropdown("Preset", ("Sphere", "Custom"), initial_value="Sphere")
+        release, seen, errors = threading.Event(), [], []
+
+        def callback(sent) -> None:
+            release.wait(10)
+            seen.append(sent.value)
+
+        on_user(dropdown, callback, errors.append)
+        with Probe(server.get_port()) as probe:
+            assert probe.wait_for(lambda p: "Preset" in p.labels(), 10)
+            uuid, _ = probe.widget("Preset")
+            probe.set_value(uuid, "Custom")
+            assert wait_until(lambda: dropdown.value == "Custom", 10)
+            dropdown.value = "Sphere"  # the server shows the preset it is still applying
+            release.set()
+            assert wait_until(lambda: seen != [], 10)
+        assert seen == ["Custom"] and errors == []
+    finally:
+        server.stop()
+
+
 # -- a stalled frame loop -------------------------------------------------------------------
 def _off_surface(segments: np.ndarray, semi_axes: np.ndarray) -> float:
     """Largest relative distance from the ellipsoid of a segment's end and midpoint points, as
