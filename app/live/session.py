@@ -4,13 +4,12 @@ Threads: viser runs GUI callbacks on its thread pool; they only post small actio
 session's queue and wake its frame thread, which alone touches the scene and the body. So a
 callback never blocks and never raises into viser, a slider drag is coalesced into one rebuild
 per wake-up, and a slow or departed browser never stalls another (each session has its own
-thread; viser gives each client its own send buffer, where newer poses replace unsent ones).
+thread; viser gives each client its own send buffer, and :mod:`poinsot.app.live.pacing` sends
+a client a new frame only once it has taken the ones before, so that buffer never grows).
 """
 
 from __future__ import annotations
 
-import collections
-import dataclasses
 import functools
 import logging
 import queue
@@ -26,6 +25,7 @@ from poinsot.app.live.budget import FrameBudget
 from poinsot.app.live.clock import SimClock
 from poinsot.app.live.ghost_controls import add_ghost_controls
 from poinsot.app.live.lecture import add_lecture_controls
+from poinsot.app.live.pacing import Outbox, Pacer, SessionStats
 from poinsot.app.live.panel import ControlPanel
 from poinsot.app.live.showcase import LiveShowcase
 from poinsot.app.live.uploads import UploadControls
@@ -53,28 +53,6 @@ YIELD_SECONDS = 0.002
 HOLD_SECONDS = 0.05
 
 
-@dataclasses.dataclass
-class SessionStats:
-    """Timings for the benchmark and the tests (seconds)."""
-
-    frame_seconds: collections.deque = dataclasses.field(
-        default_factory=lambda: collections.deque(maxlen=2000)
-    )
-    #: CPU time of the session thread per loop pass that drew a frame: everything Poinsot
-    #: does for one client-frame (actions, physics, scene updates, plot and time readout, and
-    #: viser's setters that queue the messages), but not viser's transport thread.
-    frame_cpu_seconds: collections.deque = dataclasses.field(
-        default_factory=lambda: collections.deque(maxlen=2000)
-    )
-    rebuild_seconds: collections.deque = dataclasses.field(
-        default_factory=lambda: collections.deque(maxlen=500)
-    )
-    frames: int = 0
-    rebuilds: int = 0
-    errors: int = 0
-    last_error: str = ""
-
-
 class Session:
     """Create on client connect (:meth:`start` launches the frame thread), :meth:`close` on
     disconnect."""
@@ -89,11 +67,14 @@ class Session:
         budget: FrameBudget | None = None,
         scene: SceneSpec | None = None,
     ) -> None:
-        """``budget``: the server's shared frame-rate governor (one per session if None);
-        ``scene``: start with this scene (:mod:`poinsot.app.scenes`) instead of ``preset``."""
+        """``budget``: the server's shared budget, through which a rebuild goes first (one per
+        session if None); ``scene``: start with this scene (:mod:`poinsot.app.scenes`) instead
+        of ``preset``. The frame rate is this client's own (:class:`Pacer`)."""
         self.client = client
         self.max_fps = float(max_fps)
         self.budget = budget if budget is not None else FrameBudget(max_fps=max_fps)
+        #: This client's frame rate: as many frames as it takes, up to ``max_fps``.
+        self.pacer = Pacer(Outbox(client), max_fps=self.max_fps)
         self.stats = SessionStats()
         self.clock = SimClock(speed=preset.speed)
         self.preset = preset
@@ -268,15 +249,26 @@ class Session:
                 if now >= next_frame and self.budget.rebuilding and now - due < HOLD_SECONDS:
                     next_frame = now + YIELD_SECONDS  # a slider move elsewhere goes first
                 elif now >= next_frame:
-                    next_frame = due = now + 1.0 / min(self.max_fps, self.budget.fps)
-                    self._advance()
-                    self._refresh(now)
-                    drawn = True
+                    drawn = self._frame_if_taken(now)
+                    next_frame = due = now + self.pacer.interval
             except Exception as exc:  # the loop must survive anything; the user sees it
                 self._report(exc)
                 next_frame = time.monotonic() + 1.0 / self.max_fps
             if drawn:
                 self.stats.frame_cpu_seconds.append(time.thread_time() - cpu0)
+
+    def _frame_if_taken(self, now: float) -> bool:
+        """Draw a frame, unless the browser has not yet taken the frames sent before
+        (:class:`Pacer`: the frame is skipped and this client's rate lowered). One frame's
+        messages (poses, traces, labels, plot, readouts) go out as one atomic window."""
+        if not self.pacer.may_draw():
+            self.stats.skipped += 1
+            return False
+        with self.client.atomic():
+            self._advance()
+            self._refresh(now)
+        self.pacer.sent()
+        return True
 
     def _refresh(self, now: float) -> None:
         """After a frame: the plot at PLOT_HZ, the time readout (and retired widgets) at
@@ -317,7 +309,6 @@ class Session:
         self.ghost.on_frame(self.frame)
         self.stats.frame_seconds.append(time.perf_counter() - start)
         self.stats.frames += 1
-        self.budget.frame_done()
 
     def _report(self, exc: BaseException) -> None:
         self.stats.errors += 1

@@ -1,0 +1,157 @@
+"""Outgoing frame rate per client: as many frames as the client takes, never a backlog.
+
+Each browser has its own send queue in viser (the client's message buffer, drained by a task
+on viser's event loop that hands windows of messages to the websocket). A frame's messages are
+*taken* when that task has drained them from the queue; it stops draining while the socket's
+write buffer is full (websockets waits for the socket to drain), that is while the browser, or
+the network to it, does not keep up. :class:`Outbox` reads, for one client, the id of the last
+message the frame put in the queue and how far the draining task has got.
+
+:class:`Pacer` is the session's frame-rate controller. After each frame it records the frame's
+last message id (:meth:`Pacer.sent`); before the next it asks how many frames are still
+queued (:meth:`Pacer.may_draw`): with more than MAX_IN_FLIGHT, the frame is skipped (the time
+shown jumps forward at the next one; the traces are filled from the exact solution) and the
+client's rate is halved; a frame taken on time lets the rate climb back to ``max_fps``. A
+client that reads nothing gets no new frames, so its queue holds at most MAX_IN_FLIGHT frames
+however long it stalls, while the other sessions (each its own thread and queue) go on.
+
+Nothing here caps the server as a whole: with many clients on few cores, the frames simply
+take longer to drain, and each client's rate settles where its frames are taken.
+"""
+
+from __future__ import annotations
+
+import collections
+import dataclasses
+from typing import Any
+
+import viser
+
+#: Frames a client may have queued, not yet taken, before the next frame is skipped.
+MAX_IN_FLIGHT = 1
+#: The slowest rate a stalled client is polled at [frames per second]: it costs one check.
+MIN_FPS = 2.0
+#: A frame taken on time raises the rate by this factor (a skip halves it).
+RAISE = 1.25
+
+
+class Outbox:
+    """How far one client's send queue has been taken (viser's per-client message buffer)."""
+
+    def __init__(self, client: viser.ClientHandle) -> None:
+        self.client_id = client.client_id
+        self._buffer: Any = _message_buffer(client)
+
+    @property
+    def available(self) -> bool:
+        return self._buffer is not None
+
+    def last_queued(self) -> int:
+        """The id of the last message put in the client's queue (-1: none)."""
+        return int(self._buffer.message_counter) - 1 if self._buffer is not None else -1
+
+    def last_taken(self) -> int:
+        """The id of the last message the client's sender has taken from the queue (every
+        message after it is still queued)."""
+        taken = None if self._buffer is None else self._buffer.generator_cursors.get(self.client_id)
+        return self.last_queued() if taken is None else int(taken)  # no sender yet: nothing due
+
+    def pending(self) -> int:
+        """Messages in the client's queue now (after viser's coalescing of updates)."""
+        return len(self._buffer.message_from_id) if self._buffer is not None else 0
+
+
+def _message_buffer(client: viser.ClientHandle) -> Any:
+    """viser 1.1 keeps the queue on the client's connection; None if that ever changes (the
+    pacer then never skips: the behaviour before pacing)."""
+    connection = getattr(client, "_websock_connection", None)
+    getter = getattr(connection, "get_message_buffer", None)
+    if getter is None:
+        return None
+    buffer = getter()
+    needed = ("message_counter", "generator_cursors", "message_from_id")
+    return buffer if all(hasattr(buffer, name) for name in needed) else None
+
+
+@dataclasses.dataclass
+class PacerStats:
+    drawn: int = 0
+    skipped: int = 0
+    #: The most frames ever found queued before a frame (bounded by MAX_IN_FLIGHT + 1).
+    max_in_flight: int = 0
+
+
+class Pacer:
+    """A client's frame rate (see the module's docstring). Frame thread only."""
+
+    def __init__(
+        self,
+        outbox: Outbox,
+        max_fps: float = 60.0,
+        min_fps: float = MIN_FPS,
+        max_in_flight: int = MAX_IN_FLIGHT,
+    ) -> None:
+        self.outbox = outbox
+        self.max_fps = float(max_fps)
+        self.min_fps = min(float(min_fps), self.max_fps)
+        self.max_in_flight = int(max_in_flight)
+        self.fps = self.max_fps
+        self.stats = PacerStats()
+        self._marks: collections.deque[int] = collections.deque()
+
+    @property
+    def interval(self) -> float:
+        """Seconds to the next frame at the client's current rate."""
+        return 1.0 / self.fps
+
+    def in_flight(self) -> int:
+        """Frames drawn whose messages the client has not all taken yet."""
+        taken = self.outbox.last_taken()
+        marks = self._marks
+        while marks and marks[0] <= taken:
+            marks.popleft()
+        return len(marks)
+
+    def may_draw(self) -> bool:
+        """Before a frame: False (and a lower rate) while the client has too many frames
+        queued; otherwise True (and a higher rate if the client keeps up)."""
+        queued = self.in_flight()
+        self.stats.max_in_flight = max(self.stats.max_in_flight, queued)
+        if queued > self.max_in_flight:
+            self.fps = max(self.min_fps, 0.5 * self.fps)
+            self.stats.skipped += 1
+            return False
+        if queued <= 1:
+            self.fps = min(self.max_fps, RAISE * self.fps)
+        return True
+
+    def sent(self) -> None:
+        """After a frame: remember its last message, to know when the client has taken it."""
+        self.stats.drawn += 1
+        last = self.outbox.last_queued()
+        if not self._marks or last > self._marks[-1]:
+            self._marks.append(last)
+
+
+@dataclasses.dataclass
+class SessionStats:
+    """Timings for the benchmark and the tests (seconds)."""
+
+    frame_seconds: collections.deque = dataclasses.field(
+        default_factory=lambda: collections.deque(maxlen=2000)
+    )
+    #: CPU time of the session thread per loop pass that drew a frame: everything Poinsot
+    #: does for one client-frame (actions, physics, scene updates, plot and time readout, and
+    #: viser's setters that queue the messages), but not viser's transport thread.
+    frame_cpu_seconds: collections.deque = dataclasses.field(
+        default_factory=lambda: collections.deque(maxlen=2000)
+    )
+    rebuild_seconds: collections.deque = dataclasses.field(
+        default_factory=lambda: collections.deque(maxlen=500)
+    )
+    frames: int = 0
+    #: Frames not drawn because the browser had not taken the ones before (pacing).
+    skipped: int = 0
+    rebuilds: int = 0
+    errors: int = 0
+    last_error: str = ""
