@@ -26,7 +26,6 @@ Only anchors and these offsets change, and only when they do: a label rides on i
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 from collections.abc import Sequence
 
@@ -67,11 +66,15 @@ class Camera:
     height: float
 
     def axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The camera's forward, right and up unit vectors (world)."""
-        return self._axes
+        """The camera's forward, right and up unit vectors (world), computed once (kept in the
+        instance without ``functools.cached_property``, whose lock all threads shared)."""
+        axes = self.__dict__.get("_axes")
+        if axes is None:
+            axes = self._compute_axes()
+            object.__setattr__(self, "_axes", axes)
+        return axes
 
-    @functools.cached_property
-    def _axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _compute_axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         forward = np.asarray(self.look_at, float) - np.asarray(self.position, float)
         forward /= np.linalg.norm(forward)
         right = np.cross(forward, self.up)
@@ -132,31 +135,44 @@ class Placement:
     overlap: float
 
 
-def _costs(
-    boxes: np.ndarray,
-    placed: np.ndarray,
-    centres: np.ndarray,
-    radii: np.ndarray,
-    weights: np.ndarray,
+def _overlap_costs(boxes: np.ndarray, placed: np.ndarray) -> np.ndarray:
+    """The overlap of each candidate box (K, 4) with the boxes placed (M, 4), each grown by
+    GAP_PX, times LABEL_WEIGHT."""
+    w = np.minimum(boxes[:, None, 2], placed[None, :, 2])
+    w = w - np.maximum(boxes[:, None, 0], placed[None, :, 0]) + GAP_PX
+    h = np.minimum(boxes[:, None, 3], placed[None, :, 3])
+    h = h - np.maximum(boxes[:, None, 1], placed[None, :, 1]) + GAP_PX
+    return LABEL_WEIGHT * np.sum(np.maximum(w, 0.0) * np.maximum(h, 0.0), axis=1)
+
+
+def _disc_costs(
+    boxes: np.ndarray, centres: np.ndarray, radii: np.ndarray, weights: np.ndarray
 ) -> np.ndarray:
-    """The cost of each candidate box (K, 4): its overlap with the boxes placed (M, 4), each
-    grown by GAP_PX, times LABEL_WEIGHT, plus its weighted reach into the discs (D)."""
+    """The weighted reach of each candidate box (K, 4) into the discs (D): it does not depend
+    on the other labels, so every label's candidates are costed in one pass. A box farther
+    than a disc's radius from it along x or y cannot reach it (cost 0): only the boxes near
+    some disc get the exact sum."""
     cost = np.zeros(len(boxes))
-    if len(placed):
-        w = np.minimum(boxes[:, None, 2], placed[None, :, 2])
-        w = w - np.maximum(boxes[:, None, 0], placed[None, :, 0]) + GAP_PX
-        h = np.minimum(boxes[:, None, 3], placed[None, :, 3])
-        h = h - np.maximum(boxes[:, None, 1], placed[None, :, 1]) + GAP_PX
-        cost += LABEL_WEIGHT * np.sum(np.maximum(w, 0.0) * np.maximum(h, 0.0), axis=1)
-    if len(centres):
-        nearest = np.minimum(np.maximum(centres[None], boxes[:, None, :2]), boxes[:, None, 2:])
-        gap = nearest - centres[None]
-        reach = radii[None, :] + GAP_PX - np.hypot(gap[..., 0], gap[..., 1])
-        cost += np.sum(weights[None, :] * np.maximum(reach, 0.0) ** 2, axis=1)
+    if not len(centres):
+        return cost
+    cx, cy, limit = centres[None, :, 0], centres[None, :, 1], (radii + GAP_PX)[None, :]
+    near_x = (boxes[:, None, 0] - cx < limit) & (cx - boxes[:, None, 2] < limit)
+    near_y = (boxes[:, None, 1] - cy < limit) & (cy - boxes[:, None, 3] < limit)
+    rows = np.flatnonzero(np.any(near_x & near_y, axis=1))
+    if not len(rows):
+        return cost
+    near = boxes[rows]
+    nearest = np.minimum(np.maximum(centres[None], near[:, None, :2]), near[:, None, 2:])
+    gap = nearest - centres[None]
+    reach = radii[None, :] + GAP_PX - np.hypot(gap[..., 0], gap[..., 1])
+    cost[rows] = np.sum(weights[None, :] * np.maximum(reach, 0.0) ** 2, axis=1)
     return cost
 
 
 _ANCHOR_NAMES = tuple(ANCHORS)
+_ANCHOR_INDEX = {name: i for i, name in enumerate(_ANCHOR_NAMES)}
+#: Each anchor's (fx, fy), in the order of _ANCHOR_NAMES.
+_FRACTIONS = np.array(list(ANCHORS.values()), dtype=np.float64)
 #: The unit direction (screen, y down) in which each anchor's box lies from its point.
 _ANCHOR_DIRECTIONS = np.array([[fx + 0.5, fy + 0.5] for fx, fy in ANCHORS.values()])
 _ANCHOR_DIRECTIONS /= np.linalg.norm(_ANCHOR_DIRECTIONS, axis=1)[:, None]
@@ -165,9 +181,11 @@ _ANCHOR_DIRECTIONS /= np.linalg.norm(_ANCHOR_DIRECTIONS, axis=1)[:, None]
 def _ranked(direction: np.ndarray, current: str) -> list[str]:
     """Anchors, the one whose box lies most along ``direction`` (screen) first; the current
     anchor wins ties, so that a label does not flicker between equals."""
-    score = -(_ANCHOR_DIRECTIONS @ direction)
-    score -= 1e-3 * np.array([name == current for name in _ANCHOR_NAMES])
-    return [_ANCHOR_NAMES[i] for i in np.argsort(score, kind="stable")]
+    score = (-(_ANCHOR_DIRECTIONS @ direction)).tolist()
+    if current in _ANCHOR_INDEX:
+        score[_ANCHOR_INDEX[current]] -= 1e-3
+    # A stable sort of a few floats: Python's is much cheaper than numpy's on 8 elements.
+    return [_ANCHOR_NAMES[i] for i in sorted(range(len(score)), key=score.__getitem__)]
 
 
 def _outward(*candidates: np.ndarray) -> np.ndarray:
@@ -191,6 +209,17 @@ MARKER_WEIGHT = 5.0
 PUSH_RINGS = 3
 
 
+@dataclasses.dataclass(frozen=True)
+class _Candidates:
+    """A label's places to try, best first: anchors, screen shifts (K, 2), boxes (K, 4)."""
+
+    slot: Slot
+    depth: float
+    anchors: list[str]
+    shifts: np.ndarray
+    boxes: np.ndarray
+
+
 def lay_out(
     slots: Sequence[Slot],
     camera: Camera,
@@ -199,33 +228,61 @@ def lay_out(
 ) -> dict[str, Placement]:
     """Place ``slots`` in their order (most important first); ``markers``: (world point,
     radius [CSS px]) that no box may cover; ``arrows``: (start, end, half-width [CSS px]) that
-    the boxes avoid crossing. Labels behind the camera keep their anchor."""
-    _, right, up = camera.axes()
-    centres, radii, weights = _discs(camera, markers, arrows)
-    placed_boxes = np.zeros((0, 4))
+    the boxes avoid crossing. Labels behind the camera keep their anchor.
+
+    A candidate's cost is its overlap with the labels placed before it (LABEL_WEIGHT) plus its
+    reach into the markers and arrows; the first candidate of cost 0 wins, else the cheapest.
+    The second part is the same whatever the order, so it is computed for all labels at once
+    and only the first is computed per label (a layout is a few numpy calls per label)."""
     placed: dict[str, Placement] = {}
     if not slots:
         return placed
+    _, right, up = camera.axes()
     points = np.array([[slot.point, slot.tip, slot.root] for slot in slots], float)
     screen, depths = camera.project(points.reshape(-1, 3))
     screen, depths = screen.reshape(-1, 3, 2), depths.reshape(-1, 3)
-    for slot, (point, tip, root), depth in zip(slots, screen, depths[:, 0], strict=True):
-        if depth <= 0:
-            continue
-        direction = _outward(tip - root, point - tip)
-        anchors, shifts = _options(slot, point, tip, direction)
-        width, height = box_size(slot.text, slot.scale)
-        corner = point + shifts + np.array([ANCHORS[a] for a in anchors]) * (width, height)
-        boxes = np.concatenate([corner, corner + (width, height)], axis=1)
-        cost = _costs(boxes, placed_boxes, centres, radii, weights)
+    candidates = [
+        _candidates(slot, point, tip, root, float(depth))
+        for slot, (point, tip, root), depth in zip(slots, screen, depths[:, 0], strict=True)
+        if depth > 0
+    ]
+    if not candidates:
+        return placed
+    reach = _disc_costs(
+        np.concatenate([c.boxes for c in candidates]), *_discs(camera, markers, arrows)
+    )
+    placed_boxes: list[np.ndarray] = []
+    start = 0
+    for c in candidates:
+        cost = reach[start : start + len(c.boxes)]
+        start += len(c.boxes)
+        if placed_boxes:
+            cost = _overlap_costs(c.boxes, np.array(placed_boxes)) + cost
         free = np.flatnonzero(cost == 0.0)
         k = int(free[0]) if len(free) else int(np.argmin(cost))
-        shift = shifts[k] * camera.world_per_px(float(depth))
+        shift = c.shifts[k] * camera.world_per_px(c.depth)
         offset = shift[0] * right - shift[1] * up
-        box = (float(boxes[k, 0]), float(boxes[k, 1]), float(boxes[k, 2]), float(boxes[k, 3]))
-        placed[slot.key] = Placement(anchors[k], offset, box, float(cost[k]))
-        placed_boxes = np.vstack([placed_boxes, boxes[k]])
+        box = c.boxes[k]
+        placed[c.slot.key] = Placement(
+            c.anchors[k],
+            offset,
+            (float(box[0]), float(box[1]), float(box[2]), float(box[3])),
+            float(cost[k]),
+        )
+        placed_boxes.append(box)
     return placed
+
+
+def _candidates(
+    slot: Slot, point: np.ndarray, tip: np.ndarray, root: np.ndarray, depth: float
+) -> _Candidates:
+    """The places to try for ``slot``, its point, tip and root on screen (see :func:`_options`)."""
+    direction = _outward(tip - root, point - tip)
+    anchors, shifts = _options(slot, point, tip, direction)
+    width, height = box_size(slot.text, slot.scale)
+    corner = point + shifts + _FRACTIONS[[_ANCHOR_INDEX[a] for a in anchors]] * (width, height)
+    boxes = np.concatenate([corner, corner + (width, height)], axis=1)
+    return _Candidates(slot, depth, anchors, shifts, boxes)
 
 
 def _discs(
@@ -265,6 +322,7 @@ def _anchor_towards(direction: np.ndarray) -> str:
 
 
 _DIRECTION_ANCHORS = [_anchor_towards(d) for d in _DIRECTIONS]
+_RINGS = np.arange(1, PUSH_RINGS + 1, dtype=np.float64)
 
 
 def _options(
@@ -278,9 +336,9 @@ def _options(
     if not slot.movable:
         return ranked, np.zeros((len(ranked), 2))
     reach = max(math.hypot(*(point - tip)), slot.clearance, 1.0)
-    order = np.argsort(-(_DIRECTIONS @ direction), kind="stable")
-    rings = np.arange(1, PUSH_RINGS + 1, dtype=np.float64)
-    pushes = rings[:, None, None] * reach * _DIRECTIONS[order][None, :, :]
+    score = (-(_DIRECTIONS @ direction)).tolist()
+    order = sorted(range(len(score)), key=score.__getitem__)  # stable, as np.argsort's
+    pushes = _RINGS[:, None, None] * reach * _DIRECTIONS[order][None, :, :]
     pushes = pushes.reshape(-1, 2) + (tip - point)
     anchors = [_DIRECTION_ANCHORS[i] for i in order] * PUSH_RINGS
     return anchors + ranked, np.vstack([pushes, np.zeros((len(ranked), 2))])
