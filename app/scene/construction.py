@@ -20,8 +20,11 @@ Sizes are in display units (:mod:`poinsot.app.scene.geometry`); the nodes of eac
 made by :mod:`poinsot.app.scene.nodes`.
 
 Traffic: :meth:`PoinsotScene.load` (once per parameter change) sends meshes, scales and
-static curves; :meth:`PoinsotScene.advance` (per frame) sends the body pose, the contact point,
-the omega arrow's tip, and trail increments only.
+static curves; :meth:`PoinsotScene.advance` (per frame) sends three messages: the body frame's
+``wxyz`` (everything that turns with the body is under ``/space/body``), the tip frame's
+position (the contact point's marker and the omega label ride on it) and the omega arrow's
+points; and every TRAIL_EVERY frames one message per trace. The labels' own messages come
+only when their layout changes an anchor or a push (:mod:`poinsot.app.scene.labels`).
 """
 
 from __future__ import annotations
@@ -53,9 +56,11 @@ MAX_CHORD = 0.02
 #: MAX_SAMPLES_PER_FRAME samples. Never a straight chord through the body.
 MAX_FILL_SAMPLES = 4096
 MAX_SAMPLES_PER_FRAME = 64
-#: The traces are sent every TRAIL_EVERY frames (30 Hz at 60 frames per second): half the
-#: messages, and the trace's end trails the contact point by at most one frame.
-TRAIL_EVERY = 2
+#: The traces are sent every TRAIL_EVERY frames (15 Hz at 60 frames per second), one message
+#: per trace (the head chunk's points): a quarter of the messages and of the head's resends.
+#: The trace's end trails the contact point (its marker covers it) by at most three frames,
+#: and is completed as soon as the time stands still (paused).
+TRAIL_EVERY = 4
 
 ROOT = "/space"
 #: The labels' order of importance: earlier ones choose their place first.
@@ -272,6 +277,9 @@ class PoinsotScene:
         k = sampler.index(float(t))
         last = self._k_last
         if k == last and self._frame is not None:
+            if self._pending:  # the time stands still: complete the traces
+                with self._atomic():
+                    self.flush_trails()
             return self._frame
         restart = last is None or k < last
         if last is None or k <= last:  # k == last: a redraw (new elements), same time

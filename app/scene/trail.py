@@ -2,10 +2,14 @@
 
 Viser resends a node's whole ``points`` array when it changes, so a single growing line would
 cost O(trail length) bytes per frame. Instead the trail is a ring of small line-segment nodes
-("chunks"): each frame only the head chunk (at most ``chunk`` segments) is resent; a full head
-is frozen and a new one started; the oldest chunks are removed once the trail is longer than
-its length. Bytes per frame are bounded by the chunk size; the length stays within one chunk
-below ``max_points``.
+("chunks"): each append only resends the head chunk (at most ``chunk`` segments), in one
+message unless the head fills; a full head is frozen and a new one started; the oldest chunks
+are dropped once the trail is longer than its length. Bytes per append are bounded by the chunk
+size; the length stays within one chunk below ``max_points``.
+
+A dropped chunk is not removed but kept as a spare, shrunk to one point of the trail (hidden
+under it), and reused as the next head: a chunk's node is made once, and in the steady state
+an append sends only ``points`` updates (making a node costs many times an update in viser).
 """
 
 from __future__ import annotations
@@ -17,6 +21,8 @@ import viser
 
 #: Segments per chunk: the most a frame resends (24 segments x 2 x 3 float32 = 576 bytes).
 CHUNK_SEGMENTS = 24
+#: Spare chunks kept for reuse (a shorter trail removes the rest).
+MAX_SPARE = 2
 
 
 class Trail:
@@ -45,6 +51,8 @@ class Trail:
         self._frozen: collections.deque[tuple[viser.LineSegmentsHandle, int]] = collections.deque()
         self._frozen_segments = 0  # sum of the frozen chunks' segment counts
         self._head: viser.LineSegmentsHandle | None = None
+        #: Dropped chunks, shrunk to a point of the trail, for the next heads.
+        self._spare: list[viser.LineSegmentsHandle] = []
         # The head chunk's segments live in a preallocated buffer: rows [0, n) are drawn.
         self._buffer = np.empty((self._chunk, 2, 3), dtype=np.float32)
         self._n = 0
@@ -89,6 +97,9 @@ class Trail:
 
     # -- mutation ------------------------------------------------------------------------
     def clear(self) -> None:
+        for handle in self._spare:
+            handle.remove()
+        self._spare.clear()
         for handle, _ in self._frozen:
             handle.remove()
         self._frozen.clear()
@@ -104,6 +115,7 @@ class Trail:
         self._color = np.asarray(color, dtype=np.uint8)
         self._width = float(width_px)
         handles = [h for h, _ in self._frozen] + ([self._head] if self._head is not None else [])
+        handles += self._spare
         for handle in handles:
             handle.colors = self._color
             handle.thickness = self._width
@@ -142,7 +154,10 @@ class Trail:
 
     # -- internals -----------------------------------------------------------------------
     def _send_head(self) -> None:
-        if self._head is None:
+        if self._head is None and self._spare:
+            self._head = self._spare.pop()
+            self._head.points = self._buffer[: self._n]
+        elif self._head is None:
             self._counter += 1
             self._head = self._api.add_line_segments(
                 f"{self._name}/c{self._counter}",
@@ -166,4 +181,8 @@ class Trail:
         while self._frozen and self.segment_count > self._max_points:
             handle, n = self._frozen.popleft()
             self._frozen_segments -= n
-            handle.remove()
+            if self._last is None or len(self._spare) >= MAX_SPARE:
+                handle.remove()
+            else:  # shrunk onto the trail's newest point, under the line: nothing shows of it
+                handle.points = np.broadcast_to(self._last, (1, 2, 3))
+                self._spare.append(handle)
