@@ -12,8 +12,11 @@ prints:
   process's CPU time (that, plus viser's asyncio transport: serialisation, compression and the
   websocket sends) divided by the frames drawn for all clients; also the wall time of one
   frame in a session's thread (median, p95);
-- bytes sent per frame: what one client receives per frame, scene traffic (poses and trail
-  increments) and the GUI's (the plot at 10 Hz and the time readout) separately;
+- bytes and messages per frame: what one client receives per frame drawn for it, everything
+  (poses, trace increments, labels, the plot at 10 Hz and the time readout: one frame is one
+  websocket message), and its viser messages, all and the scene's alone; and the frames the
+  session skipped because the client had not yet taken the ones before
+  (:mod:`poinsot.app.live.pacing`);
 - slider-to-redraw time: from a client sending a slider value to that client receiving the new
   ellipsoid (the scale of ``/space/body/ellipsoid``), median and p95, and the server's
   rebuild time alone.
@@ -71,16 +74,18 @@ def _clients_main(port: int, count: int, seconds: float, redraws: int, conn: Con
         probe.close()
 
 
-def _traffic(probes: list[Probe], seconds: float) -> list[tuple[int, int, int]]:
-    """(scene bytes, GUI bytes, websocket messages) each probe receives in ``seconds``."""
+def _traffic(probes: list[Probe], seconds: float) -> list[tuple[int, int, int, int]]:
+    """(bytes, websocket messages, viser messages, scene messages) each probe receives in
+    ``seconds``."""
     start = [len(p.batches) for p in probes]
     time.sleep(seconds)
     traffic = []
     for probe, n0 in zip(probes, start, strict=True):
         batches = probe.batches[n0:]
-        gui = sum(b.nbytes for b in batches if "GuiUpdateMessage" in b.types)
         total = sum(b.nbytes for b in batches)
-        traffic.append((total - gui, gui, len(batches)))
+        messages = sum(len(b.types) for b in batches)
+        scene = sum(1 for b in batches for kind in b.types if not kind.startswith("Gui"))
+        traffic.append((total, len(batches), messages, scene))
     return traffic
 
 
@@ -131,8 +136,10 @@ class Result:
     frame_wall_median_ms: float
     frame_wall_p95_ms: float
     frames_per_second_per_client: float
-    scene_bytes_per_frame: float
-    gui_bytes_per_second: float
+    skipped_per_second_per_client: float
+    bytes_per_frame: float
+    messages_per_frame: float
+    scene_messages_per_frame: float
     redraw_median_ms: float
     redraw_p95_ms: float
     rebuild_median_ms: float
@@ -157,11 +164,13 @@ def run(clients: int, seconds: float = 5.0, redraws: int = 30) -> Result:
             s.stats.frame_seconds.clear()
             s.stats.frame_cpu_seconds.clear()
         frames0 = {id(s): s.stats.frames for s in sessions}
+        skipped0 = sum(s.stats.skipped for s in sessions)
         cpu0, wall0 = time.process_time(), time.perf_counter()
         parent.send("go")
         kind, traffic = parent.recv()
         cpu1, wall1 = time.process_time(), time.perf_counter()
         frames = {id(s): s.stats.frames - frames0[id(s)] for s in sessions}
+        skipped = sum(s.stats.skipped for s in sessions) - skipped0
         total_frames = sum(frames.values())
         frame_walls = [x for s in sessions for x in s.stats.frame_seconds]
         frame_cpus = [x for s in sessions for x in s.stats.frame_cpu_seconds]
@@ -177,8 +186,7 @@ def run(clients: int, seconds: float = 5.0, redraws: int = 30) -> Result:
         app.stop()
     per_client_frames = total_frames / clients
     elapsed = wall1 - wall0
-    scene_bytes = [t[0] for t in traffic]
-    gui_bytes = [t[1] for t in traffic]
+    per_frame = max(per_client_frames, 1)
     return Result(
         clients=clients,
         cpu_per_client_frame_ms=1e3 * (cpu1 - cpu0) / max(total_frames, 1),
@@ -187,8 +195,10 @@ def run(clients: int, seconds: float = 5.0, redraws: int = 30) -> Result:
         frame_wall_median_ms=1e3 * statistics.median(frame_walls),
         frame_wall_p95_ms=1e3 * _percentile(frame_walls, 0.95),
         frames_per_second_per_client=per_client_frames / elapsed,
-        scene_bytes_per_frame=statistics.mean(scene_bytes) / max(per_client_frames, 1),
-        gui_bytes_per_second=statistics.mean(gui_bytes) / elapsed,
+        skipped_per_second_per_client=skipped / clients / elapsed,
+        bytes_per_frame=statistics.mean(t[0] for t in traffic) / per_frame,
+        messages_per_frame=statistics.mean(t[2] for t in traffic) / per_frame,
+        scene_messages_per_frame=statistics.mean(t[3] for t in traffic) / per_frame,
         redraw_median_ms=1e3 * statistics.median(latencies) if latencies else float("nan"),
         redraw_p95_ms=1e3 * _percentile(latencies, 0.95),
         rebuild_median_ms=1e3 * statistics.median(rebuilds) if rebuilds else float("nan"),
@@ -259,9 +269,11 @@ def format_result(r: Result) -> str:
             f"  frame in session thread     : median {r.frame_wall_median_ms:.3f} ms, "
             f"p95 {r.frame_wall_p95_ms:.3f} ms (wall)",
             f"  frames per second per client: {r.frames_per_second_per_client:7.1f}"
-            "        (cap 60)",
-            f"  bytes sent per frame        : {r.scene_bytes_per_frame:7.0f} B  (poses + trail "
-            f"increments) + GUI {r.gui_bytes_per_second / 1e3:.1f} kB/s (plot 10 Hz, time 5 Hz)",
+            f"        (cap 60; {r.skipped_per_second_per_client:.1f}/s skipped, not yet taken)",
+            f"  bytes sent per frame        : {r.bytes_per_frame:7.0f} B  (everything: poses, "
+            "traces, labels, plot 10 Hz, time 5 Hz)   (target <= 2 kB)",
+            f"  messages per frame          : {r.messages_per_frame:7.2f}    (scene "
+            f"{r.scene_messages_per_frame:.2f}: 3 poses + a trace increment every 4th frame)",
             f"  slider-to-redraw            : median {r.redraw_median_ms:.1f} ms, "
             f"p95 {r.redraw_p95_ms:.1f} ms   (target <= 30 ms)",
             f"  server rebuild alone        : median {r.rebuild_median_ms:.2f} ms, "
