@@ -4,12 +4,17 @@ Each browser has its own send queue in viser (the client's message buffer, drain
 on viser's event loop that hands windows of messages to the websocket). A frame's messages are
 *taken* when that task has drained them from the queue; it stops draining while the socket's
 write buffer is full (websockets waits for the socket to drain), that is while the browser, or
-the network to it, does not keep up. :class:`Outbox` reads, for one client, the id of the last
-message the frame put in the queue and how far the draining task has got.
+the network to it, does not keep up. Past the queue, the bytes wait in the websocket's write
+buffer and then in the kernel's socket buffer until the client's side acknowledges them (TCP);
+the kernel lets that buffer grow to megabytes, thousands of stale frames for a client that
+reads nothing. :class:`Outbox` reads, for one client, the id of the last message the frame
+put in the queue, how far the draining task has got, and the bytes written but not yet
+acknowledged by the client (the transport's buffer plus the socket's ``SIOCOUTQ``).
 
 :class:`Pacer` is the session's frame-rate controller. After each frame it records the frame's
 last message id (:meth:`Pacer.sent`); before the next it asks how many frames are still
-queued (:meth:`Pacer.may_draw`): with more than MAX_IN_FLIGHT, the frame is skipped (the time
+queued (:meth:`Pacer.may_draw`): with more than MAX_IN_FLIGHT, or more than MAX_UNACKED bytes
+not acknowledged, the frame is skipped (the time
 shown jumps forward at the next one; the traces are filled from the exact solution) and the
 client's rate is halved; a frame taken on time lets the rate climb back to ``max_fps``. A
 client that reads nothing gets no new frames, so its queue holds at most MAX_IN_FLIGHT frames
@@ -23,12 +28,18 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+import fcntl
+import struct
+import termios
 from typing import Any
 
 import viser
 
 #: Frames a client may have queued, not yet taken, before the next frame is skipped.
 MAX_IN_FLIGHT = 1
+#: Bytes written to a client but not yet acknowledged by it before the next frame is skipped
+#: (a few frames' worth; a client that keeps up has about one frame's bytes in flight).
+MAX_UNACKED = 32 * 1024
 #: The slowest rate a stalled client is polled at [frames per second]: it costs one check.
 MIN_FPS = 2.0
 #: A frame taken on time raises the rate by this factor (a skip halves it).
@@ -41,6 +52,7 @@ class Outbox:
     def __init__(self, client: viser.ClientHandle) -> None:
         self.client_id = client.client_id
         self._buffer: Any = _message_buffer(client)
+        self._transport: Any = _transport(client)
 
     @property
     def available(self) -> bool:
@@ -60,6 +72,22 @@ class Outbox:
         """Messages in the client's queue now (after viser's coalescing of updates)."""
         return len(self._buffer.message_from_id) if self._buffer is not None else 0
 
+    def unacknowledged(self) -> int:
+        """Bytes written to the client and not yet acknowledged by it: the websocket
+        transport's buffer and the kernel's send queue (0 if unknown)."""
+        transport = self._transport
+        if transport is None:
+            return 0
+        try:
+            queued = int(transport.get_write_buffer_size())
+            sock = transport.get_extra_info("socket")
+            if sock is None:
+                return queued
+            raw = fcntl.ioctl(sock.fileno(), termios.TIOCOUTQ, b"\0\0\0\0")  # SIOCOUTQ
+            return queued + struct.unpack("i", raw)[0]
+        except (OSError, ValueError, AttributeError):  # closed meanwhile
+            return 0
+
 
 def _message_buffer(client: viser.ClientHandle) -> Any:
     """viser 1.1 keeps the queue on the client's connection; None if that ever changes (the
@@ -71,6 +99,16 @@ def _message_buffer(client: viser.ClientHandle) -> Any:
     buffer = getter()
     needed = ("message_counter", "generator_cursors", "message_from_id")
     return buffer if all(hasattr(buffer, name) for name in needed) else None
+
+
+def _transport(client: viser.ClientHandle) -> Any:
+    """The asyncio transport of the client's websocket (viser 1.1 keeps the live connections
+    on its websocket server), or None."""
+    server = getattr(getattr(client, "_viser_server", None), "_websock_server", None)
+    connections = getattr(server, "_live_connections", None)
+    connection = connections.get(client.client_id) if isinstance(connections, dict) else None
+    transport = getattr(connection, "transport", None)
+    return transport if hasattr(transport, "get_write_buffer_size") else None
 
 
 @dataclasses.dataclass
@@ -90,11 +128,13 @@ class Pacer:
         max_fps: float = 60.0,
         min_fps: float = MIN_FPS,
         max_in_flight: int = MAX_IN_FLIGHT,
+        max_unacked: int = MAX_UNACKED,
     ) -> None:
         self.outbox = outbox
         self.max_fps = float(max_fps)
         self.min_fps = min(float(min_fps), self.max_fps)
         self.max_in_flight = int(max_in_flight)
+        self.max_unacked = int(max_unacked)
         self.fps = self.max_fps
         self.stats = PacerStats()
         self._marks: collections.deque[int] = collections.deque()
@@ -117,7 +157,7 @@ class Pacer:
         queued; otherwise True (and a higher rate if the client keeps up)."""
         queued = self.in_flight()
         self.stats.max_in_flight = max(self.stats.max_in_flight, queued)
-        if queued > self.max_in_flight:
+        if queued > self.max_in_flight or self.outbox.unacknowledged() > self.max_unacked:
             self.fps = max(self.min_fps, 0.5 * self.fps)
             self.stats.skipped += 1
             return False
