@@ -38,8 +38,11 @@ LARGE_TEXT_PERCENT = 130
 #: ... and of the projector mode.
 PROJECTOR_TEXT_PERCENT = 150
 #: Labels are laid out this often [Hz] (their boxes ride on their frames in between; a
-#: layout costs about a millisecond), and only when the camera or the time has changed.
+#: layout costs about a millisecond), and only when the camera or the time has changed; and
+#: at most every LABEL_MIN_FRAMES frames, so that a client whose frame rate is lowered (a busy
+#: server, a slow browser) gets fewer layouts too: at most a fifth of its frames carry one.
 LABEL_HZ = 6.0
+LABEL_MIN_FRAMES = 5
 #: The two-view camera: from the front (x runs across the screen, the body frame's picture on
 #: the right), this high above the plane [degrees] and this far from the middle between the
 #: pictures [display units].
@@ -119,6 +122,7 @@ class Display:
         self._lock = threading.Lock()
         self.body_view: BodyView | None = None
         self._next_layout = 0.0
+        self._frames_since_layout = LABEL_MIN_FRAMES
         self._laid_out: tuple | None = None  # (camera, time) of the last layout
 
     # -- wishes (any thread) ---------------------------------------------------------------
@@ -144,8 +148,10 @@ class Display:
             if view.geometry is not scene.geometry:
                 view.fit(scene.geometry, self._attitude0(frame))
             view.advance(frame)
-        if now >= self._next_layout:
+        self._frames_since_layout += 1
+        if now >= self._next_layout and self._frames_since_layout >= LABEL_MIN_FRAMES:
             self._next_layout = now + 1.0 / LABEL_HZ
+            self._frames_since_layout = 0
             self.lay_out_labels(None if frame is None else frame.t)
 
     def lay_out_labels(self, t: float | None = None) -> dict:

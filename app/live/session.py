@@ -45,6 +45,7 @@ MAX_FPS = 60.0
 #: Plot and time-readout refresh rates [Hz]: the plot resends its whole window.
 PLOT_HZ = 10.0
 TIME_HZ = 5.0
+PLOT_MIN_FRAMES = 6
 #: "Step" advances this many wall seconds' worth of simulation time.
 STEP_SECONDS = 0.1
 #: While another session rebuilds, a due frame is retried after this long [s], and held for
@@ -93,6 +94,7 @@ class Session:
         self._generation = 0  # bumped after each rebuild (tests wait on it)
         self._thread: threading.Thread | None = None
         self._last_plot = self._last_time = 0.0  # monotonic times of the last refreshes
+        self._frames_since_plot = PLOT_MIN_FRAMES
         #: The scene being shown, if one is chosen instead of a preset (frame thread).
         self.showcase: LiveShowcase | None = None
         self.speed_range = SPEED_RANGE
@@ -271,13 +273,17 @@ class Session:
         return True
 
     def _refresh(self, now: float) -> None:
-        """After a frame: the plot at PLOT_HZ, the time readout (and retired widgets) at
-        TIME_HZ."""
+        """After a frame: a plot sample at PLOT_HZ, sent at most every PLOT_MIN_FRAMES frames
+        (the whole window is resent: a client at a lowered frame rate gets it less often),
+        the time readout (and retired widgets) at TIME_HZ."""
         motion = self.panel.motion
+        self._frames_since_plot += 1
         if now - self._last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
             self._last_plot = now
             motion.record_plot(self.frame.t, self.frame.omega)
-            motion.send_plot()
+            if self._frames_since_plot >= PLOT_MIN_FRAMES:
+                self._frames_since_plot = 0
+                motion.send_plot()
         if now - self._last_time >= 1.0 / TIME_HZ:
             self._last_time = now
             motion.show_time(self.frame.t if self.frame is not None else 0.0, self.clock.paused)

@@ -423,7 +423,7 @@ class LabelNode:
         if base is not None:
             offset = placement.offset
             if rotation is not None:  # a world offset, into the body's coordinates
-                offset = rotation.inv().apply(offset)
+                offset = rotation.apply(offset, inverse=True)
             position = np.asarray(base, float) + offset
             if np.max(np.abs(position - self.position)) > POSITION_TOLERANCE:
                 self.position = position
