@@ -70,11 +70,10 @@ class Session:
     ) -> None:
         """``budget``: the server's shared budget, through which a rebuild goes first (one per
         session if None); ``scene``: start with this scene (:mod:`poinsot.app.scenes`) instead
-        of ``preset``. The frame rate is this client's own (:class:`Pacer`)."""
+        of ``preset``. Frames: as many as the client takes, up to ``max_fps`` (:attr:`pacer`)."""
         self.client = client
         self.max_fps = float(max_fps)
         self.budget = budget if budget is not None else FrameBudget(max_fps=max_fps)
-        #: This client's frame rate: as many frames as it takes, up to ``max_fps``.
         self.pacer = Pacer(Outbox(client), max_fps=self.max_fps)
         self.stats = SessionStats()
         self.clock = SimClock(speed=preset.speed)
@@ -94,7 +93,6 @@ class Session:
         self._generation = 0  # bumped after each rebuild (tests wait on it)
         self._thread: threading.Thread | None = None
         self._last_plot = self._last_time = 0.0  # monotonic times of the last refreshes
-        self._frames_since_plot = PLOT_MIN_FRAMES
         #: The scene being shown, if one is chosen instead of a preset (frame thread).
         self.showcase: LiveShowcase | None = None
         self.speed_range = SPEED_RANGE
@@ -117,10 +115,8 @@ class Session:
         else:
             self._apply_scene(scene)
         self._rebuild()
-        # Exports, camera views, theme and hotkeys mount on the session's panel.
-        self.lecture = add_lecture_controls(self)
-        # The numerical ghost: its controls now, the ghost itself only when switched on.
-        self.ghost = add_ghost_controls(self)
+        self.lecture = add_lecture_controls(self)  # exports, views, theme, hotkeys
+        self.ghost = add_ghost_controls(self)  # its controls; the ghost when switched on
         self._fit_ghost()
 
     # -- lifecycle -----------------------------------------------------------------------
@@ -271,6 +267,8 @@ class Session:
             self._refresh(now)
         self.pacer.sent()
         return True
+
+    _frames_since_plot = PLOT_MIN_FRAMES  # frames drawn since the plot was last sent
 
     def _refresh(self, now: float) -> None:
         """After a frame: a plot sample at PLOT_HZ, sent at most every PLOT_MIN_FRAMES frames
