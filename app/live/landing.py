@@ -20,7 +20,7 @@ import threading
 import time
 import urllib.parse
 from collections.abc import Sequence
-from typing import Protocol
+from typing import Any, Protocol
 
 from poinsot.app.live.network import PortError, port_problem
 
@@ -35,6 +35,8 @@ class Backend(Protocol):
 
     @property
     def port(self) -> int: ...
+    @property
+    def pid(self) -> int | None: ...
     @property
     def alive(self) -> bool: ...
     @property
@@ -79,10 +81,17 @@ class Balancer:
             self._pending[best].append(time.monotonic())
             return self.backends[best]
 
-    def status(self) -> list[dict[str, int | bool]]:
+    def status(self) -> list[dict[str, int | bool | None]]:
+        """Per backend: its port, pid, whether it is alive, its clients and its load."""
         with self._lock:
             return [
-                {"port": b.port, "alive": b.alive, "clients": b.clients, "load": self.load(i)}
+                {
+                    "port": b.port,
+                    "pid": b.pid,
+                    "alive": b.alive,
+                    "clients": b.clients,
+                    "load": self.load(i),
+                }
                 for i, b in enumerate(self.backends)
             ]
 
@@ -173,12 +182,12 @@ def resolve(port: int, host: str = "127.0.0.1", timeout: float = 10.0) -> int:
     return port
 
 
-def status(port: int, host: str = "127.0.0.1", timeout: float = 10.0) -> list[dict[str, int]]:
+def status(port: int, host: str = "127.0.0.1", timeout: float = 10.0) -> list[dict[str, Any]]:
     """The landing's view of its workers (``GET /poinsot-status``)."""
     connection = http.client.HTTPConnection(host, port, timeout=timeout)
     try:
         connection.request("GET", STATUS_PATH)
-        result: list[dict[str, int]] = json.loads(connection.getresponse().read())
+        result: list[dict[str, Any]] = json.loads(connection.getresponse().read())
     finally:
         connection.close()
     return result

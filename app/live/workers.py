@@ -127,6 +127,10 @@ class Worker:
         self.port = int(payload)
 
     @property
+    def pid(self) -> int | None:
+        return self.process.pid
+
+    @property
     def alive(self) -> bool:
         return self.process.is_alive()
 
