@@ -20,7 +20,7 @@ import signal
 import sys
 import threading
 import traceback
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from multiprocessing.connection import Connection
 from typing import TYPE_CHECKING, Any
 
@@ -73,7 +73,9 @@ def _worker_main(
             return
         _count_clients(app.server, load)
         conn.send(("ready", app.port))
-        conn.recv()  # "stop", or EOFError: the parent is gone
+        while (request := conn.recv()) != "stop":  # EOFError: the parent is gone
+            _, look = request  # ("inspect", function of the app): the load test's questions
+            conn.send(look(app))
     except (EOFError, BrokenPipeError):  # the parent is gone
         pass
     except Exception:
@@ -125,6 +127,14 @@ class Worker:
         if kind == "error":
             raise PortError(payload)
         self.port = int(payload)
+
+    def inspect(self, look: Callable[[PoinsotApp], Any], timeout: float = 30.0) -> Any:
+        """``look(app)`` run in the worker on its app (a module-level function: it is pickled
+        by name), e.g. the load test's count of sessions and frames."""
+        self.conn.send(("inspect", look))
+        if not self.conn.poll(timeout):
+            raise TimeoutError(f"worker {self.index} did not answer within {timeout:.0f} s")
+        return self.conn.recv()
 
     @property
     def pid(self) -> int | None:

@@ -313,3 +313,27 @@ def test_serve_on_all_interfaces_prints_the_board():
             assert "█" in text and "Students open" in text
     finally:
         stop_classroom(room)
+
+
+# -- the load test through a landing -------------------------------------------------------
+@pytest.mark.slow
+def test_the_load_test_soaks_a_classroom_of_workers():
+    """``python -m poinsot.app.load --phase soak --workers 2``: the clients arrive through
+    the landing, the sessions are counted in both workers, their CPU and memory are summed."""
+    from poinsot.app.load.cli import run
+    from poinsot.app.load.config import Config
+
+    report = run(["soak"], Config(clients=4, workers=2, seconds=3.0), verbose=False)
+    assert report.figure("soak", "sessions lost").value == 0
+    assert report.figure("soak", "clients gone silent").value == 0
+    assert not [f for f in report.figures if f.name == "completed"], report.figures
+    assert report.figure("soak", "fps per client, each").detail["clients"] == 4
+    assert report.figure("soak", "fps per client, each").value > 0
+
+
+def test_the_load_test_takes_workers_for_the_soak_only(capsys):
+    from poinsot.app.load import cli as load_cli
+
+    with pytest.raises(SystemExit):
+        load_cli.main(["--phase", "storm", "--workers", "2"])
+    assert "only with --phase soak" in capsys.readouterr().err
