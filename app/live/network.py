@@ -96,12 +96,13 @@ def lan_addresses() -> list[tuple[str, str]]:
 
 
 def qr_text(text: str) -> str:
-    """``text`` as a QR code drawn with Unicode half blocks (two modules a character), dark on
-    a light quiet zone, so that a phone reads it off a dark or light terminal."""
+    """``text`` as a QR code drawn with Unicode half blocks (two rows of modules a line) and
+    its four-module quiet zone: light modules are drawn (█), dark ones left blank, so that on
+    a terminal with light text on a dark background it is dark on light, as printed."""
     import segno
 
     code = segno.make(text, error="m", boost_error=False)
-    rows = [[bool(v) for v in row] for row in code.matrix_iter(scale=1, border=2)]
+    rows = [[bool(v) for v in row] for row in code.matrix_iter(scale=1, border=4)]
     if len(rows) % 2:
         rows.append([False] * len(rows[0]))
     glyph = {(False, False): "█", (True, False): "▄", (False, True): "▀", (True, True): " "}

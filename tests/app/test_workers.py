@@ -9,6 +9,7 @@ counts and events.
 from __future__ import annotations
 
 import dataclasses
+import errno
 import os
 import re
 import signal
@@ -254,6 +255,14 @@ def test_a_port_without_permission_is_one_line():
         network.check_port("127.0.0.1", 80)
 
 
+def test_each_reason_a_port_cannot_be_served_is_named():
+    assert "not allowed" in network.port_problem("0.0.0.0", 80, errno.EACCES)
+    assert "busy" in network.port_problem("0.0.0.0", 8080, errno.EADDRINUSE)
+    assert "not an address" in network.port_problem("10.9.9.9", 8080, errno.EADDRNOTAVAIL)
+    with pytest.raises(network.PortError, match="not a TCP port"):
+        network.check_port("127.0.0.1", 70000)
+
+
 def test_port_zero_takes_any_free_port(capsys, monkeypatch):
     network.check_port("127.0.0.1", 0)  # never refused
     with pytest.raises(SystemExit):
@@ -274,7 +283,7 @@ def _unprint(qr: str) -> list[list[bool]]:
 
 def test_the_qr_code_draws_exactly_the_address():
     url = "http://192.168.1.23:8080"
-    expected = [[bool(v) for v in row] for row in segno.make(url, error="m").matrix_iter(border=2)]
+    expected = [[bool(v) for v in row] for row in segno.make(url, error="m").matrix_iter(border=4)]
     drawn = _unprint(network.qr_text(url))
     assert drawn[: len(expected)] == expected
     assert not any(any(row) for row in drawn[len(expected) :])  # padding only
