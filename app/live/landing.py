@@ -16,13 +16,14 @@ import collections
 import http.client
 import http.server
 import json
+import socket
 import threading
 import time
 import urllib.parse
 from collections.abc import Sequence
 from typing import Any, Protocol
 
-from poinsot.app.live.network import PortError, port_problem
+from poinsot.app.live.network import PortError, bind_errno, port_problem
 
 #: A browser sent to a worker that has not connected within this many seconds is forgotten
 #: (it closed the tab, or reloaded straight on the worker's port).
@@ -148,10 +149,11 @@ class LandingServer(http.server.ThreadingHTTPServer):
     def __init__(self, host: str, port: int, balancer: Balancer) -> None:
         self.balancer = balancer
         self.fallback_host = "localhost" if host in ("0.0.0.0", "::", "") else host
+        self.address_family = socket.AF_INET6 if ":" in host else socket.AF_INET
         try:
             super().__init__((host, port), _Handler)
         except OSError as exc:
-            raise PortError(port_problem(host, port, exc.errno)) from None
+            raise PortError(port_problem(host, port, bind_errno(exc))) from None
 
     @property
     def port(self) -> int:

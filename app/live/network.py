@@ -40,7 +40,13 @@ def check_port(host: str, port: int) -> None:
         try:
             sock.bind((host, port))
         except OSError as exc:
-            raise PortError(port_problem(host, port, exc.errno)) from None
+            raise PortError(port_problem(host, port, bind_errno(exc))) from None
+
+
+def bind_errno(exc: OSError) -> int | None:
+    """The ``errno`` of a failed bind; a host name that names no address of ours counts as
+    ``EADDRNOTAVAIL`` (the resolver's own codes are not errno values)."""
+    return errno.EADDRNOTAVAIL if isinstance(exc, socket.gaierror) else exc.errno
 
 
 def port_problem(host: str, port: int, code: int | None = None) -> str:

@@ -261,6 +261,11 @@ def test_each_reason_a_port_cannot_be_served_is_named():
     assert "not an address" in network.port_problem("10.9.9.9", 8080, errno.EADDRNOTAVAIL)
     with pytest.raises(network.PortError, match="not a TCP port"):
         network.check_port("127.0.0.1", 70000)
+    with pytest.raises(network.PortError, match="203.0.113.7 is not an address"):
+        network.check_port("203.0.113.7", 8080)  # TEST-NET-3: no interface has it
+    assert network.bind_errno(socket.gaierror(-2, "Name or service not known")) == (
+        errno.EADDRNOTAVAIL
+    )  # a host name that resolves to nothing of ours
 
 
 def test_port_zero_takes_any_free_port(capsys, monkeypatch):
