@@ -31,11 +31,14 @@ install: $(VENV)/.installed
 install-test: $(VENV)/.installed-test
 
 # Debian's Chromium drives the real-browser tests (playwright uses it via executable_path).
-# strace lets a test prove that the browser reaches nothing past loopback.
+# strace lets a test prove that the browser reaches nothing past loopback; nginx runs the
+# README's load-balancer set-up on loopback (tests/app/test_nginx.py).
 chromium:
-	@if [ -x "$(CHROMIUM)" ] && command -v strace >/dev/null; then echo "chromium: $(CHROMIUM)"; else \
-		echo "installing Debian's chromium and strace"; \
-		$(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y chromium strace; fi
+	@if [ -x "$(CHROMIUM)" ] && command -v strace >/dev/null && [ -x /usr/sbin/nginx ]; then \
+		echo "chromium: $(CHROMIUM)"; else \
+		echo "installing Debian's chromium, strace and nginx-light"; \
+		$(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y \
+			chromium strace nginx-light; fi
 
 run: install
 	$(VENV)/bin/poinsot serve --host $(HOST) --port $(PORT)

@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import inspect
 import math
+import os
 import pathlib
 import sys
 import time
@@ -105,14 +106,43 @@ def _size(text: str) -> tuple[int, int]:
         raise argparse.ArgumentTypeError(str(exc)) from exc
 
 
+def _workers(text: str) -> int:
+    """A number of worker processes: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of processes") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: at least 1 worker process")
+    return value
+
+
 # -- the commands ---------------------------------------------------------------------------
-def serve(host: str, port: int, preset: str, start_scene: SceneSpec | None) -> int:
+def serve(host: str, port: int, preset: str, start_scene: SceneSpec | None, workers: int) -> int:
     """Serve until interrupted (Ctrl-C); each browser starts with ``start_scene`` if given,
-    else with ``preset``."""
+    else with ``preset``. With ``workers`` > 1 the sessions run in that many processes behind
+    a landing port (:mod:`poinsot.app.live.workers`). A port that cannot be served is one
+    line and exit status 2."""
+    from poinsot.app.live.network import PortError, board, check_port, port_problem
+
+    try:
+        check_port(host, port)
+        if workers > 1:
+            from poinsot.app.live.workers import serve_classroom
+
+            scene = start_scene.name if start_scene else None
+            return serve_classroom(host, port, workers, preset, scene)
+    except PortError as exc:
+        print(f"poinsot serve: {exc}", file=sys.stderr)
+        return 2
     from poinsot.app.live.server import PoinsotApp
 
     app = PoinsotApp(host, port, preset=preset_by_key(preset), scene=start_scene)
-    print(f"Poinsot is running at {app.url}  (Ctrl-C to stop)", flush=True)
+    if port and app.port != port:  # viser took the next free port: the board would be wrong
+        app.stop()
+        print(f"poinsot serve: {port_problem(host, port)}", file=sys.stderr)
+        return 2
+    print(board(host, app.port), flush=True)
     try:
         while True:
             time.sleep(3600)
@@ -207,7 +237,21 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         default="127.0.0.1",
         help="interface to listen on (0.0.0.0 lets students on the room's network connect)",
     )
-    parser.add_argument("--port", type=int, default=8080, help="TCP port (0 = any free port)")
+    parser.add_argument(
+        "--port",
+        type=int,
+        default=8080,
+        help="TCP port; if it is busy the server says so and stops (0 = any free port)",
+    )
+    parser.add_argument(
+        "--workers",
+        type=_workers,
+        default=os.cpu_count() or 1,
+        metavar="N",
+        help="processes serving the sessions (default: the number of cores, here %(default)s);"
+        " with N > 1 the port redirects each new browser to the least-loaded one, on the "
+        "ports that follow it; 1 = one process",
+    )
     which = parser.add_mutually_exclusive_group()
     which.add_argument(
         "--preset",

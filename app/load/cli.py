@@ -25,6 +25,7 @@ def build_parser() -> argparse.ArgumentParser:
     add = parser.add_argument
     add("--phase", nargs="+", choices=PHASES, default=list(PHASES), help="phases to run, in order")
     add("--clients", type=int, default=cfg.clients, help="clients in the soak, stall and flood")
+    add("--workers", type=int, default=cfg.workers, help="server processes (soak only)")
     add("--seconds", type=float, default=cfg.seconds, help="length of the soak [s]")
     add("--slider-period", type=float, default=cfg.slider_period, help="a slider move every [s]")
     add("--storm", type=int, default=cfg.storm, help="connects and departures in the storm")
@@ -55,6 +56,8 @@ def _options(args: argparse.Namespace) -> tuple[list[str], Config, Bounds]:
 def _check(parser: argparse.ArgumentParser, phases: list[str], cfg: Config) -> None:
     if cfg.clients < 1 or cfg.seconds <= 0 or cfg.storm < 1 or cfg.storm_workers < 1:
         parser.error("--clients, --seconds, --storm and --storm-workers must be positive")
+    if cfg.workers < 1 or (cfg.workers > 1 and phases != ["soak"]):
+        parser.error("--workers must be >= 1, and more than 1 only with --phase soak")
     if {"stall", "flood"} & set(phases) and cfg.clients < 2:
         parser.error("stall and flood need --clients >= 2 (one stalls, the others are measured)")
     if min(cfg.stall_seconds, cfg.flood_seconds, cfg.flood_rate, cfg.settle_seconds) <= 0:
@@ -83,7 +86,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     phases, cfg, bounds = _options(parser.parse_args(argv))
     _check(parser, phases, cfg)
     print(
-        f"Poinsot load test: {' '.join(phases)}; {cfg.clients} clients, soak {cfg.seconds:g} s, "
+        f"Poinsot load test: {' '.join(phases)}; {cfg.clients} clients, {cfg.workers} server "
+        f"process(es), soak {cfg.seconds:g} s, "
         f"storm {cfg.storm}; python {sys.version.split()[0]}, {os.cpu_count()} CPUs, "
         f"load average {_load_average()} (1, 5, 15 min)",
         flush=True,
