@@ -113,12 +113,16 @@ def _size(text: str) -> tuple[int, int]:
 
 
 # -- the commands ---------------------------------------------------------------------------
-def serve(host: str, port: int, preset: str, start_scene: SceneSpec | None) -> int:
+def serve(
+    host: str, port: int, preset: str, start_scene: SceneSpec | None, allow_origin: list[str]
+) -> int:
     """Serve until interrupted (Ctrl-C); each browser starts with ``start_scene`` if given,
     else with ``preset``."""
     from poinsot.app.live.server import PoinsotApp
 
-    app = PoinsotApp(host, port, preset=preset_by_key(preset), scene=start_scene)
+    app = PoinsotApp(
+        host, port, preset=preset_by_key(preset), scene=start_scene, allow_origins=allow_origin
+    )
     print(f"Poinsot is running at {app.url}  (Ctrl-C to stop)", flush=True)
     try:
         while True:
@@ -215,6 +219,7 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         help="interface to listen on (0.0.0.0 lets students on the room's network connect)",
     )
     parser.add_argument("--port", type=int, default=8080, help="TCP port (0 = any free port)")
+    parser.add_argument("--allow-origin", action="append", default=[], help="another page's origin")
     which = parser.add_mutually_exclusive_group()
     which.add_argument(
         "--preset",

@@ -1,0 +1,171 @@
+"""What the server checks on a websocket before viser acts on it: the page it comes from (its
+``Origin``), how much it sends (:class:`~poinsot.app.live.budget.MessageBudget`), and that each
+message is one the browser could have sent.
+
+viser 1.1 accepts a websocket in its server's ``ws_handler``, runs the infra-level connect
+callbacks, and only then starts reading the connection (``_message_consumer``: ``await
+websocket.recv()``, then its own decoding and dispatch). :class:`WireGuard` registers one such
+callback (``WebsockServer.on_client_connect``): there it reads the handshake's headers and
+either closes the connection (an origin not allowed: before any message is read, so no
+session is ever built) or wraps that connection's ``recv``, the earliest point at which a
+message of this client is seen. A message refused there is never decoded by viser.
+
+Origins: a browser sends ``Origin`` with every websocket; a page may only drive the server if
+it was served by it (the origin's host:port is the ``Host`` the browser connected to), or if
+its origin is listed (``--allow-origin``). Tools that are not browsers (the probe, the load
+test, curl) send no ``Origin``: they are let in, as is standard, since no web page can open a
+websocket without one.
+
+This reaches into two of viser 1.1's internals, both kept in this module:
+``ViserServer._websock_server`` and ``WebsockServer._live_connections``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import threading
+import time
+from collections.abc import Awaitable, Callable, Iterable
+from typing import Any
+from urllib.parse import urlsplit
+
+import msgspec
+import viser
+
+from poinsot.app.live.budget import MessageBudget
+
+#: Messages a second one client may send, sustained, and in one burst (a browser sends a few
+#: dozen a second at most: camera moves while orbiting, a dragged slider, upload parts).
+MESSAGE_RATE = 200.0
+MESSAGE_BURST = 400.0
+#: A client over its budget this long (without a second's pause) is disconnected [s].
+EXCESS_SECONDS = 3.0
+#: Websocket close code for a policy violation (RFC 6455, 7.4.1).
+POLICY_VIOLATION = 1008
+
+
+def normalise_origin(origin: str) -> str:
+    """``scheme://host[:port]`` in lower case, without a trailing slash."""
+    return origin.strip().rstrip("/").lower()
+
+
+def origin_allowed(origin: str | None, host: str | None, allowed: Iterable[str] = ()) -> bool:
+    """May a websocket with these ``Origin`` and ``Host`` headers connect? Yes without an
+    origin (not a browser), for a listed origin, and for the server's own pages (the origin's
+    host:port is the ``Host`` header); no for anything else, including ``null`` (a local file
+    or a sandboxed frame)."""
+    if origin is None:
+        return True
+    normalised = normalise_origin(origin)
+    if normalised in {normalise_origin(a) for a in allowed}:
+        return True
+    parts = urlsplit(normalised)
+    if parts.scheme not in ("http", "https") or not parts.netloc or host is None:
+        return False
+    return parts.netloc == host.strip().lower()
+
+
+def _browser_could_send(raw: Any) -> bool:
+    """A binary msgpack map with a type; a GUI update carries only a value (viser would set any
+    attribute of the widget's state that a client names, its callbacks included)."""
+    if not isinstance(raw, bytes):
+        return False
+    try:
+        message = msgspec.msgpack.decode(raw)
+    except msgspec.DecodeError:
+        return False
+    if not isinstance(message, dict) or not isinstance(message.get("type"), str):
+        return False
+    if message["type"] == "GuiUpdateMessage":
+        updates = message.get("updates")
+        return isinstance(updates, dict) and set(updates) == {"value"}
+    return True
+
+
+class WireGuard:
+    """Origin check and message budget on every websocket of ``server``."""
+
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        allowed_origins: Iterable[str] = (),
+        *,
+        rate: float = MESSAGE_RATE,
+        burst: float = MESSAGE_BURST,
+        excess_seconds: float = EXCESS_SECONDS,
+    ) -> None:
+        self.allowed_origins = tuple(normalise_origin(o) for o in allowed_origins)
+        self._limits = (rate, burst, excess_seconds)
+        self._infra = server._websock_server
+        self._lock = threading.Lock()
+        self._budgets: dict[int, MessageBudget] = {}
+        #: Connections refused for their origin; clients closed for flooding.
+        self.refused = 0
+        self.disconnected = 0
+        #: Messages dropped: beyond a budget, or not one a browser sends.
+        self.dropped = 0
+        self.malformed = 0
+        self._infra.on_client_connect(self._accept)
+        self._infra.on_client_disconnect(self._forget)
+
+    def budget(self, client_id: int) -> MessageBudget | None:
+        """The budget of a connected client (tests)."""
+        with self._lock:
+            return self._budgets.get(client_id)
+
+    async def _accept(self, connection: Any) -> None:
+        # the connection viser reads from (its consumer calls ``recv`` on the instance)
+        websocket: Any = self._infra._live_connections.get(connection.client_id)
+        if websocket is None:
+            return
+        headers = websocket.request.headers if websocket.request is not None else {}
+        if not origin_allowed(headers.get("Origin"), headers.get("Host"), self.allowed_origins):
+            with self._lock:
+                self.refused += 1
+            websocket.recv = _discarding(websocket.recv)
+            await websocket.close(POLICY_VIOLATION, "origin not allowed")
+            return
+        budget = MessageBudget(*self._limits)
+        with self._lock:
+            self._budgets[connection.client_id] = budget
+        websocket.recv = self._budgeted(websocket, budget)
+
+    def _forget(self, connection: Any) -> None:
+        with self._lock:
+            self._budgets.pop(connection.client_id, None)
+
+    def _budgeted(self, websocket: Any, budget: MessageBudget) -> Callable[[], Awaitable[Any]]:
+        receive = websocket.recv
+        closing: list[asyncio.Task[None]] = []
+
+        async def recv() -> Any:
+            while True:
+                raw = await receive()
+                now = time.monotonic()
+                if not budget.admit(now):
+                    with self._lock:
+                        self.dropped += 1
+                    if budget.sustained(now) and not closing:
+                        with self._lock:
+                            self.disconnected += 1
+                        close = websocket.close(POLICY_VIOLATION, "message budget exceeded")
+                        closing.append(asyncio.create_task(close))
+                    continue
+                if not _browser_could_send(raw):
+                    with self._lock:
+                        self.malformed += 1
+                    continue
+                return raw
+
+        return recv
+
+
+def _discarding(receive: Callable[[], Awaitable[Any]]) -> Callable[[], Awaitable[Any]]:
+    """A ``recv`` that reads and drops everything until the connection is closed (it raises
+    ``ConnectionClosed`` then, which ends viser's handler for it)."""
+
+    async def recv() -> Any:
+        while True:
+            await receive()
+
+    return recv

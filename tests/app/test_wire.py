@@ -1,0 +1,165 @@
+"""Nothing from the wire is trusted: origins, raw widget values, floods, pending uploads."""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+import pytest
+from conftest import session_of, wait_until
+from viser import _messages
+
+from poinsot.app.live.guard import POLICY_VIOLATION, origin_allowed
+from poinsot.app.live.probe import Probe
+from poinsot.app.live.transfers import handle_id
+from poinsot.app.live.widgets import checked
+from poinsot.app.parameters import Parameters
+from poinsot.app.presets import DEFAULT_PRESET
+
+# -- origins ---------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("origin", "host", "allowed", "expected"),
+    [
+        (None, "127.0.0.1:8080", (), True),  # not a browser
+        ("http://127.0.0.1:8080", "127.0.0.1:8080", (), True),
+        ("https://Room.Example:8443/", "room.example:8443", (), True),
+        ("http://evil.example", "127.0.0.1:8080", (), False),
+        ("http://127.0.0.1:8081", "127.0.0.1:8080", (), False),  # another port is another site
+        ("null", "127.0.0.1:8080", (), False),  # a local file, a sandboxed frame
+        ("http://127.0.0.1:8080", None, (), False),
+        ("http://slides.example", "127.0.0.1:8080", ("http://slides.example/",), True),
+        ("file://", "127.0.0.1:8080", (), False),
+    ],
+)
+def test_which_origins_may_connect(origin, host, allowed, expected):
+    assert origin_allowed(origin, host, allowed) is expected
+
+
+def _session_built(app, probe: Probe) -> bool:
+    return wait_until(lambda: probe.closed or len(app.sessions()) == 1, 15) and not probe.closed
+
+
+@pytest.mark.parametrize(
+    ("origin", "served"),
+    [
+        ("http://evil.example", False),
+        ("same", True),
+        ("http://slides.example", True),  # given to --allow-origin
+        (None, True),  # the probe, curl, the load test: no Origin header
+    ],
+)
+def test_a_page_from_another_origin_gets_no_session(make_app, make_probe, origin, served):
+    app = make_app(allow_origins=["http://slides.example"])
+    if origin == "same":
+        origin = f"http://127.0.0.1:{app.port}"
+    probe = make_probe(app, origin=origin)
+    if served:
+        assert _session_built(app, probe)
+        assert app.guard.refused == 0
+    else:
+        assert wait_until(lambda: probe.closed, 10)
+        assert probe.close_code == POLICY_VIOLATION
+        time.sleep(0.5)  # a session built late would show now
+        assert len(app.sessions()) == 0 and app.guard.refused == 1
+        assert not any(n.startswith("/space/body") for n in probe.nodes)
+
+
+# -- raw values --------------------------------------------------------------------------------
+def _non_finite(value: Any) -> bool:
+    if isinstance(value, float):
+        return not math.isfinite(value)
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind == "f" and not bool(np.isfinite(value).all())
+    if isinstance(value, dict):
+        return any(_non_finite(v) for v in value.values())
+    if isinstance(value, list | tuple):
+        return any(_non_finite(v) for v in value)
+    return False
+
+
+JUNK = [math.nan, math.inf, -math.inf, 1e300, -1e300, 99_999_999, "abc", None, [1, 2], "Nope"]
+INPUTS = ("GuiSliderMessage", "GuiNumberMessage", "GuiDropdownMessage", "GuiButtonGroupMessage")
+
+
+def _inputs(probe: Probe) -> dict[str, Any]:
+    _, widgets = probe.snapshot()
+    return {uuid: w for uuid, w in widgets.items() if w.type in INPUTS}
+
+
+def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(poinsot_app, probe):
+    """Every value input of the panel gets what no browser sends: numbers are clamped into the
+    widget's range, the rest refused (the widget shows its last value again); no frame fails,
+    no NaN is sent, and a valid edit afterwards still works."""
+    session = session_of(poinsot_app)
+    sent_nan: list[str] = []
+    probe.add_listener(lambda m, _: _non_finite(m) and sent_nan.append(m["type"]))
+    inputs = _inputs(probe)
+    assert {"I₁", "D = |L|²/2T", "|ω₀|", "Speed", "Trail length", "Preset"} <= {
+        w.props.get("label") for w in inputs.values()
+    }
+    for uuid in inputs:
+        for junk in JUNK:
+            probe.set_value(uuid, junk)
+    # a valid value after the junk: once it has arrived, so have the junk's callbacks
+    trail_uuid, _ = probe.widget("Trail length")
+    probe.set_value(trail_uuid, 1234)
+    assert wait_until(lambda: session.scene.trail_points == 1234, 15)
+    for handle in (session.panel.preset, session.panel.widgets.speed):
+        assert handle.value == checked(handle, handle.value)
+    # then valid edits: a preset (the junk made a sphere of the moments), and D
+    preset_uuid, _ = probe.widget("Preset")
+    probe.set_value(preset_uuid, DEFAULT_PRESET.label)
+    assert wait_until(lambda: session.params == Parameters.from_preset(DEFAULT_PRESET), 15)
+    d_uuid = handle_id(session.panel.widgets.energy)  # the one shown (others are kept hidden)
+    assert probe.wait_for(lambda p: p.widgets[d_uuid].props["max"] > p.widgets[d_uuid].props["min"])
+    d = probe.widgets[d_uuid]
+    target = round(0.3 * d.props["min"] + 0.7 * d.props["max"], 2)
+    probe.set_value(d_uuid, target)
+    assert wait_until(lambda: abs(session.params.D - target) < 0.02, 15), (
+        poinsot_app.guard.dropped,
+        poinsot_app.guard.malformed,
+        len(inputs),
+        session.params,
+        target,
+    )
+    frames = session.stats.frames
+    assert wait_until(lambda: session.stats.frames > frames + 10, 10), "the frames stopped"
+    assert session.stats.errors == 0, session.stats.last_error
+    assert not sent_nan
+    assert math.isfinite(session.clock.speed) and math.isfinite(session.clock.now())
+    for widget in _inputs(probe).values():
+        if "min" in widget.props and widget.value is not None:
+            assert widget.props["min"] <= widget.value <= widget.props["max"], widget.props
+        if "options" in widget.props:
+            assert widget.value in widget.props["options"], widget.props
+
+
+def test_a_number_beyond_the_range_is_clamped_and_shown_clamped(poinsot_app, probe):
+    session = session_of(poinsot_app)
+    uuid, widget = probe.widget("|ω₀|")
+    top = widget.props["max"]
+    probe.set_value(uuid, 99_999_999.0)
+    assert probe.wait_for(lambda p: p.widgets[uuid].value == top, 10)
+    assert wait_until(lambda: abs(session.params.omega_norm - top) < 1e-9, 10)
+    uuid, widget = probe.widget("Speed")
+    before = session.clock.speed
+    probe.set_value(uuid, math.nan)
+    assert probe.wait_for(lambda p: p.widgets[uuid].value == before, 10)  # set back
+    probe.set_value(uuid, -1e300)
+    assert probe.wait_for(lambda p: p.widgets[uuid].value == widget.props["min"], 10)
+    assert wait_until(lambda: session.clock.speed == widget.props["min"], 10)
+    assert session.stats.errors == 0, session.stats.last_error
+
+
+def test_a_gui_update_naming_another_property_is_dropped(poinsot_app, probe):
+    """A browser sends only values; viser would set any attribute named (the callbacks)."""
+    session = session_of(poinsot_app)
+    uuid, widget = probe.widget("Speed")
+    probe.send(_messages.GuiUpdateMessage(uuid, {"max": 1e300, "update_cb": []}))
+    assert wait_until(lambda: poinsot_app.guard.malformed == 1, 10)
+    probe.set_value(uuid, 1e300)
+    assert wait_until(lambda: session.clock.speed == widget.props["max"], 10)
