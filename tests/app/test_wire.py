@@ -11,6 +11,7 @@ import pytest
 from conftest import session_of, wait_until
 from viser import _messages
 
+from poinsot.app.live import guard
 from poinsot.app.live.guard import POLICY_VIOLATION, origin_allowed
 from poinsot.app.live.probe import Probe
 from poinsot.app.live.transfers import handle_id
@@ -163,3 +164,39 @@ def test_a_gui_update_naming_another_property_is_dropped(poinsot_app, probe):
     assert wait_until(lambda: poinsot_app.guard.malformed == 1, 10)
     probe.set_value(uuid, 1e300)
     assert wait_until(lambda: session.clock.speed == widget.props["max"], 10)
+
+
+# -- floods ------------------------------------------------------------------------------------
+FLOOD_RATE = 10_000.0
+WINDOW = 6.0  # seconds of frames counted, quiet and flooded (compared as a ratio)
+
+
+@pytest.mark.slow
+def test_a_flooding_client_is_cut_off_and_the_others_keep_their_frames(make_app, make_probe):
+    """A raw client (its own process) sends 10k camera messages a second: beyond its budget
+    they are dropped unread by viser, then it is disconnected; another client's frames during
+    the flood stay >= 80 % of its frames in as long a quiet window, measured just before."""
+    from poinsot.app.load.flood import Flooder
+
+    app = make_app()
+    make_probe(app)
+    quiet_session = session_of(app)
+    assert wait_until(lambda: quiet_session.stats.frames > 30, 15)
+
+    def frames_in(seconds: float) -> int:
+        start = quiet_session.stats.frames
+        time.sleep(seconds)
+        return quiet_session.stats.frames - start
+
+    with Flooder(app.port, FLOOD_RATE, WINDOW, lifetime=120.0) as flooder:
+        assert len(app.sessions()) == 2
+        quiet = frames_in(WINDOW)
+        flooder.begin()
+        flooded = frames_in(WINDOW)
+        sent = flooder.end()
+    assert sent["sent"] > 2 * guard.MESSAGE_BURST
+    assert app.guard.dropped > guard.MESSAGE_BURST, (app.guard.dropped, sent)
+    assert app.guard.disconnected == 1 and sent["closed_by_server"], sent
+    assert wait_until(lambda: len(app.sessions()) == 1, 10)
+    assert quiet_session.stats.errors == 0
+    assert flooded >= 0.8 * quiet, (flooded, quiet, sent)
