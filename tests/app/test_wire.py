@@ -3,21 +3,24 @@
 from __future__ import annotations
 
 import math
+import threading
 import time
 from typing import Any
 
 import numpy as np
 import pytest
 from conftest import session_of, wait_until
+from uploading import MESH
 from viser import _messages
 
 from poinsot.app.live import guard
+from poinsot.app.live import transfers as transfers_module
 from poinsot.app.live.guard import POLICY_VIOLATION, origin_allowed
 from poinsot.app.live.probe import Probe
 from poinsot.app.live.transfers import handle_id
 from poinsot.app.live.widgets import checked
 from poinsot.app.parameters import Parameters
-from poinsot.app.presets import DEFAULT_PRESET
+from poinsot.app.presets import DEFAULT_PRESET, MESH_BODY
 
 # -- origins ---------------------------------------------------------------------------------
 
@@ -200,3 +203,60 @@ def test_a_flooding_client_is_cut_off_and_the_others_keep_their_frames(make_app,
     assert wait_until(lambda: len(app.sessions()) == 1, 10)
     assert quiet_session.stats.errors == 0
     assert flooded >= 0.8 * quiet, (flooded, quiet, sent)
+
+
+# -- bounded: uploads --------------------------------------------------------------------------
+MB = 1_000_000
+
+
+def _peak_while(measure, action) -> int:
+    """The largest ``measure()`` seen while ``action()`` runs (polled from another thread)."""
+    peak, done = [0], threading.Event()
+
+    def poll() -> None:
+        while not done.is_set():
+            peak[0] = max(peak[0], measure())
+            time.sleep(0.005)
+
+    poller = threading.Thread(target=poll, daemon=True)
+    poller.start()
+    try:
+        action()
+    finally:
+        done.set()
+        poller.join()
+    return max(peak[0], measure())
+
+
+def test_pending_uploads_stay_bounded_and_are_freed_when_the_client_leaves(poinsot_app, probe):
+    """A raw client sends 200 MB of upload parts: ten transfers of 19 MB announced at once to
+    the mesh button, parts sent round robin, and parts "uploaded" to a slider. The parts held
+    stay within one client's pending cap (plus a part), and are freed when it leaves."""
+    session = session_of(poinsot_app)
+    probe.set_value(probe.widget("Preset")[0], MESH_BODY.label)
+    assert probe.wait_for(lambda p: MESH in p.labels(), 10)
+    guard_ = session.uploads.guard
+    button, _ = probe.widget(MESH)
+    slider, _ = probe.widget("Speed")
+    part = b"\0" * MB
+
+    def send_200_mb() -> None:
+        transfers = [f"t{k}" for k in range(10)]
+        for t in transfers:
+            probe.send(_messages.FileTransferStartUpload(button, t, f"{t}.stl", "x", 19, 19 * MB))
+        probe.send(_messages.FileTransferStartUpload(slider, "s", "s.stl", "x", 10, 10 * MB))
+        for k in range(19):
+            for t in transfers:
+                probe.send(_messages.FileTransferPart(button, t, k, part))
+        for k in range(9):  # the slider's, and the first transfer's last part, never come
+            probe.send(_messages.FileTransferPart(slider, "s", k, part))
+        probe.widget(MESH)  # the probe's own model: nothing to wait for on the server
+
+    peak = _peak_while(guard_.pending_bytes, send_200_mb)
+    states = session.client.gui._current_file_upload_states
+    assert wait_until(lambda: guard_.pending_bytes() == 19 * MB or not states, 20)
+    assert peak <= transfers_module.MAX_PENDING_BYTES + MB, peak
+    assert set(states) <= {"t0"}  # one transfer in progress at most, the first
+    assert poinsot_app.guard.dropped == 0  # within the message budget: the caps held it
+    probe.close()
+    assert wait_until(lambda: guard_.pending_bytes() == 0 and not states, 10)
