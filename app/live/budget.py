@@ -114,8 +114,8 @@ class MessageBudget:
 
     def admit(self, now: float) -> bool:
         """Take one message arriving at ``now`` (time.monotonic()): True if within budget."""
-        self._tokens = min(self.burst, self._tokens + (now - self._last) * self.rate)
-        self._last = now
+        self._tokens = min(self.burst, self._tokens + max(0.0, now - self._last) * self.rate)
+        self._last = max(self._last, now)
         if self._tokens >= 1.0:
             self._tokens -= 1.0
             self.admitted += 1

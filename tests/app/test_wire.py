@@ -15,11 +15,13 @@ from viser import _messages
 
 from poinsot.app.live import guard
 from poinsot.app.live import transfers as transfers_module
+from poinsot.app.live.budget import MessageBudget
 from poinsot.app.live.guard import POLICY_VIOLATION, origin_allowed
+from poinsot.app.live.motion_window import PLOT_SAMPLES, MotionWindow
 from poinsot.app.live.probe import Probe
 from poinsot.app.live.transfers import handle_id
 from poinsot.app.live.widgets import checked
-from poinsot.app.parameters import Parameters
+from poinsot.app.parameters import TRAIL_RANGE, Parameters
 from poinsot.app.presets import DEFAULT_PRESET, MESH_BODY
 
 # -- origins ---------------------------------------------------------------------------------
@@ -260,3 +262,36 @@ def test_pending_uploads_stay_bounded_and_are_freed_when_the_client_leaves(poins
     assert poinsot_app.guard.dropped == 0  # within the message budget: the caps held it
     probe.close()
     assert wait_until(lambda: guard_.pending_bytes() == 0 and not states, 10)
+
+
+# -- bounded: trails, the plot, what a client may queue -----------------------------------------
+def test_a_client_cannot_lengthen_the_trails_beyond_their_cap(poinsot_app, probe):
+    """The trail length a client sends is clamped to the slider's top (the ring of chunks
+    itself holds its length: tests/app/test_parts.py)."""
+    session = session_of(poinsot_app)
+    probe.set_value(probe.widget("Trail length")[0], 10**12)
+    assert wait_until(lambda: session.scene.trail_points == TRAIL_RANGE[1], 10)
+    assert all(t.max_points == TRAIL_RANGE[1] for t in session.scene._trails.values())
+
+
+def test_the_plot_keeps_a_window_of_samples(poinsot_app):
+    motion = MotionWindow(poinsot_app.server.gui, order=0.0)
+    motion.add_plot()
+    for k in range(3 * PLOT_SAMPLES):
+        motion.record_plot(0.01 * k, np.array([1.0, 2.0, 3.0]))
+    assert motion.send_plot()
+    assert motion.plot is not None
+    assert all(len(series) == PLOT_SAMPLES for series in motion.plot.data)
+
+
+def test_what_a_client_gets_through_is_bounded_by_its_budget():
+    """The budget admits at most its burst at once and its rate after; a second within the
+    budget ends a streak of excess."""
+    budget = MessageBudget(rate=100.0, burst=50.0, excess_seconds=2.0)
+    t = time.monotonic()
+    admitted = sum(budget.admit(t) for _ in range(1000))  # 1000 at once
+    assert admitted == 50 and budget.dropped == 950 and not budget.sustained(t)
+    flood = [t + 0.001 * k for k in range(1, 3001)]  # 3 s at 1000 messages a second
+    admitted = sum(budget.admit(now) for now in flood)
+    assert admitted <= 100.0 * 3.0 + 1 and budget.sustained(flood[-1])
+    assert not budget.sustained(flood[-1] + 1.5)  # it paused
