@@ -8,7 +8,9 @@ websocket.recv()``, then its own decoding and dispatch). :class:`WireGuard` regi
 callback (``WebsockServer.on_client_connect``): there it reads the handshake's headers and
 either closes the connection (an origin not allowed: before any message is read, so no
 session is ever built) or wraps that connection's ``recv``, the earliest point at which a
-message of this client is seen. A message refused there is never decoded by viser.
+message of this client is seen. A message refused there is never decoded by viser; while a
+client is over its budget, its connection is read no faster than the budget refills, so a flood
+waits in its own socket (TCP holds the sender back) instead of costing the server CPU.
 
 Origins: a browser sends ``Origin`` with every websocket; a page may only drive the server if
 it was served by it (the origin's host:port is the ``Host`` the browser connected to), or if
@@ -150,6 +152,9 @@ class WireGuard:
                             self.disconnected += 1
                         close = websocket.close(POLICY_VIOLATION, "message budget exceeded")
                         closing.append(asyncio.create_task(close))
+                    # Read no faster than the budget refills: the rest waits in the client's
+                    # socket (its sends block), costing this process nothing.
+                    await asyncio.sleep(1.0 / budget.rate)
                     continue
                 if not _browser_could_send(raw):
                     with self._lock:
