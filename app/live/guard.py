@@ -67,20 +67,37 @@ def origin_allowed(origin: str | None, host: str | None, allowed: Iterable[str] 
     return parts.netloc == host.strip().lower()
 
 
-def _browser_could_send(raw: Any) -> bool:
-    """A binary msgpack map with a type; a GUI update carries only a value (viser would set any
-    attribute of the widget's state that a client names, its callbacks included)."""
+def _browser_message(raw: Any) -> dict[str, Any] | None:
+    """The decoded message if a browser could have sent it: a binary msgpack map with a type,
+    and a GUI update carrying only a value (viser would set any attribute of the widget's
+    state that a client names, its callbacks included); None otherwise."""
     if not isinstance(raw, bytes):
-        return False
+        return None
     try:
         message = msgspec.msgpack.decode(raw)
     except msgspec.DecodeError:
-        return False
+        return None
     if not isinstance(message, dict) or not isinstance(message.get("type"), str):
-        return False
+        return None
     if message["type"] == "GuiUpdateMessage":
         updates = message.get("updates")
-        return isinstance(updates, dict) and set(updates) == {"value"}
+        if not (isinstance(updates, dict) and set(updates) == {"value"}):
+            return None
+    return message
+
+
+def _fits(handle: Any, value: Any) -> bool:
+    """Can viser convert ``value`` to the type of the widget's value, as it will? (A text
+    for a slider, or nothing, would raise inside viser's handler, logged as an error.)"""
+    current = getattr(handle, "value", None)
+    if current is None:
+        return True
+    if isinstance(current, tuple):
+        return isinstance(value, list | tuple) and len(value) == len(current)
+    try:
+        type(current)(value)
+    except (TypeError, ValueError, OverflowError):
+        return False
     return True
 
 
@@ -98,6 +115,7 @@ class WireGuard:
     ) -> None:
         self.allowed_origins = tuple(normalise_origin(o) for o in allowed_origins)
         self._limits = (rate, burst, excess_seconds)
+        self._server = server
         self._infra = server._websock_server
         self._lock = threading.Lock()
         self._budgets: dict[int, MessageBudget] = {}
@@ -130,13 +148,30 @@ class WireGuard:
         budget = MessageBudget(*self._limits)
         with self._lock:
             self._budgets[connection.client_id] = budget
-        websocket.recv = self._budgeted(websocket, budget)
+        websocket.recv = self._budgeted(connection.client_id, websocket, budget)
 
     def _forget(self, connection: Any) -> None:
         with self._lock:
             self._budgets.pop(connection.client_id, None)
 
-    def _budgeted(self, websocket: Any, budget: MessageBudget) -> Callable[[], Awaitable[Any]]:
+    def _acceptable(self, client_id: int, raw: Any) -> bool:
+        """A message a browser could send, whose value (for a GUI update) fits its widget."""
+        message = _browser_message(raw)
+        if message is None:
+            return False
+        if message["type"] != "GuiUpdateMessage":
+            return True
+        client = self._server._connected_clients.get(client_id)
+        uuid = str(message.get("uuid"))
+        for gui in (client.gui if client is not None else None, self._server.gui):
+            handle = gui._gui_input_handle_from_uuid.get(uuid) if gui else None
+            if handle is not None:
+                return _fits(handle, message["updates"]["value"])
+        return True  # no such widget: viser ignores it
+
+    def _budgeted(
+        self, client_id: int, websocket: Any, budget: MessageBudget
+    ) -> Callable[[], Awaitable[Any]]:
         receive = websocket.recv
         closing: list[asyncio.Task[None]] = []
 
@@ -156,7 +191,7 @@ class WireGuard:
                     # socket (its sends block), costing this process nothing.
                     await asyncio.sleep(1.0 / budget.rate)
                     continue
-                if not _browser_could_send(raw):
+                if not self._acceptable(client_id, raw):
                     with self._lock:
                         self.malformed += 1
                     continue

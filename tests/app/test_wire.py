@@ -96,7 +96,9 @@ def _inputs(probe: Probe) -> dict[str, Any]:
     return {uuid: w for uuid, w in widgets.items() if w.type in INPUTS}
 
 
-def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(poinsot_app, probe):
+def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(
+    poinsot_app, probe, caplog
+):
     """Every value input of the panel gets what no browser sends: numbers are clamped into the
     widget's range, the rest refused (the widget shows its last value again); no frame fails,
     no NaN is sent, and a valid edit afterwards still works."""
@@ -136,6 +138,9 @@ def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(poinso
     assert wait_until(lambda: session.stats.frames > frames + 10, 10), "the frames stopped"
     assert session.stats.errors == 0, session.stats.last_error
     assert not sent_nan
+    # a value viser could not even convert (a text for a slider) never reaches it
+    assert poinsot_app.guard.malformed > 0
+    assert not [r for r in caplog.records if r.levelname == "ERROR"], caplog.text[:2000]
     assert math.isfinite(session.clock.speed) and math.isfinite(session.clock.now())
     for widget in _inputs(probe).values():
         if "min" in widget.props and widget.value is not None:
