@@ -54,7 +54,13 @@ def _count_clients(server: Any, load: Any) -> None:
 
 
 def _worker_main(
-    conn: Connection, load: Any, host: str, port: int, preset: str, scene: str | None
+    conn: Connection,
+    load: Any,
+    host: str,
+    port: int,
+    preset: str,
+    scene: str | None,
+    origins: tuple[str, ...] = (),
 ) -> None:
     """The worker: serve, report ``("ready", port)``, stop when told or when the parent's end
     of the pipe closes (then, whatever happens, the process ends within ``STOP_GRACE``).
@@ -67,7 +73,7 @@ def _worker_main(
     app = None
     status = 0
     try:
-        app = _serve(host, port, preset, scene)
+        app = _serve(host, port, preset, scene, origins)
         if port and app.port != port:  # viser moved on to the next free port: refuse
             conn.send(("error", port_problem(host, port)))
             return
@@ -88,26 +94,38 @@ def _worker_main(
         os._exit(status)
 
 
-def _serve(host: str, port: int, preset: str, scene: str | None) -> PoinsotApp:
+def _serve(
+    host: str, port: int, preset: str, scene: str | None, origins: tuple[str, ...]
+) -> PoinsotApp:
     from poinsot.app.live.server import PoinsotApp
     from poinsot.app.presets import preset_by_key
     from poinsot.app.scenes import scene_by_name
 
     start_scene = scene_by_name(scene) if scene else None
-    return PoinsotApp(host, port, preset=preset_by_key(preset), scene=start_scene)
+    return PoinsotApp(
+        host, port, preset=preset_by_key(preset), scene=start_scene, allow_origins=origins
+    )
 
 
 class Worker:
     """The parent's handle on one worker process (a :class:`~.landing.Backend`)."""
 
-    def __init__(self, index: int, host: str, port: int, preset: str, scene: str | None):
+    def __init__(
+        self,
+        index: int,
+        host: str,
+        port: int,
+        preset: str,
+        scene: str | None,
+        origins: tuple[str, ...] = (),
+    ):
         ctx = mp.get_context("spawn")
         self.index = index
         self.load = ctx.RawArray("q", 2)  # clients now, clients ever (written by the worker)
         self.conn, child_end = ctx.Pipe()
         self.process = ctx.Process(
             target=_worker_main,
-            args=(child_end, self.load, host, port, preset, scene),
+            args=(child_end, self.load, host, port, preset, scene, origins),
             name=f"poinsot-worker-{index}",
             daemon=True,
         )
@@ -167,7 +185,14 @@ class Worker:
         self.conn.close()
 
 
-def start_workers(count: int, host: str, port: int, preset: str, scene: str | None) -> list[Worker]:
+def start_workers(
+    count: int,
+    host: str,
+    port: int,
+    preset: str,
+    scene: str | None,
+    origins: tuple[str, ...] = (),
+) -> list[Worker]:
     """Start ``count`` workers (all at once) and wait until every one serves. With a fixed
     ``port`` they take the next ports, ``port + 1`` to ``port + count`` (one range to open in
     a firewall); with 0, any free ports. Raises :class:`PortError` (one line) if a port is
@@ -175,7 +200,7 @@ def start_workers(count: int, host: str, port: int, preset: str, scene: str | No
     ports = [port + 1 + i if port else 0 for i in range(count)]
     for p in ports:
         check_port(host, p)
-    workers = [Worker(i, host, p, preset, scene) for i, p in enumerate(ports)]
+    workers = [Worker(i, host, p, preset, scene, origins) for i, p in enumerate(ports)]
     try:
         for worker in workers:
             worker.wait_ready(START_TIMEOUT)
@@ -214,7 +239,14 @@ def report_ended(workers: Sequence[Worker], timeout: float) -> int:
 
 
 def serve_classroom(
-    host: str, port: int, count: int, preset: str, scene: str | None, *, announce: bool = True
+    host: str,
+    port: int,
+    count: int,
+    preset: str,
+    scene: str | None,
+    *,
+    announce: bool = True,
+    origins: tuple[str, ...] = (),
 ) -> int:
     """Run ``count`` workers behind a landing on ``host:port`` until Ctrl-C (exit status 0),
     or until every worker has ended (1). A port that cannot be served raises
@@ -223,7 +255,7 @@ def serve_classroom(
     from poinsot.app.live.network import board
 
     check_port(host, port)
-    workers = start_workers(count, host, port, preset, scene)
+    workers = start_workers(count, host, port, preset, scene, origins)
     try:
         landing = LandingServer(host, port, Balancer(workers))
     except PortError:

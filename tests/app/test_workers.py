@@ -272,7 +272,7 @@ def test_port_zero_takes_any_free_port(capsys, monkeypatch):
     network.check_port("127.0.0.1", 0)  # never refused
     with pytest.raises(SystemExit):
         cli.build_parser().parse_args(["serve", "--workers", "0"])
-    assert "at least 1 worker" in capsys.readouterr().err
+    assert "whole number >= 1" in capsys.readouterr().err
 
 
 # -- the board -----------------------------------------------------------------------------
