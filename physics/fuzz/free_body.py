@@ -10,10 +10,10 @@ from typing import Any
 import numpy as np
 
 from poinsot.physics import FreeRigidBody, Regime
-from poinsot.physics import fuzz_values as values
-from poinsot.physics.fuzz_checks import Invariants, finite, number, require, rotation
-from poinsot.physics.fuzz_harness import Call
-from poinsot.physics.fuzz_values import Source, pick
+from poinsot.physics.fuzz import values
+from poinsot.physics.fuzz.checks import Invariants, finite, number, require, rotation
+from poinsot.physics.fuzz.harness import Call
+from poinsot.physics.fuzz.values import Source, pick
 
 __all__ = ["TARGETS", "body_maker", "short"]
 
