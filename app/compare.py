@@ -88,9 +88,17 @@ _APP_LINES = [
         _pattern(r"frames per second per client:\s*#"),
         [("{} frames per second per client", RATE)],
     ),
-    (
+    (  # scene bytes only, the GUI's apart (older revisions)
         _pattern(r"bytes sent per frame\s*:\s*# B .*GUI # kB/s"),
         [("{} scene bytes per frame [B]", COST), ("{} GUI traffic [kB/s]", COST)],
+    ),
+    (  # everything one client receives (one websocket message per frame)
+        _pattern(r"bytes sent per frame\s*:\s*# B\s+\(everything"),
+        [("{} all bytes per frame [B]", COST)],
+    ),
+    (
+        _pattern(r"messages per frame\s*:\s*#\s+\(scene #"),
+        [("{} viser messages per frame", COST), ("{} scene messages per frame", COST)],
     ),
     (
         _pattern(r"slider-to-redraw\s*: median # ms, p95 # ms"),
@@ -197,7 +205,17 @@ def ratios(new_runs: Sequence[Figures], old_runs: Sequence[Figures]) -> list[Rat
     return result
 
 
-def format_ratios(rows: Sequence[Ratio], header: str) -> str:
+def one_sided(new_runs: Sequence[Figures], old_runs: Sequence[Figures]) -> list[str]:
+    """Figures only one side printed (a benchmark that gained or changed a line): not
+    compared, but named, so that nothing is dropped silently."""
+    new = {name for run in new_runs for name in run}
+    old = {name for run in old_runs for name in run}
+    return [f"{name} (new only)" for name in sorted(new - old)] + [
+        f"{name} (old only)" for name in sorted(old - new)
+    ]
+
+
+def format_ratios(rows: Sequence[Ratio], header: str, unpaired: Sequence[str] = ()) -> str:
     """The table of ratios with the limits they are judged against, and a one-line tally."""
     width = max([len(r.name) for r in rows] + [30])
     lines = [
@@ -209,6 +227,7 @@ def format_ratios(rows: Sequence[Ratio], header: str) -> str:
     for r in rows:
         low, high = (min(r.ratios), max(r.ratios)) if r.ratios else (float("nan"),) * 2
         lines.append(f"{r.name:{width}s}  {r.median:7.3f}  {low:6.3f}-{high:<6.3f}  {r.verdict}")
+    lines += [f"not compared, printed by one side only: {name}" for name in unpaired]
     missed = [r.name for r in rows if r.verdict == "MISSED"]
     judged = [r for r in rows if r.verdict in ("met", "MISSED")]
     lines.append(
@@ -314,9 +333,11 @@ def checkout(repo: pathlib.Path, revision: str) -> Iterator[pathlib.Path]:
 
 def compare(
     new: Tree, old: Tree, benchmarks: Sequence[str], options: argparse.Namespace
-) -> list[Ratio]:
-    """Alternate the runs (new, old, new, old, ...) for ``options.rounds`` rounds."""
-    rows = []
+) -> tuple[list[Ratio], list[str]]:
+    """Alternate the runs (new, old, new, old, ...) for ``options.rounds`` rounds; the ratios,
+    and the figures only one side printed."""
+    rows: list[Ratio] = []
+    unpaired: list[str] = []
     for benchmark in benchmarks:
         new_runs: list[Figures] = []
         old_runs: list[Figures] = []
@@ -325,13 +346,15 @@ def compare(
                 print(f"  round {k + 1}/{options.rounds}: {benchmark} {label}", file=sys.stderr)
                 runs.append(run_benchmark(tree, benchmark, options))
         rows += ratios(new_runs, old_runs)
-    return rows
+        unpaired += one_sided(new_runs, old_runs)
+    return rows, unpaired
 
 
 def run_comparison(
     repo: pathlib.Path, against: str, benchmarks: Sequence[str], options: argparse.Namespace
-) -> list[Ratio]:
-    """The working tree at ``repo`` against revision ``against`` of the same repository."""
+) -> tuple[list[Ratio], list[str]]:
+    """The working tree at ``repo`` against revision ``against`` of the same repository: the
+    ratios, and the figures only one side printed."""
     with checkout(repo, against) as other, tempfile.TemporaryDirectory() as scratch:
         new = prepare(repo, pathlib.Path(scratch) / "new")
         old = prepare(other, pathlib.Path(scratch) / "old")
@@ -366,7 +389,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     repo = pathlib.Path(__file__).resolve().parents[1]
     load0 = os.getloadavg()[0]
     try:
-        rows = run_comparison(repo, options.against, benchmarks, options)
+        rows, unpaired = run_comparison(repo, options.against, benchmarks, options)
     except subprocess.CalledProcessError as error:
         print(
             f"compare: git cannot check out {options.against!r}: {error.stderr.strip()}",
@@ -381,7 +404,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"{options.rounds} alternating round(s), {os.cpu_count()} CPUs, load average "
         f"{load0:.1f} at start, {os.getloadavg()[0]:.1f} at end"
     )
-    print(format_ratios(rows, header))
+    print(format_ratios(rows, header, unpaired))
     return 1 if any(r.verdict == "MISSED" for r in rows) else 0
 
 

@@ -149,6 +149,27 @@ def test_a_figure_missing_on_one_side_or_unmeasured_is_not_judged():
     assert rows["app 1 client(s): slider-to-redraw p95 [ms]"].verdict == "n/a"  # nan
 
 
+def test_a_benchmark_line_that_changed_is_named_not_compared():
+    """The app benchmark that counts every byte of a frame (one websocket message) and its
+    viser messages, against one that counted the scene's bytes and the GUI's apart."""
+    changed = app_text().replace(
+        "612 B  (poses + trail increments) + GUI 3.4 kB/s (plot 10 Hz, time 5 Hz)",
+        "1210 B  (everything: poses, traces, labels, plot 10 Hz, time 5 Hz)   (target <= 2 kB)\n"
+        "  messages per frame          :    4.30    (scene 3.25: 3 poses + a trace increment)",
+    )
+    new, old = [compare.parse_app(changed)], [compare.parse_app(app_text())]
+    assert new[0]["app 1 client(s): all bytes per frame [B]"] == (1210.0, COST)
+    assert new[0]["app 10 client(s): scene messages per frame"] == (3.25, COST)
+    unpaired = compare.one_sided(new, old)
+    assert "app 1 client(s): viser messages per frame (new only)" in unpaired
+    assert "app 10 client(s): GUI traffic [kB/s] (old only)" in unpaired
+    names = {r.name for r in compare.ratios(new, old)}
+    assert "app 1 client(s): frames per second per client" in names
+    assert not any("bytes" in name for name in names)
+    table = compare.format_ratios(compare.ratios(new, old), "header", unpaired)
+    assert "printed by one side only: app 1 client(s): all bytes per frame [B] (new only)" in table
+
+
 def test_the_table_states_the_limits_and_names_what_missed():
     rows = [Ratio("fast", COST, (0.9, 1.0, 1.05)), Ratio("fps", RATE, (0.5, 0.6, 0.7))]
     table = compare.format_ratios(rows, "header")
@@ -188,7 +209,9 @@ def test_the_working_tree_runs_against_an_older_layout_from_a_temporary_worktree
     # Uncommitted: the working tree, not HEAD, is what gets measured.
     (repo / "physics" / "canned.py").write_text(f"TEXT = {physics_text(omega_ns=5.0)!r}\n")
     options = compare.build_parser().parse_args(["--against", "HEAD~1", "--rounds", "2"])
-    rows = {r.name: r for r in compare.run_comparison(repo, "HEAD~1", ["physics", "app"], options)}
+    found, unpaired = compare.run_comparison(repo, "HEAD~1", ["physics", "app"], options)
+    rows = {r.name: r for r in found}
+    assert unpaired == []
     assert rows["physics generic (1,2,3) omega [ns/point]"].ratios == (0.25, 0.25)
     assert rows["app 10 client(s): frames per second per client"].verdict == "MISSED"
     assert rows["app 1 client(s): rebuild median [ms]"].ratios == (1.0, 1.0)
@@ -233,7 +256,7 @@ def test_the_real_physics_benchmark_of_head_against_head(capsys):
     options = compare.build_parser().parse_args(
         ["--against", "HEAD", "--rounds", "1", "-n", "2000", "--repeat", "1"]
     )
-    rows = compare.run_comparison(REPO, "HEAD", ["physics"], options)
-    assert len(rows) == 3 * 6 + 3
+    rows, unpaired = compare.run_comparison(REPO, "HEAD", ["physics"], options)
+    assert len(rows) == 3 * 6 + 3 and unpaired == []
     assert all(len(r.ratios) == 1 and r.median > 0 for r in rows)
     assert _git(REPO, "worktree", "list") == worktrees
