@@ -7,7 +7,7 @@ PORT   ?= 8080
 CHROMIUM ?= /usr/bin/chromium
 SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: run test install install-test chromium bench load lint clean
+.PHONY: run test install install-test chromium bench bench-compare load lint clean
 
 $(VENV)/bin/activate:
 	$(PYTHON) -m venv $(VENV)
@@ -31,11 +31,14 @@ install: $(VENV)/.installed
 install-test: $(VENV)/.installed-test
 
 # Debian's Chromium drives the real-browser tests (playwright uses it via executable_path).
-# strace lets a test prove that the browser reaches nothing past loopback.
+# strace lets a test prove that the browser reaches nothing past loopback; nginx runs the
+# README's load-balancer set-up on loopback (tests/app/test_nginx.py).
 chromium:
-	@if [ -x "$(CHROMIUM)" ] && command -v strace >/dev/null; then echo "chromium: $(CHROMIUM)"; else \
-		echo "installing Debian's chromium and strace"; \
-		$(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y chromium strace; fi
+	@if [ -x "$(CHROMIUM)" ] && command -v strace >/dev/null && [ -x /usr/sbin/nginx ]; then \
+		echo "chromium: $(CHROMIUM)"; else \
+		echo "installing Debian's chromium, strace and nginx-light"; \
+		$(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y \
+			chromium strace nginx-light; fi
 
 run: install
 	$(VENV)/bin/poinsot serve --host $(HOST) --port $(PORT)
@@ -45,6 +48,11 @@ test: install-test chromium
 
 bench: install
 	$(PY) -m poinsot.physics.benchmark
+
+# Both benchmarks of this working tree against another revision, alternating, as ratios new/old
+# (exits 1 when a figure regressed), e.g. make bench-compare AGAINST=8b3cd8c ARGS="--rounds 5".
+bench-compare: install
+	$(PY) -m poinsot.app.compare --against $(AGAINST) $(ARGS)
 
 # Load test of the live server on loopback (about 8 minutes; exits 1 when a goal is missed).
 # Options go in ARGS, e.g. make load ARGS="--phase soak storm --clients 10 --seconds 60".

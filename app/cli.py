@@ -15,13 +15,25 @@ from __future__ import annotations
 import argparse
 import inspect
 import math
+import os
 import pathlib
 import sys
 import time
 from collections.abc import Callable, Sequence
-from typing import NoReturn
 
-from poinsot.app.exports.html import HTML_FPS
+from poinsot.app.arguments import (
+    OneLineParser,
+    bounded_float,
+    input_path,
+    non_negative_float,
+    output_dir,
+    output_file,
+    port_number,
+    positive_float,
+    positive_int,
+    run_guarded,
+)
+from poinsot.app.exports.html import HTML_FPS, HTML_MAX_SECONDS
 from poinsot.app.exports.screenshot import parse_size, resolve_scene
 from poinsot.app.presets import PRESETS, Preset, preset_by_key
 from poinsot.app.scene.cameras import CAMERA_NAMES, RIDE_ALONG, canonical
@@ -41,11 +53,8 @@ class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
         return super()._get_help_string(action)
 
 
-class CommandParser(argparse.ArgumentParser):
-    """A subcommand's parser: a bad option is one line on stderr (exit status 2)."""
-
-    def error(self, message: str) -> NoReturn:
-        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+class CommandParser(OneLineParser):
+    """A command's parser: a bad option is one line on stderr (exit status 2)."""
 
 
 # -- converters (text -> value; a readable error for argparse) ------------------------------
@@ -106,13 +115,40 @@ def _size(text: str) -> tuple[int, int]:
 
 
 # -- the commands ---------------------------------------------------------------------------
-def serve(host: str, port: int, preset: str, start_scene: SceneSpec | None) -> int:
+def serve(
+    host: str,
+    port: int,
+    preset: str,
+    start_scene: SceneSpec | None,
+    workers: int,
+    allow_origin: list[str],
+) -> int:
     """Serve until interrupted (Ctrl-C); each browser starts with ``start_scene`` if given,
-    else with ``preset``."""
+    else with ``preset``. With ``workers`` > 1 the sessions run in that many processes behind
+    a landing port (:mod:`poinsot.app.live.workers`). A port that cannot be served is one
+    line and exit status 2."""
+    from poinsot.app.live.network import PortError, board, check_port, port_problem
+
+    try:
+        check_port(host, port)
+        if workers > 1:
+            from poinsot.app.live.workers import serve_classroom
+
+            scene = start_scene.name if start_scene else None
+            return serve_classroom(host, port, workers, preset, scene, origins=tuple(allow_origin))
+    except PortError as exc:
+        print(f"poinsot serve: {exc}", file=sys.stderr)
+        return 2
     from poinsot.app.live.server import PoinsotApp
 
-    app = PoinsotApp(host, port, preset=preset_by_key(preset), scene=start_scene)
-    print(f"Poinsot is running at {app.url}  (Ctrl-C to stop)", flush=True)
+    app = PoinsotApp(
+        host, port, preset=preset_by_key(preset), scene=start_scene, allow_origins=allow_origin
+    )
+    if port and app.port != port:  # viser took the next free port: the board would be wrong
+        app.stop()
+        print(f"poinsot serve: {port_problem(host, port)}", file=sys.stderr)
+        return 2
+    print(board(host, app.port), flush=True)
     try:
         while True:
             time.sleep(3600)
@@ -177,7 +213,7 @@ def fit(
 
     if start is not None and end is not None and not start < end:
         print(
-            f"poinsot fit: the start ({start:g} s) must come before the end ({end:g} s)",
+            f"poinsot fit: error: the start ({start:g} s) must come before the end ({end:g} s)",
             file=sys.stderr,
         )
         return 2
@@ -207,7 +243,28 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         default="127.0.0.1",
         help="interface to listen on (0.0.0.0 lets students on the room's network connect)",
     )
-    parser.add_argument("--port", type=int, default=8080, help="TCP port (0 = any free port)")
+    parser.add_argument(
+        "--port",
+        type=port_number,
+        default=8080,
+        help="TCP port; if it is busy the server says so and stops (0 = any free port)",
+    )
+    parser.add_argument(
+        "--workers",
+        type=positive_int,
+        default=os.cpu_count() or 1,
+        metavar="N",
+        help="processes serving the sessions (default: the number of cores, here %(default)s);"
+        " with N > 1 the port redirects each new browser to the least-loaded one, on the "
+        "ports that follow it; 1 = one process",
+    )
+    parser.add_argument(
+        "--allow-origin",
+        action="append",
+        default=[],
+        metavar="ORIGIN",
+        help="also accept browsers from this page's origin (http://host:port); repeatable",
+    )
     which = parser.add_mutually_exclusive_group()
     which.add_argument(
         "--preset",
@@ -230,7 +287,9 @@ def _add_report_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--quick", action="store_true", help="a reduced case matrix and fewer settings (< 60 s)"
     )
-    parser.add_argument("--out", default="out/report", help="output directory (created)")
+    parser.add_argument(
+        "--out", type=output_dir, default="out/report", help="output directory (created)"
+    )
     parser.set_defaults(func=report)
 
 
@@ -257,7 +316,7 @@ def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
         "--time",
         dest="t",
         metavar="TIME",
-        type=float,
+        type=non_negative_float,
         default=None,
         help="simulation time of the picture (default: one period of omega)",
     )
@@ -282,7 +341,7 @@ def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_false",
         help="keep the view's field of view instead of framing the construction",
     )
-    parser.add_argument("--out", type=pathlib.Path, required=True, help="output .png file")
+    parser.add_argument("--out", type=output_file, required=True, help="output .png file")
     parser.set_defaults(func=screenshot)
 
 
@@ -299,8 +358,15 @@ def _add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="NAME",
         help="or a scene to record: " + ", ".join(scene_names()),
     )
-    parser.add_argument("--seconds", type=float, default=20.0, help="clip length (wall seconds)")
-    parser.add_argument("--fps", type=float, default=HTML_FPS, help="recorded frames per second")
+    parser.add_argument(
+        "--seconds",
+        type=bounded_float(0.0, HTML_MAX_SECONDS, open_low=True),
+        default=20.0,
+        help="clip length (wall seconds)",
+    )
+    parser.add_argument(
+        "--fps", type=bounded_float(1.0, 60.0), default=HTML_FPS, help="recorded frames per second"
+    )
     parser.add_argument(
         "--view",
         type=_fixed_view,
@@ -309,23 +375,27 @@ def _add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
         help="initial camera, as the browser's buttons name it (the viewer can still orbit)",
     )
     parser.add_argument("--light", action="store_true", help="light theme (default: dark)")
-    parser.add_argument("--out", type=pathlib.Path, required=True, help="output .html file")
+    parser.add_argument("--out", type=output_file, required=True, help="output .html file")
     parser.set_defaults(func=export_html)
 
 
 def _add_benchmark_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--clients", type=int, nargs="+", default=[1, 20], help="browsers per run, one run each"
+        "--clients",
+        type=positive_int,
+        nargs="+",
+        default=[1, 20],
+        help="browsers per run, one run each",
     )
-    parser.add_argument("--seconds", type=float, default=5.0, help="steady-state window")
-    parser.add_argument("--redraws", type=int, default=30, help="slider moves per run")
+    parser.add_argument("--seconds", type=positive_float, default=5.0, help="steady-state window")
+    parser.add_argument("--redraws", type=positive_int, default=30, help="slider moves per run")
     parser.set_defaults(func=benchmark)
 
 
 def _add_fit_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "path",
-        type=pathlib.Path,
+        type=input_path,
         metavar="PATH",
         help="a phyphox export (folder or .zip) or a CSV of t, ωx, ωy, ωz",
     )
@@ -336,12 +406,12 @@ def _add_fit_arguments(parser: argparse.ArgumentParser) -> None:
         "--end", type=_seconds, metavar="E", help="fit only up to this time [s] (one stretch)"
     )
     parser.add_argument(
-        "--json", dest="json_out", type=pathlib.Path, metavar="OUT", help="write the fits as JSON"
+        "--json", dest="json_out", type=output_file, metavar="OUT", help="write the fits as JSON"
     )
     parser.add_argument(
         "--plot",
         dest="plot_out",
-        type=pathlib.Path,
+        type=output_file,
         metavar="OUT.png",
         help="plot the measured ω against the fits (needs matplotlib)",
     )
@@ -383,23 +453,31 @@ _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] =
 }
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="poinsot", description=DESCRIPTION, formatter_class=HelpFormatter
+def _add_debug_argument(parser: argparse.ArgumentParser, default: object) -> None:
+    parser.add_argument(
+        "--debug",
+        action="store_true",
+        default=default,
+        help="show the traceback of an unexpected failure (else one line)",
     )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = CommandParser(prog="poinsot", description=DESCRIPTION, formatter_class=HelpFormatter)
+    _add_debug_argument(parser, False)
     _add_serve_arguments(parser)  # `poinsot --host ...` is `poinsot serve --host ...`
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=CommandParser)
     for name, (help_text, add_arguments) in _SUBCOMMANDS.items():
-        add_arguments(
-            sub.add_parser(
-                name, help=help_text, description=help_text, formatter_class=HelpFormatter
-            )
+        command = sub.add_parser(
+            name, help=help_text, description=help_text, formatter_class=HelpFormatter
         )
+        # `poinsot --debug fit ...` and `poinsot fit --debug ...` both work.
+        _add_debug_argument(command, argparse.SUPPRESS)
+        add_arguments(command)
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+def _run(args: argparse.Namespace) -> int:
     if args.func is report:  # the report's own entry point takes the parsed options as they are
         return int(report(args))
     # A command takes the options named by its parameters (the top-level parser's serve
@@ -407,6 +485,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     options = vars(args)
     names = inspect.signature(args.func).parameters
     return int(args.func(**{name: options[name] for name in names}))
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Parse, run the command; a bad argument is one line and exit status 2, an unexpected
+    failure one line and exit status 1 (with its traceback under ``--debug``)."""
+    args = build_parser().parse_args(argv)
+    prog = f"poinsot {args.command or 'serve'}"
+    return run_guarded(prog, lambda: _run(args), debug=args.debug)
 
 
 if __name__ == "__main__":  # python -m poinsot.app.cli behaves as python -m poinsot.app and poinsot

@@ -91,7 +91,8 @@ def measure_growth_rate(
             f"by {start_factor:.3g} and then by two e-folds before it reaches {hi:g}; "
             "start closer to the intermediate axis"
         )
-    step = _growth_step(body, step, math.log(hi / p0))
+    # A difference of logarithms: hi/p0 overflows for a subnormal start p0.
+    step = _growth_step(body, step, math.log(hi) - math.log(p0))
     t, p = _walk_until(body, step, hi)
     first_hi = int(np.argmax(p >= hi))
     t, p = t[:first_hi], p[:first_hi]

@@ -147,6 +147,8 @@ def real_array(value: object, name: str, expected: str = "real numbers") -> NDAr
         ) from None
     kind = arr.dtype.kind
     if kind in _REAL_KINDS:
+        if arr.dtype.itemsize <= 8:  # fits in a double: no overflow, and no costly np.errstate
+            return arr.astype(np.float64)
         with np.errstate(over="ignore"):  # a long double beyond 1.8e308 becomes inf: refused later
             return arr.astype(np.float64)
     if kind == "O":

@@ -13,6 +13,7 @@ import contextlib
 import io
 import math
 import warnings
+from typing import Self
 
 import numpy as np
 import viser
@@ -35,7 +36,81 @@ SEEK_STEP = 0.05
 SEEK_WINDOW = 250.0
 
 
-class Stage:
+def open_server(host: str, port: int, dark_mode: bool) -> viser.ViserServer:
+    """A viser server lit and themed as each browser of the app is, without world axes."""
+    # viser prints a "listening" banner (and "Server stopped"): noise from a stage, which
+    # nobody browses by hand, so it is swallowed.
+    with contextlib.redirect_stdout(io.StringIO()):
+        server = viser.ViserServer(host=host, port=port, verbose=False)
+    try:
+        warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection")
+        configure_theme(server.gui, dark_mode=dark_mode)
+        server.scene.world_axes.visible = False
+        apply_lighting(server.scene)
+    except BaseException:
+        stop_server(server)
+        raise
+    return server
+
+
+def stop_server(server: viser.ViserServer) -> None:
+    with contextlib.redirect_stdout(io.StringIO()):
+        server.stop()
+
+
+class ServedStage:
+    """What every stage does with its server and its time: ``with``, :meth:`stop`, the
+    :attr:`url`, the initial camera, and :meth:`seek` (by :meth:`advance` from a
+    :meth:`restart`, which a stage defines)."""
+
+    server: viser.ViserServer
+    frame: Frame
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def stop(self) -> None:
+        stop_server(self.server)
+
+    @property
+    def url(self) -> str:
+        return f"http://{self.server.get_host()}:{self.server.get_port()}"
+
+    def advance(self, t: float) -> Frame:
+        """Pose the stage at ``t`` and extend its traces (one animation frame)."""
+        raise NotImplementedError
+
+    def restart(self, t: float) -> Frame:
+        """Show time ``t`` with the traces started afresh there."""
+        raise NotImplementedError
+
+    def seek(self, t: float) -> Frame:
+        """Show time ``t`` as a running app would: the traces drawn up to ``t``."""
+        t = float(t)
+        if not math.isfinite(t) or t < 0.0:
+            raise ValueError(f"the time must be a finite number >= 0, got {t}")
+        start = max(0.0, t - SEEK_WINDOW)
+        if t < self.frame.t or start > self.frame.t:
+            # Restart the traces at ``start`` instead of drawing one long chord to it.
+            self.frame = self.restart(start)
+        steps = max(1, math.ceil((t - self.frame.t) / SEEK_STEP))
+        for tt in np.linspace(self.frame.t, t, steps + 1)[1:]:
+            self.advance(float(tt))
+        return self.frame
+
+    def set_initial_camera(self, view: View) -> None:
+        """The camera every browser opening the stage (or a recording of it) starts with."""
+        camera = self.server.initial_camera
+        camera.up = view.up
+        camera.position = view.position
+        camera.look_at = view.look_at
+        camera.fov = math.radians(view.fov_degrees)
+
+
+class Stage(ServedStage):
     """Create, :meth:`seek` or :meth:`advance`, then :meth:`stop` (or use ``with``)."""
 
     def __init__(
@@ -53,15 +128,8 @@ class Stage:
         body = params.build()
         self.params = params
         self.dark_mode = dark_mode
-        # viser prints a "listening" banner (and "Server stopped"): noise from a stage, which
-        # nobody browses by hand, so it is swallowed.
-        with contextlib.redirect_stdout(io.StringIO()):
-            self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        self.server = open_server(host, port, dark_mode)
         try:
-            warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection")
-            configure_theme(self.server.gui, dark_mode=dark_mode)
-            self.server.scene.world_axes.visible = False
-            apply_lighting(self.server.scene)  # as each browser of the app is lit
             self.scene = PoinsotScene(
                 self.server.scene, elements, trail_points, atomic=self.server.atomic
             )
@@ -78,21 +146,6 @@ class Stage:
         kwargs.setdefault("trail_points", preset.trail_points)
         return cls(Parameters.from_preset(preset), preset.solid, preset.elements, **kwargs)
 
-    # -- context manager -----------------------------------------------------------------
-    def __enter__(self) -> Stage:
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.stop()
-
-    def stop(self) -> None:
-        with contextlib.redirect_stdout(io.StringIO()):
-            self.server.stop()
-
-    @property
-    def url(self) -> str:
-        return f"http://{self.server.get_host()}:{self.server.get_port()}"
-
     # -- time ----------------------------------------------------------------------------
     @property
     def t(self) -> float:
@@ -103,19 +156,8 @@ class Stage:
         self.frame = self.scene.advance(float(t))
         return self.frame
 
-    def seek(self, t: float) -> Frame:
-        """Show time ``t`` as a running app would: the traces drawn up to ``t``."""
-        t = float(t)
-        if not math.isfinite(t) or t < 0.0:
-            raise ValueError(f"the time must be a finite number >= 0, got {t}")
-        start = max(0.0, t - SEEK_WINDOW)
-        if t < self.frame.t or start > self.frame.t:
-            # Restart the traces at ``start`` instead of drawing one long chord to it.
-            self.frame = self.scene.load(self.body, self.solid, t=start)
-        steps = max(1, math.ceil((t - self.frame.t) / SEEK_STEP))
-        for tt in np.linspace(self.frame.t, t, steps + 1)[1:]:
-            self.advance(float(tt))
-        return self.frame
+    def restart(self, t: float) -> Frame:
+        return self.scene.load(self.body, self.solid, t=t)
 
     # -- camera --------------------------------------------------------------------------
     def lay_out_labels(self, view: View, size: tuple[int, int]) -> None:
@@ -131,11 +173,3 @@ class Stage:
         )
         with self.server.atomic():
             self.scene.lay_out_labels(camera)
-
-    def set_initial_camera(self, view: View) -> None:
-        """The camera every browser opening the stage (or a recording of it) starts with."""
-        camera = self.server.initial_camera
-        camera.up = view.up
-        camera.position = view.position
-        camera.look_at = view.look_at
-        camera.fov = math.radians(view.fov_degrees)

@@ -11,11 +11,14 @@ It also gives a slider move precedence: while any session rebuilds its scene (:m
 the other sessions hold their next frame (:attr:`rebuilding`), so the rebuild has the
 interpreter to itself and the student who moved the slider sees the new body at once; the
 others lose at most a frame or two.
+
+:class:`MessageBudget` is the other direction: how many messages one client may send.
 """
 
 from __future__ import annotations
 
 import contextlib
+import math
 import threading
 import time
 from collections.abc import Iterator
@@ -90,3 +93,42 @@ class FrameBudget:
         else:
             self._fps = self.max_fps
         self._t0, self._cpu0, self._frames = now, time.process_time(), 0
+
+
+class MessageBudget:
+    """What one client may send: ``rate`` messages a second, in bursts of up to ``burst`` (a
+    token bucket). A message beyond it is refused (:meth:`admit` is False) and counted; a client
+    that keeps exceeding it for ``excess_seconds`` is :meth:`sustained` (the guard then closes
+    its connection). A browser sends at most a few dozen messages a second (camera moves, a
+    slider dragged, parts of an upload): it never meets the limit."""
+
+    def __init__(self, rate: float, burst: float, excess_seconds: float) -> None:
+        self.rate, self.burst = float(rate), float(burst)
+        self.excess_seconds = float(excess_seconds)
+        self._tokens = self.burst
+        self._last = time.monotonic()
+        self._excess_since: float | None = None
+        self._last_refusal = -math.inf
+        self.admitted = 0
+        self.dropped = 0
+
+    def admit(self, now: float) -> bool:
+        """Take one message arriving at ``now`` (time.monotonic()): True if within budget."""
+        self._tokens = min(self.burst, self._tokens + max(0.0, now - self._last) * self.rate)
+        self._last = max(self._last, now)
+        if self._tokens >= 1.0:
+            self._tokens -= 1.0
+            self.admitted += 1
+            return True
+        self.dropped += 1
+        if now - self._last_refusal > 1.0:  # a second within budget ends a streak of excess
+            self._excess_since = now
+        self._last_refusal = now
+        return False
+
+    def sustained(self, now: float) -> bool:
+        """True once the client has been over its budget for ``excess_seconds`` without a
+        second's pause."""
+        if self._excess_since is None or now - self._last_refusal > 1.0:
+            return False
+        return now - self._excess_since >= self.excess_seconds

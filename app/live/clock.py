@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections.abc import Callable
@@ -38,6 +39,8 @@ class SimClock:
 
     @speed.setter
     def speed(self, speed: float) -> None:
+        if not math.isfinite(speed):  # the clock would read NaN from now on, every frame
+            raise ValueError(f"the speed must be a finite number, not {speed!r}")
         with self._lock:
             self._reanchor_locked()
             self._speed = float(speed)
@@ -54,6 +57,8 @@ class SimClock:
 
     def step(self, dt: float) -> None:
         """Advance by ``dt`` simulation seconds (used while paused)."""
+        if not math.isfinite(dt):
+            raise ValueError(f"a step must be a finite time, not {dt!r}")
         with self._lock:
             self._reanchor_locked()
             self._t_anchor += float(dt)

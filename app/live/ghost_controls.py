@@ -21,12 +21,11 @@ from __future__ import annotations
 
 import dataclasses
 import threading
-from collections.abc import Callable
 from typing import Any, Protocol
 
 import viser
 
-from poinsot.app.live.widgets import Retirement, set_value
+from poinsot.app.live.widgets import Retirement, Sent, on_user, set_value
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.ghost import (
@@ -96,33 +95,27 @@ class GhostControls:
                 hint="Relative tolerance (adaptive) or step h = T/n, T the period of ω.",
             )
             self.message = gui.add_markdown("", order=3.0)
-        self.enabled.on_update(self._guarded(self._on_enabled))
-        self.method.on_update(self._guarded(self._on_method))
-        self.setting.on_update(self._guarded(self._on_setting))
+        # Browser changes only, each value checked against its widget first (:func:`on_user`).
+        on_user(self.enabled, self._on_enabled, self._record_error)
+        on_user(self.method, self._on_method, self._record_error)
+        on_user(self.setting, self._on_setting, self._record_error)
 
     # -- callbacks (viser's threads): record the wish only -------------------------------
-    def _guarded(self, callback: Callable[[Any], None]) -> Callable[[viser.GuiEvent], None]:
-        def wrapped(event: viser.GuiEvent) -> None:
-            if event.client is None:  # a value set by the server
-                return
-            try:
-                callback(event.target)
-            except Exception as exc:  # shown by the frame thread, never raised into viser
-                with self._lock:
-                    self._callback_error = f"{type(exc).__name__}: {exc}"
+    def _record_error(self, exc: Exception) -> None:
+        """Shown by the frame thread, never raised into viser."""
+        with self._lock:
+            self._callback_error = f"{type(exc).__name__}: {exc}"
 
-        return wrapped
+    def _on_enabled(self, sent: Sent) -> None:
+        self.configure(enabled=bool(sent.value))
 
-    def _on_enabled(self, handle: viser.GuiCheckboxHandle) -> None:
-        self.configure(enabled=bool(handle.value))
-
-    def _on_method(self, handle: viser.GuiDropdownHandle[str]) -> None:
+    def _on_method(self, sent: Sent) -> None:
         for name, label in METHOD_LABELS.items():
-            if label == handle.value:
+            if label == sent.value:
                 self.configure(method=name)
 
-    def _on_setting(self, handle: viser.GuiDropdownHandle[str]) -> None:
-        value = str(handle.value)
+    def _on_setting(self, sent: Sent) -> None:
+        value = str(sent.value)
         if value.startswith("T/"):
             self.configure(divisions=int(value[2:]))
         else:

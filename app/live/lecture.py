@@ -33,7 +33,7 @@ from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filen
 from poinsot.app.live.clock import SimClock
 from poinsot.app.live.display import LARGE_TEXT_PERCENT, Display
 from poinsot.app.live.motion_window import MotionWindow
-from poinsot.app.live.widgets import set_value
+from poinsot.app.live.widgets import Sent, on_user, set_value
 from poinsot.app.presets import Preset
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.cameras import BODY_VIEW, CAMERA_NAMES, RIDE_ALONG, ride_along, space_view
@@ -88,15 +88,19 @@ class LectureControls:
         self.last_download: str = ""  # name of the last file handed to the browser
         with self.client.gui.add_folder("Lecture: views and export", order=order):
             self._add_widgets(self.client.gui)
-        self.views.on_click(self._on_view)
-        self.screenshot.on_click(lambda _: self._discard(self.take_screenshot()))
-        self.csv.on_click(lambda _: self._discard(self.download_csv()))
-        self.glb.on_click(lambda _: self._discard(self.download_glb()))
         self.display = Display(session, session.panel.motion, self.style)
-        self.dark.on_update(lambda event: self.set_theme(dark=bool(event.target.value)))
-        self.large.on_update(lambda event: self.set_theme(large=bool(event.target.value)))
-        self.projector.on_update(lambda e: self.display.request(projector=bool(e.target.value)))
-        self.two_views.on_update(lambda e: self.display.request(two_views=bool(e.target.value)))
+        # Browser changes only, each value checked against its widget first (:func:`on_user`).
+        for handle, callback in (
+            (self.views, self._on_view),
+            (self.screenshot, lambda _: self._discard(self.take_screenshot())),
+            (self.csv, lambda _: self._discard(self.download_csv())),
+            (self.glb, lambda _: self._discard(self.download_glb())),
+            (self.dark, lambda sent: self.set_theme(dark=bool(sent.value))),
+            (self.large, lambda sent: self.set_theme(large=bool(sent.value))),
+            (self.projector, lambda sent: self.display.request(projector=bool(sent.value))),
+            (self.two_views, lambda sent: self.display.request(two_views=bool(sent.value))),
+        ):
+            on_user(handle, callback, self._report)
         self.commands = self._add_hotkeys(self.client.gui)
 
     def _add_widgets(self, gui: viser.GuiApi) -> None:
@@ -188,9 +192,13 @@ class LectureControls:
         self.message.content = f"**⚠ {text}**" if error else text
 
     # -- camera --------------------------------------------------------------------------
-    def _on_view(self, event: viser.GuiEvent[viser.GuiButtonGroupHandle]) -> None:
-        if event.target.value in CAMERA_NAMES:
-            self.set_camera(event.target.value)
+    def _on_view(self, sent: Sent) -> None:
+        if sent.value in CAMERA_NAMES:
+            self.set_camera(sent.value)
+
+    def _report(self, exc: Exception) -> None:
+        """A callback's failure, shown under the lecture tools (never raised into viser)."""
+        self.show(f"Failed: {type(exc).__name__}: {exc}", error=True)
 
     def set_camera(self, name: str) -> None:
         """Move this browser's camera to a view; "ride-along" rides along from now on."""

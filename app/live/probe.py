@@ -9,6 +9,7 @@ model; the benchmark measures traffic and latency with it.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import threading
 import time
@@ -81,7 +82,16 @@ def _decode_frame(frame: bytes) -> list[dict[str, Any]]:
 class Probe:
     """Connect to a viser server on ``port``; use as a context manager."""
 
-    def __init__(self, port: int, host: str = "127.0.0.1", *, keep_batches: bool = True):
+    def __init__(
+        self,
+        port: int,
+        host: str = "127.0.0.1",
+        *,
+        keep_batches: bool = True,
+        origin: str | None = None,
+    ):
+        """``origin``: the ``Origin`` header a browser would send (a page's
+        ``scheme://host:port``); None sends none, as tools that are not browsers do."""
         self.uri = f"ws://{host}:{port}"
         self.nodes: dict[str, Node] = {}
         self.widgets: dict[str, Widget] = {}
@@ -97,12 +107,33 @@ class Probe:
             max_size=None,
             compression=None,
             open_timeout=10,
+            origin=None if origin is None else websockets.Origin(origin),
         )
         self._closed = False
         self._reading = threading.Event()
         self._reading.set()
         self._thread = threading.Thread(target=self._receive, daemon=True, name="viser-probe")
         self._thread.start()
+        self._send_first_camera()
+
+    def _send_first_camera(self) -> None:
+        """The camera message that makes viser call a client connected. A server that refuses
+        the connection may have closed it already: :attr:`close_code` then says why."""
+        with contextlib.suppress(websockets.ConnectionClosed):
+            self._send_camera()
+
+    @property
+    def close_code(self) -> int | None:
+        """The code of the server's close frame (1008: refused by policy), None while open."""
+        return self._ws.close_code
+
+    @property
+    def closed(self) -> bool:
+        """True once the connection is closed (by either side)."""
+        with self._cond:
+            return self._closed
+
+    def _send_camera(self) -> None:
         self.send(
             _messages.ViewerCameraMessage(
                 wxyz=(1.0, 0.0, 0.0, 0.0),

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import threading
 import warnings
+from collections.abc import Iterable
 
 import viser
 
 from poinsot.app.live.budget import FrameBudget
+from poinsot.app.live.guard import WireGuard
 from poinsot.app.live.session import MAX_FPS, Session
 from poinsot.app.presets import DEFAULT_PRESET, Preset
 from poinsot.app.scenes.spec import SceneSpec
@@ -25,8 +27,11 @@ class PoinsotApp:
         scene: SceneSpec | None = None,
         max_fps: float = MAX_FPS,
         verbose: bool = False,
+        allow_origins: Iterable[str] = (),
     ) -> None:
-        """Each new browser starts with ``preset``, or with ``scene`` if one is given."""
+        """Each new browser starts with ``preset``, or with ``scene`` if one is given. A
+        browser's websocket is refused unless it comes from a page this server served, or from
+        one of ``allow_origins`` (``scheme://host[:port]``); see :mod:`.guard`."""
         self.preset = preset
         self.scene = scene
         self.max_fps = max_fps
@@ -43,6 +48,8 @@ class PoinsotApp:
         self.server = viser.ViserServer(host=host, port=port, verbose=verbose)
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
         self.server.scene.world_axes.visible = False
+        # First of this app's handlers: a refused websocket never reaches the ones below.
+        self.guard = WireGuard(self.server, allow_origins)
         # A session's frame thread may draw one last frame between the browser leaving and the
         # disconnect callback stopping it; viser then warns once that the message is dropped.
         # That is expected here, not a leak: the thread stops right after.

@@ -8,9 +8,17 @@ add up to more, is dropped at once (viser forgets it, the parts that follow are 
 acknowledged, never kept), and ``refused`` is called, so that the student reads why. The
 browser's progress notice completes as usual.
 
+It also bounds what a client that is not a browser could make the server hold: a transfer to a
+widget that is not an upload button is forgotten at once; one client has at most
+:data:`MAX_TRANSFERS` transfers in progress, announcing at most :data:`MAX_PENDING_BYTES` in all;
+a transfer whose parts add up to more than it announced is dropped. Parts held for a transfer
+that never completes are freed when the client leaves (viser drops its transfers then);
+:meth:`TransferGuard.pending_bytes` counts them.
+
 This reaches into two of viser 1.1's internals, both kept in this module: the client's message
 interface (``ClientHandle._websock_connection``), where the handlers are registered, and the
-GUI's table of transfers in progress (``GuiApi._current_file_upload_states``).
+GUI's tables of widgets and of transfers in progress (``GuiApi._gui_input_handle_from_uuid``,
+``GuiApi._current_file_upload_states``).
 """
 
 from __future__ import annotations
@@ -22,6 +30,14 @@ from typing import Any
 
 import viser
 from viser import _messages
+
+#: Transfers one client may have in progress at once.
+MAX_TRANSFERS = 2
+#: Bytes one client's transfers in progress may announce in all (the largest upload cap).
+MAX_PENDING_BYTES = 20_000_000
+#: Refused transfers whose remaining parts are still answered, per client (older ones are
+#: forgotten: their parts are then ignored by viser, unanswered).
+MAX_DROPPED = 16
 
 #: ``refused(button id, file name, size in bytes or the bytes so far, cap)``.
 Refusal = Callable[[str, str, int, int], None]
@@ -66,19 +82,46 @@ class TransferGuard:
         with self._lock:
             return len(self._dropped)
 
+    def pending_bytes(self) -> int:
+        """Bytes of this client's uploads held in memory, waiting for their other parts."""
+        return sum(
+            sum(len(part) for part in list(state["parts"].values()))
+            for state in list(self._states().values())
+            if state.get("client_id") == self._client.client_id
+        )
+
+    def _pending(self, excluding: str) -> tuple[int, int]:
+        """(transfers, bytes announced) of this client's other transfers in progress."""
+        others = [
+            state
+            for uuid, state in list(self._states().items())
+            if uuid != excluding and state.get("client_id") == self._client.client_id
+        ]
+        return len(others), sum(int(state["total_bytes"]) for state in others)
+
     # -- handlers (viser's event loop: short, never raising) -----------------------------
     def _states(self) -> dict[str, Any]:
         return self._client.gui._current_file_upload_states
 
     def _on_start(self, client_id: int, message: _messages.FileTransferStartUpload) -> None:
-        cap = self.caps.get(message.source_component_uuid)
-        if cap is None:
+        uuid, button = message.transfer_uuid, message.source_component_uuid
+        if uuid not in self._states():
+            return  # viser took nothing (no such widget)
+        handle = self._client.gui._gui_input_handle_from_uuid.get(button)
+        if not isinstance(handle, viser.GuiUploadButtonHandle):
+            self._states().pop(uuid, None)  # no browser uploads to a slider
             return
-        self._names[message.transfer_uuid] = message.filename
-        if message.size_bytes > cap:
-            button = message.source_component_uuid
-            self._drop(message.transfer_uuid, button, message.size_bytes)
-            self._refused(button, message.filename, int(message.size_bytes), cap)
+        cap = self.caps.get(button, MAX_PENDING_BYTES)
+        size = int(message.size_bytes)
+        transfers, announced = self._pending(excluding=uuid)
+        too_many = transfers >= MAX_TRANSFERS or announced + size > MAX_PENDING_BYTES
+        if size > cap or size < 0 or too_many:
+            self._drop(uuid, button, max(size, 0))
+            if button in self.caps:
+                self._refused(button, message.filename, size, min(cap, MAX_PENDING_BYTES))
+            return
+        if button in self.caps:
+            self._names[uuid] = message.filename
 
     def _on_part(self, client_id: int, message: _messages.FileTransferPart) -> None:
         uuid = message.transfer_uuid
@@ -87,23 +130,29 @@ class TransferGuard:
         if dropped is not None:
             self._acknowledge(uuid, dropped, len(message.content))
             return
-        cap = self.caps.get(message.source_component_uuid or "")
+        button = message.source_component_uuid or ""
+        cap = self.caps.get(button, MAX_PENDING_BYTES)
         state = self._states().get(uuid)
-        if cap is None or state is None:
+        if state is None:
             self._names.pop(uuid, None)  # finished (or never ours)
             return
         received = int(state["transferred_bytes"])
-        if received > cap:  # more than announced: a client that does not say its size
+        if received > cap or received > int(state["total_bytes"]):  # more than announced
             button = str(message.source_component_uuid)
             self._drop(uuid, button, int(state["total_bytes"]))
             with self._lock:
                 self._dropped[uuid].received = received
-            self._refused(button, self._names.get(uuid, "the file"), received, cap)
+            if button in self.caps:
+                self._refused(button, self._names.get(uuid, "the file"), received, cap)
 
     def _drop(self, uuid: str, button: str, total: int) -> None:
         self._states().pop(uuid, None)  # viser keeps nothing more of it
         with self._lock:
             self._dropped[uuid] = _Dropped(button, total)
+            while len(self._dropped) > MAX_DROPPED:  # the oldest first (dicts keep order)
+                forgotten = next(iter(self._dropped))
+                del self._dropped[forgotten]
+                self._names.pop(forgotten, None)
 
     def _acknowledge(self, uuid: str, dropped: _Dropped, size: int) -> None:
         """Count a part of a refused transfer, and tell the browser it arrived."""

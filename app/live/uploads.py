@@ -31,7 +31,7 @@ from poinsot.app.elements import Control
 from poinsot.app.live.overlay import Measured
 from poinsot.app.live.panel import ControlPanel
 from poinsot.app.live.transfers import TransferGuard, handle_id
-from poinsot.app.live.widgets import Removable
+from poinsot.app.live.widgets import Removable, Sent, on_user
 from poinsot.app.own_bodies import FittedToss
 from poinsot.app.presets import FITTED_TOSS, MESH_BODY, Preset
 
@@ -170,12 +170,12 @@ class UploadControls:
         self._kinds[handle_id(button)] = "mesh"
         button.on_upload(self._on_upload("mesh", own_bodies.MAX_MESH_BYTES))
 
-        def choose(event: viser.GuiEvent[Any]) -> None:
-            label = str(menu.value)
-            if event.client is not None and label in labels:
+        def choose(sent: Sent) -> None:
+            label = str(sent.value)
+            if label in labels:
                 self._submit("mesh", label, lambda: bundled_body(labels[label]))
 
-        menu.on_update(self._guarded(choose))
+        on_user(menu, choose, self.host.report)  # browser changes only, the value checked
         return [folder]
 
     # -- callbacks (viser's thread pool: short, never raising) ------------------------------

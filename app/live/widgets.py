@@ -19,6 +19,8 @@ against every stall, so:
 from __future__ import annotations
 
 import asyncio
+import contextlib
+import math
 import time
 from collections.abc import Callable, Hashable, Iterable
 from typing import Any, Protocol, TypeVar
@@ -122,14 +124,82 @@ class Sent:
         self.value = value
 
 
+class Refused(ValueError):
+    """A value no browser widget could have sent (not a number, not an option...)."""
+
+
+#: The longest text a text box may send [characters].
+MAX_TEXT = 10_000
+
+
+def _clamped(handle: Any, value: float) -> float:
+    """``value`` within the handle's ``min`` and ``max`` (a slider's or a number box's)."""
+    low, high = getattr(handle, "min", None), getattr(handle, "max", None)
+    if isinstance(low, int | float) and value < low:
+        value = low
+    if isinstance(high, int | float) and value > high:
+        value = high
+    return value
+
+
+def checked(handle: Any, value: Any) -> Any:
+    """``value`` as the browser's widget would have let the user give it: a number clamped into
+    the widget's range; raises :class:`Refused` for what no widget sends (NaN or an infinity,
+    an option that is not offered, a text longer than :data:`MAX_TEXT`)."""
+    if isinstance(handle, viser.GuiButtonHandle):
+        return value
+    options = getattr(handle, "options", None)
+    if options is not None:
+        if value not in tuple(options):
+            raise Refused(f"{value!r} is not one of the options")
+        return value
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, int):  # no NaN; beyond the double range it is clamped like any other
+        return type(value)(_clamped(handle, value))
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise Refused(f"{value!r} is not a finite number")
+        return float(_clamped(handle, value))
+    if isinstance(value, str) and len(value) > MAX_TEXT:
+        raise Refused(f"a text of {len(value)} characters (at most {MAX_TEXT})")
+    if isinstance(value, tuple) and not all(
+        math.isfinite(v) for v in value if isinstance(v, float)
+    ):
+        raise Refused(f"{value!r} has a value that is not a finite number")
+    return value
+
+
+def _accepted(handle: Any, sent: Sent, last: Sent) -> bool:
+    """On the event loop, as a browser's value arrives (viser has stored it in the handle):
+    keep it if a widget could have sent it, clamped; else put the widget back to ``last``,
+    the last valid value, in the handle and in the browser. True if the value is accepted."""
+    value = handle.value
+    try:
+        value = checked(handle, value)
+    except (Refused, OverflowError, TypeError):
+        handle.value = last.value  # sent back to the browser too
+        return False
+    if value != handle.value:
+        handle.value = value  # the browser shows the clamped value
+    sent.value = last.value = value
+    return True
+
+
 def on_user(
     handle: Any, callback: Callable[[Sent], None], report: Callable[[Exception], None]
 ) -> Any:
     """Run ``callback(sent)`` for changes made in a browser only (a value set by the server
     fires the same viser callbacks, with no client). The callback runs on a worker thread,
     never raises into viser (``report`` gets the exception) and reads, as ``sent.value``, the
-    value the browser sent last: two quick changes may run out of order, both read the later."""
+    value the browser sent last: two quick changes may run out of order, both read the later.
+
+    Nothing a client sends is trusted: a value is first :func:`checked` against the widget, as
+    the browser would (a number clamped into the slider's range, an option among the options);
+    a value no widget could send (NaN, an option not offered) never reaches the callback, and
+    the widget shows its last valid value again."""
     sent = Sent(getattr(handle, "value", None))
+    last = Sent(sent.value)  # the last valid value, the server's or the browser's
 
     def run() -> None:
         try:
@@ -138,11 +208,16 @@ def on_user(
             report(exc)
 
     async def received(event: viser.GuiEvent[Any]) -> None:
-        if event.client is None:
+        if not hasattr(handle, "value"):  # a button
+            if event.client is not None:
+                asyncio.get_running_loop().run_in_executor(None, run)
             return
-        if hasattr(handle, "value"):
-            sent.value = handle.value
-        asyncio.get_running_loop().run_in_executor(None, run)  # never waits on the callback
+        if event.client is None:  # set by the server: remember it if valid (it runs later)
+            with contextlib.suppress(Refused, OverflowError, TypeError):
+                last.value = checked(handle, handle.value)
+            return
+        if _accepted(handle, sent, last):
+            asyncio.get_running_loop().run_in_executor(None, run)  # never waits on the callback
 
     if isinstance(handle, viser.GuiButtonHandle | viser.GuiButtonGroupHandle):
         handle.on_click(received)

@@ -9,6 +9,15 @@ import sys
 import time
 from collections.abc import Sequence
 
+from poinsot.app.arguments import (
+    OneLineParser,
+    fraction,
+    non_negative_float,
+    non_negative_int,
+    positive_float,
+    positive_int,
+    run_guarded,
+)
 from poinsot.app.load.config import Config, Report
 from poinsot.app.load.figures import Bounds, exit_status, format_table, missed
 from poinsot.app.load.phases import PHASES, run_phase
@@ -16,7 +25,7 @@ from poinsot.app.load.phases import PHASES, run_phase
 
 def build_parser() -> argparse.ArgumentParser:
     cfg, bounds = Config(), Bounds()
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="python -m poinsot.app.load",
         description="Load test of the live server on this machine's loopback: a soak, a storm "
         "of connections, a stalled client, a flooding client. Prints a table of figures and "
@@ -24,23 +33,25 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add = parser.add_argument
     add("--phase", nargs="+", choices=PHASES, default=list(PHASES), help="phases to run, in order")
-    add("--clients", type=int, default=cfg.clients, help="clients in the soak, stall and flood")
-    add("--seconds", type=float, default=cfg.seconds, help="length of the soak [s]")
-    add("--slider-period", type=float, default=cfg.slider_period, help="a slider move every [s]")
-    add("--storm", type=int, default=cfg.storm, help="connects and departures in the storm")
-    add("--storm-workers", type=int, default=cfg.storm_workers, help="visits at a time")
-    add("--storm-steady", type=int, default=cfg.storm_steady, help="clients kept through it")
-    add("--settle-seconds", type=float, default=cfg.settle_seconds, help="after the storm [s]")
-    add("--stall-seconds", type=float, default=cfg.stall_seconds, help="one client stalls [s]")
-    add("--flood-seconds", type=float, default=cfg.flood_seconds, help="one client floods [s]")
-    add("--flood-rate", type=float, default=cfg.flood_rate, help="messages a second")
+    add("--clients", type=positive_int, default=cfg.clients, help="clients in each phase")
+    add("--workers", type=positive_int, default=cfg.workers, help="server processes (soak only)")
+    add("--seconds", type=positive_float, default=cfg.seconds, help="length of the soak [s]")
+    add("--slider-period", type=positive_float, default=cfg.slider_period, help="slider every [s]")
+    add("--storm", type=positive_int, default=cfg.storm, help="connects and departures")
+    add("--storm-workers", type=positive_int, default=cfg.storm_workers, help="visits at a time")
+    add("--storm-steady", type=non_negative_int, default=cfg.storm_steady, help="kept through it")
+    add("--settle-seconds", type=positive_float, default=cfg.settle_seconds, help="after it [s]")
+    add("--stall-seconds", type=positive_float, default=cfg.stall_seconds, help="one stalls [s]")
+    add("--flood-seconds", type=positive_float, default=cfg.flood_seconds, help="one floods [s]")
+    add("--flood-rate", type=positive_float, default=cfg.flood_rate, help="messages a second")
+    add("--debug", action="store_true", help="show the traceback of a failure (else one line)")
     goals = parser.add_argument_group("goals")
-    goals.add_argument("--min-fps", type=float, default=bounds.min_fps)
-    goals.add_argument("--max-redraw-ms", type=float, default=bounds.max_redraw_ms)
-    goals.add_argument("--max-rss-growth", type=float, default=bounds.max_rss_growth)
-    goals.add_argument("--storm-tolerance", type=float, default=bounds.storm_tolerance)
-    goals.add_argument("--min-keep", type=float, default=bounds.min_keep)
-    goals.add_argument("--max-errors", type=int, default=bounds.max_errors)
+    goals.add_argument("--min-fps", type=non_negative_float, default=bounds.min_fps)
+    goals.add_argument("--max-redraw-ms", type=positive_float, default=bounds.max_redraw_ms)
+    goals.add_argument("--max-rss-growth", type=non_negative_float, default=bounds.max_rss_growth)
+    goals.add_argument("--storm-tolerance", type=non_negative_float, default=bounds.storm_tolerance)
+    goals.add_argument("--min-keep", type=fraction, default=bounds.min_keep)
+    goals.add_argument("--max-errors", type=non_negative_int, default=bounds.max_errors)
     return parser
 
 
@@ -53,12 +64,11 @@ def _options(args: argparse.Namespace) -> tuple[list[str], Config, Bounds]:
 
 
 def _check(parser: argparse.ArgumentParser, phases: list[str], cfg: Config) -> None:
-    if cfg.clients < 1 or cfg.seconds <= 0 or cfg.storm < 1 or cfg.storm_workers < 1:
-        parser.error("--clients, --seconds, --storm and --storm-workers must be positive")
+    """What the converters cannot see alone (each option is checked by its ``type``)."""
+    if cfg.workers > 1 and phases != ["soak"]:
+        parser.error("--workers more than 1 only with --phase soak")
     if {"stall", "flood"} & set(phases) and cfg.clients < 2:
         parser.error("stall and flood need --clients >= 2 (one stalls, the others are measured)")
-    if min(cfg.stall_seconds, cfg.flood_seconds, cfg.flood_rate, cfg.settle_seconds) <= 0:
-        parser.error("the stall, flood and settle options must be positive")
 
 
 def _load_average() -> str:
@@ -79,11 +89,19 @@ def run(phases: Sequence[str], cfg: Config, verbose: bool = True) -> Report:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Parse and run; a bad argument is one line and exit status 2, an unexpected failure one
+    line and exit status 1 (with its traceback under ``--debug``)."""
     parser = build_parser()
-    phases, cfg, bounds = _options(parser.parse_args(argv))
+    args = parser.parse_args(argv)
+    phases, cfg, bounds = _options(args)
     _check(parser, phases, cfg)
+    return run_guarded(parser.prog, lambda: _run(phases, cfg, bounds), debug=args.debug)
+
+
+def _run(phases: list[str], cfg: Config, bounds: Bounds) -> int:
     print(
-        f"Poinsot load test: {' '.join(phases)}; {cfg.clients} clients, soak {cfg.seconds:g} s, "
+        f"Poinsot load test: {' '.join(phases)}; {cfg.clients} clients, {cfg.workers} server "
+        f"process(es), soak {cfg.seconds:g} s, "
         f"storm {cfg.storm}; python {sys.version.split()[0]}, {os.cpu_count()} CPUs, "
         f"load average {_load_average()} (1, 5, 15 min)",
         flush=True,

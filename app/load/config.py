@@ -24,6 +24,7 @@ class Config:
     """The sizes of the phases (each has a command-line option)."""
 
     clients: int = 30  # in the soak, the stall and the flood
+    workers: int = 1  # server processes (behind a landing port if more than one)
     seconds: float = 300.0  # the soak
     slider_period: float = 1.0  # a slider move every this many seconds during the soak
     storm: int = 200  # connects and departures

@@ -140,6 +140,7 @@ def _window(
 
 def _main(conn: Connection, port: int, count: int, lifetime: float) -> None:
     """The child: connect ``count`` clients, then serve window and stall requests."""
+    from poinsot.app.live.landing import resolve
     from poinsot.app.live.probe import Probe
 
     deadline = time.monotonic() + lifetime
@@ -148,7 +149,7 @@ def _main(conn: Connection, port: int, count: int, lifetime: float) -> None:
     try:
         for _ in range(count):
             client = _Client()
-            probe = Probe(port, keep_batches=False)
+            probe = Probe(resolve(port), keep_batches=False)  # through a landing, if any
             probe.add_listener(client.listener)
             probes.append(probe)
             clients.append(client)

@@ -32,12 +32,13 @@ def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:
     not start, clients that never get their scene) misses its "completed" goal; the server's
     log is read in every case, and judged in the soak."""
     try:
-        server = ServerProcess(cfg.lifetime)
+        server = ServerProcess(cfg.lifetime, workers=cfg.workers)
     except Exception as exc:
         report.add(Figure(name, "completed", 0.0, f"failed: {exc}", COMPLETES))
         return
     machine, load, started = procfs.Machine.now(), os.getloadavg()[0], time.monotonic()
-    server_cpu = _cpu_seconds(server.pid)
+    pids = [server.pid, *server.worker_pids]
+    server_cpu = _cpu_seconds(pids)
     try:
         say(f"{name}: server pid {server.pid}, port {server.port}")
         BODIES[name](server, cfg, report, say)
@@ -45,7 +46,7 @@ def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:
         failure = f"failed: {type(exc).__name__}: {exc}"
         report.add(Figure(name, "completed", 0.0, failure, COMPLETES))
     finally:
-        server_cpu = _cpu_seconds(server.pid) - server_cpu
+        server_cpu = _cpu_seconds(pids) - server_cpu
         report.add(_machine(name, machine, load, server_cpu, time.monotonic() - started))
         server.finish()
     lines = server.log_errors()
@@ -59,9 +60,10 @@ def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:
     report.add(Figure(name, "server log errors", float(len(lines)), text, goal))
 
 
-def _cpu_seconds(pid: int) -> float:
+def _cpu_seconds(pids: list[int]) -> float:
+    """The CPU time of the server's processes (the one, or the landing and its workers)."""
     try:
-        return procfs.usage(pid).cpu_seconds
+        return sum(procfs.usage(pid).cpu_seconds for pid in pids)
     except OSError:
         return math.nan
 

@@ -48,6 +48,20 @@ def cpu_percent(first: Usage, last: Usage) -> float:
     return 100.0 * (last.cpu_seconds - first.cpu_seconds) / elapsed if elapsed > 0 else 0.0
 
 
+def combined(series: list[list[Usage]]) -> list[Usage]:
+    """Several processes looked at together (a server and its workers) as one: at each look,
+    their CPU times, memory and threads summed."""
+    return [
+        Usage(
+            looks[0].at,
+            sum(u.cpu_seconds for u in looks),
+            sum(u.rss_bytes for u in looks),
+            sum(u.threads for u in looks),
+        )
+        for looks in zip(*series, strict=False)
+    ]
+
+
 @dataclasses.dataclass(frozen=True)
 class Machine:
     """The whole machine's CPU time so far, from ``/proc/stat`` (clock ticks)."""

@@ -53,8 +53,39 @@ def _status(app: Any) -> dict[str, Any]:
     }
 
 
-def _main(conn: Connection, log_path: str, lifetime: float) -> None:
-    """The child: serve on a free port, answer the parent, stop within ``lifetime`` seconds."""
+class _Classroom:
+    """``poinsot serve --workers N`` inside the child: N worker processes behind a landing
+    port (:mod:`poinsot.app.live.workers`); its status sums the workers' own."""
+
+    def __init__(self, count: int) -> None:
+        from poinsot.app.live.landing import Balancer, LandingServer
+        from poinsot.app.live.workers import start_workers
+        from poinsot.app.presets import DEFAULT_PRESET
+
+        self.workers = start_workers(count, "127.0.0.1", 0, DEFAULT_PRESET.key, None)
+        self.landing = LandingServer("127.0.0.1", 0, Balancer(self.workers))
+        self.landing.start()
+        self.port = self.landing.port
+
+    def status(self) -> dict[str, Any]:
+        parts = [w.inspect(_status) for w in self.workers if w.alive]
+        total: dict[str, Any] = {k: sum(p[k] for p in parts) for k in parts[0] if k != "threads"}
+        total["threads"] = dict(
+            sum((collections.Counter(p["threads"]) for p in parts), start=collections.Counter())
+        )
+        return total
+
+    def stop(self) -> None:
+        from poinsot.app.live.workers import stop_workers
+
+        self.landing.shutdown()
+        self.landing.server_close()
+        stop_workers(self.workers)
+
+
+def _main(conn: Connection, log_path: str, lifetime: float, workers: int = 1) -> None:
+    """The child: serve on a free port (through a landing port and ``workers`` processes if
+    more than one), answer the parent, stop within ``lifetime`` seconds."""
     log = os.open(log_path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
     os.dup2(log, 1)
     os.dup2(log, 2)
@@ -65,8 +96,9 @@ def _main(conn: Connection, log_path: str, lifetime: float) -> None:
     )
     from poinsot.app.live.server import PoinsotApp
 
-    app = PoinsotApp("127.0.0.1", 0)
-    conn.send(("ready", app.port))
+    app: Any = PoinsotApp("127.0.0.1", 0) if workers == 1 else _Classroom(workers)
+    pids = [w.pid for w in app.workers] if workers > 1 else []
+    conn.send(("ready", (app.port, pids)))
     deadline = time.monotonic() + lifetime
     try:
         while time.monotonic() < deadline:
@@ -77,7 +109,7 @@ def _main(conn: Connection, log_path: str, lifetime: float) -> None:
             except EOFError:  # the parent is gone
                 break
             if request == "status":
-                conn.send(_status(app))
+                conn.send(_status(app) if workers == 1 else app.status())
             elif request == "stop":
                 break
     finally:
@@ -91,12 +123,15 @@ def _main(conn: Connection, log_path: str, lifetime: float) -> None:
 class ServerProcess(Child):
     """Start the server child; a context manager that stops and reaps it."""
 
-    def __init__(self, lifetime: float, start_timeout: float = 120.0):
+    def __init__(self, lifetime: float, start_timeout: float = 120.0, workers: int = 1):
         fd, path = tempfile.mkstemp(prefix="poinsot-load-server-", suffix=".log")
         os.close(fd)
         self.log_path = pathlib.Path(path)
-        super().__init__("server", _main, str(self.log_path), lifetime)
-        self.port: int = self.receive(start_timeout, "the server to start")
+        super().__init__("server", _main, str(self.log_path), lifetime, workers)
+        self.port: int
+        #: The worker processes' pids (none for one process): their CPU and memory count too.
+        self.worker_pids: list[int]
+        self.port, self.worker_pids = self.receive(start_timeout, "the server to start")
 
     def __enter__(self) -> ServerProcess:
         return self

@@ -34,7 +34,9 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         interval = min(1.0, max(0.1, cfg.seconds / 10.0))
         status0, t0 = server.status(), time.monotonic()
         fewest = status0["sessions"]
-        with procfs.Sampler({"server": server.pid, "clients": fleet.pid}, interval) as sampler:
+        pids = {"server": server.pid, "clients": fleet.pid}
+        pids.update({f"worker-{i}": pid for i, pid in enumerate(server.worker_pids)})
+        with procfs.Sampler(pids, interval) as sampler:
             fleet.begin_window(cfg.seconds, cfg.slider_period)
             deadline = time.monotonic() + cfg.seconds + 120.0
             while not fleet.conn.poll(min(5.0, 5 * interval)) and time.monotonic() < deadline:
@@ -103,12 +105,17 @@ def _redraw(window: Window) -> Figure:
 def _add_usage(report: Report, sampler: procfs.Sampler, seconds: float) -> None:
     """CPU over the soak; RSS early against late (the median of the first and the last tenth
     of the samples); threads at both ends."""
-    server, clients = sampler.samples["server"], sampler.samples["clients"]
+    clients = sampler.samples["clients"]
+    # The server's processes: the one, or the landing and its workers, summed.
+    server = procfs.combined([v for k, v in sampler.samples.items() if k != "clients"])
     span = max(0.1 * seconds, 2.0 * sampler.interval)
     rss0 = statistics.median(u.rss_bytes for u in server if u.at - server[0].at <= span)
     rss1 = statistics.median(u.rss_bytes for u in server if server[-1].at - u.at <= span)
     growth = rss1 / rss0 - 1.0
-    peak = max(sampler.cpu_percents("server"), default=math.nan)
+    peak = max(
+        (procfs.cpu_percent(a, b) for a, b in zip(server, server[1:], strict=False)),
+        default=math.nan,
+    )
     report.add(
         info(
             P,

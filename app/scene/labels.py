@@ -428,3 +428,11 @@ class LabelNode:
             if np.max(np.abs(position - self.position)) > POSITION_TOLERANCE:
                 self.position = position
                 self.handle.position = position
+
+
+def screen_right_in_plane(pose: Pose) -> np.ndarray:
+    """The direction in the plane (x, y) that points right on the screen (the herpolhode's
+    label goes on that side of its ring: below it on screen runs ω's arrow)."""
+    _, right, _ = pose.camera.axes()
+    norm = float(np.linalg.norm(right[:2]))
+    return right[:2] / norm if norm > 1e-6 else np.array([1.0, 0.0])

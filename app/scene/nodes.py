@@ -32,7 +32,7 @@ from poinsot.app.scene.geometry import (
     Geometry,
     triple,
 )
-from poinsot.app.scene.labels import LabelNode, Placement, Pose, Slot
+from poinsot.app.scene.labels import LabelNode, Placement, Pose, Slot, screen_right_in_plane
 from poinsot.app.scene.palette import Look
 from poinsot.app.scene.trail import Trail
 
@@ -419,7 +419,7 @@ class Trace(Drawing):
             radius = float(np.linalg.norm(tip))
             point = tip * (1.0 + BEYOND / radius) if radius > 0 else tip
             return [self.node.slot(point, tip, np.zeros(3), movable=True, clearance=BODY_CLEARANCE)]
-        toward = _screen_right(pose)
+        toward = screen_right_in_plane(pose)
         tip, centre = self._on_ring(toward), np.array([0.0, 0.0, self.ring[1]])
         self._base = self._on_ring(toward, BEYOND)
         return [self.node.slot(self._base, tip, centre, movable=True, clearance=HEAD_CLEARANCE)]
@@ -441,14 +441,6 @@ class Trace(Drawing):
         super().remove()
         self.trail.clear()
         self.trail.group.remove()
-
-
-def _screen_right(pose: Pose) -> np.ndarray:
-    """The direction in the plane (x, y) that points right on the screen (the herpolhode's
-    label goes on that side of its ring: below it on screen runs ω's arrow)."""
-    _, right, _ = pose.camera.axes()
-    norm = float(np.linalg.norm(right[:2]))
-    return right[:2] / norm if norm > 1e-6 else np.array([1.0, 0.0])
 
 
 #: Font scale of the curves' labels.

@@ -10,6 +10,7 @@ sRGB, so a picture shows exactly that colour).
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import TypeVar
 
 import numpy as np
 import viser
@@ -20,6 +21,7 @@ from poinsot.app.scene.geometry import ArrowShape, finite, triple
 from poinsot.app.scene.trail import Trail
 
 RGB = tuple[int, int, int]
+Node = TypeVar("Node", bound=viser.SceneNodeHandle)
 
 #: A line node's points before its first fit: one degenerate segment.
 NO_SEGMENT = np.zeros((1, 2, 3), np.float32)
@@ -79,17 +81,20 @@ class Parts:
         self._trails: dict[str, list[Trail]] = {}
         self._hidden: set[str] = set()
 
-    def keep(self, part: str, handle: viser.SceneNodeHandle) -> None:
+    def keep(self, part: str, handle: Node) -> Node:
+        """Keep ``handle`` as a node of ``part`` (hidden if the part is) and return it."""
         self._nodes.setdefault(part, []).append(handle)
         if part in self._hidden:
             handle.visible = False
+        return handle
 
     def lines(self, part: str, name: str, color: RGB, width: float) -> viser.LineSegmentsHandle:
-        handle = self.api.add_line_segments(
-            name, NO_SEGMENT, color, thickness=width, thickness_units="screen"
+        return self.keep(
+            part,
+            self.api.add_line_segments(
+                name, NO_SEGMENT, color, thickness=width, thickness_units="screen"
+            ),
         )
-        self.keep(part, handle)
-        return handle
 
     def surface(
         self,
@@ -102,48 +107,52 @@ class Parts:
         """A mesh; translucent and seen from both sides when ``opacity`` is given, else lit and
         flat-shaded like the presets' solids."""
         vertices, faces = mesh
-        handle = self.api.add_mesh_simple(
-            name,
-            vertices,
-            faces,
-            color=color,
-            opacity=opacity,
-            material="standard",
-            flat_shading=opacity is None,
-            side="double" if opacity is not None else "front",
-            cast_shadow=False,
-            receive_shadow=False,
+        return self.keep(
+            part,
+            self.api.add_mesh_simple(
+                name,
+                vertices,
+                faces,
+                color=color,
+                opacity=opacity,
+                material="standard",
+                flat_shading=opacity is None,
+                side="double" if opacity is not None else "front",
+                cast_shadow=False,
+                receive_shadow=False,
+            ),
         )
-        self.keep(part, handle)
-        return handle
 
     def arrow(self, part: str, name: str, color: RGB, shape: ArrowShape) -> viser.ArrowsHandle:
-        handle = self.api.add_arrows(
-            name,
-            NO_ARROW,
-            color,
-            shaft_radius=shape.shaft_radius,
-            head_radius=shape.head_radius,
-            head_length=shape.head_length,
+        return self.keep(
+            part,
+            self.api.add_arrows(
+                name,
+                NO_ARROW,
+                color,
+                shaft_radius=shape.shaft_radius,
+                head_radius=shape.head_radius,
+                head_length=shape.head_length,
+            ),
         )
-        self.keep(part, handle)
-        return handle
 
     def marker(self, part: str, name: str, color: RGB) -> viser.IcosphereHandle:
-        handle = self.api.add_icosphere(name, radius=MARKER_RADIUS, color=color, cast_shadow=False)
-        self.keep(part, handle)
-        return handle
+        return self.keep(
+            part,
+            self.api.add_icosphere(name, radius=MARKER_RADIUS, color=color, cast_shadow=False),
+        )
 
     def label(self, part: str, name: str, text: str, position: ArrayLike) -> viser.LabelHandle:
-        handle = self.api.add_label(
-            name,
-            text,
-            anchor="bottom-left",
-            font_screen_scale=1.2,
-            position=triple(position),
+        return self.keep(
+            part,
+            self.api.add_label(
+                name,
+                text,
+                anchor="bottom-left",
+                font_screen_scale=1.2,
+                position=triple(position),
+            ),
         )
-        self.keep(part, handle)
-        return handle
 
     def frame(
         self,
@@ -152,9 +161,10 @@ class Parts:
         position: ArrayLike = (0.0, 0.0, 0.0),
         wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0),
     ) -> viser.FrameHandle:
-        handle = self.api.add_frame(name, show_axes=False, position=triple(position), wxyz=wxyz)
-        self.keep(part, handle)
-        return handle
+        return self.keep(
+            part,
+            self.api.add_frame(name, show_axes=False, position=triple(position), wxyz=wxyz),
+        )
 
     def trail(self, part: str, name: str, color: RGB, width: float, points: int) -> Trail:
         trail = Trail(self.api, name, color, width, points)

@@ -27,24 +27,10 @@ import math
 import numpy as np
 
 from poinsot.app.bodies import MeshBody, bundled_body
-from poinsot.app.elements import Control, Element, Solid
-from poinsot.app.scene import meshes
-from poinsot.app.scene.batch import Frame
-from poinsot.app.scene.geometry import Geometry, triple
+from poinsot.app.elements import Control, Element
 from poinsot.app.scenes import colors
-from poinsot.app.scenes.drawing import Parts
-from poinsot.app.scenes.spec import (
-    Canvas,
-    Choice,
-    Model,
-    Part,
-    PlotSpec,
-    Readout,
-    SceneSpec,
-    Settings,
-    number,
-    relative,
-)
+from poinsot.app.scenes.base import CONSTRUCTION, OwnSolid, SceneModel, riding_mesh
+from poinsot.app.scenes.spec import Choice, Part, PlotSpec, Readout, SceneSpec, Settings, number
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
 from poinsot.physics.flip import (
     FlipTheory,
@@ -68,6 +54,11 @@ PLOT_SAMPLES = 800
 #: default, the looser ones find a stretch for the larger ε (down to 1e-4).
 GROWTH_WINDOWS = ((math.exp(5.0), 1e-3), (math.exp(3.0), 1e-2), (math.exp(2.0), 5e-2))
 HANDLE_NODE = "/space/body/handle"
+HANDLE = Part("handle", "T-handle (its mesh)", (HANDLE_NODE,), surface=colors.SOLID)
+#: Tolerances of the readouts: the flips are zeros of ω₂ refined to a few ulps of t; the fit of
+#: the growth rate is a straight line through ln p over a stretch that is not quite exponential.
+EXACT = 1e-12
+GROWTH_FIT = 1e-3
 
 
 @functools.cache
@@ -92,7 +83,7 @@ def growth_fit(body: FreeRigidBody) -> GrowthFit | None:
 
 
 @dataclasses.dataclass(frozen=True)
-class FlipModel:
+class FlipModel(OwnSolid, SceneModel):
     """The flipping T-handle at one ε, its theory and what is measured from its motion."""
 
     epsilon: float
@@ -104,13 +95,6 @@ class FlipModel:
     log_p: np.ndarray  # log₁₀ of the perturbation on it
     log_theory: np.ndarray  # log₁₀ ε + σ t / ln 10, capped at 0
 
-    @property
-    def solid(self) -> Solid | None:
-        return None  # the handle is drawn from its own mesh (HandleDrawing)
-
-    def readouts(self, t: float) -> tuple[Readout, ...]:
-        return self.rows
-
     @functools.cached_property
     def rows(self) -> tuple[Readout, ...]:
         th, flips = self.theory, self.flips
@@ -118,33 +102,41 @@ class FlipModel:
         angle = math.atan2(math.hypot(w0[0], w0[2]), abs(w0[1]))
         between = float(np.mean(np.diff(flips))) if len(flips) >= 2 else math.nan
         first = float(flips[0]) if len(flips) else math.nan
-        sigma = self.growth.rate if self.growth is not None else math.nan
-        sigma_note = (
-            f"fit of ln p over {self.growth.e_folds:.1f} e-folds"
+        growth = (
+            Readout.compare(
+                "growth rate σ",
+                th.growth_rate,
+                self.growth.rate,
+                GROWTH_FIT,
+                f"fit of ln p over {self.growth.e_folds:.1f} e-folds",
+            )
             if self.growth is not None
-            else "no exponential stretch at this ε (needs ε ≤ 1e-4)"
+            else Readout(
+                "growth rate σ",
+                number(th.growth_rate),
+                "—",
+                "no exponential stretch at this ε (needs ε ≤ 1e-4)",
+            )
         )
         return (
-            Readout("ε (angle of ω₀ from e₂)", number(self.epsilon), relative(angle, self.epsilon)),
-            Readout(
+            Readout.compare("ε (angle of ω₀ from e₂)", self.epsilon, angle, EXACT),
+            Readout.compare(
                 "time between flips, 2K(k)/λ",
-                number(th.time_between_flips, 9),
-                relative(between, th.time_between_flips, 9),
+                th.time_between_flips,
+                between,
+                EXACT,
                 "measured: spacing of the zeros of ω₂",
+                digits=9,
             ),
-            Readout(
+            Readout.compare(  # 2K = ln(16/(1 − k²)) + O(1 − k²)
                 "… its asymptote ln(16/(1−k²))/λ",
-                number(th.asymptotic_time_between_flips, 9),
-                relative(between, th.asymptotic_time_between_flips, 9),
+                th.asymptotic_time_between_flips,
+                between,
+                max(th.complementary_parameter, EXACT),
+                digits=9,
             ),
-            Readout(
-                "first flip, (K ± δ)/λ",
-                number(th.first_flip_time, 9),
-                relative(first, th.first_flip_time, 9),
-            ),
-            Readout(
-                "growth rate σ", number(th.growth_rate), relative(sigma, th.growth_rate), sigma_note
-            ),
+            Readout.compare("first flip, (K ± δ)/λ", th.first_flip_time, first, EXACT, digits=9),
+            growth,
             Readout("1 − k²", f"{th.complementary_parameter:.3e}", "—"),
         )
 
@@ -171,34 +163,6 @@ def build(settings: Settings) -> FlipModel:
     )
 
 
-class HandleDrawing:
-    """The T-handle's own mesh, inside the ellipsoid (body frame)."""
-
-    def __init__(self, canvas: Canvas) -> None:
-        self.parts = Parts(canvas.api)
-        shape = t_handle().mesh
-        self.vertices = np.asarray(shape.vertices)
-        self.mesh = self.parts.surface(
-            "handle", HANDLE_NODE, (self.vertices, np.asarray(shape.faces)), colors.SOLID
-        )
-
-    def fit(self, model: Model, geometry: Geometry | None) -> None:
-        if geometry is None:
-            raise ValueError("the T-handle rides in the Poinsot construction")
-        self.mesh.scale = triple(np.full(3, meshes.fit_scale(self.vertices, geometry.semi_axes)))
-
-    def advance(self, t: float, frame: Frame | None) -> Frame:
-        if frame is None:
-            raise RuntimeError("the T-handle rides in the Poinsot construction")
-        return frame
-
-    def set_visible(self, part: str, visible: bool) -> None:
-        self.parts.set_visible(part, visible)
-
-    def remove(self) -> None:
-        self.parts.remove()
-
-
 SPEC = SceneSpec(
     name="dzhanibekov",
     label="Scene: Dzhanibekov flip, theory vs measurement",
@@ -211,20 +175,8 @@ SPEC = SceneSpec(
     "uniform density, normalised to I₃ = 1",
     motion="FreeRigidBody(I, flip_initial_omega(ε, |ω₀| = 2)); flip_theory, measure_flips, "
     "measure_growth_rate",
-    elements=frozenset(
-        {
-            Element.ELLIPSOID,
-            Element.AXES,
-            Element.PLANE,
-            Element.CONTACT,
-            Element.OMEGA,
-            Element.L,
-            Element.POLHODE,
-            Element.POLHODE_FULL,
-            Element.HERPOLHODE,
-        }
-    ),
-    parts=(Part("handle", "T-handle (its mesh)", (HANDLE_NODE,), surface=colors.SOLID),),
+    elements=CONSTRUCTION | {Element.POLHODE, Element.POLHODE_FULL},
+    parts=(HANDLE,),
     controls=(
         Choice(
             "epsilon",
@@ -254,8 +206,9 @@ SPEC = SceneSpec(
         ),
     ),
     build=build,
-    draw=HandleDrawing,
+    draw=riding_mesh(HANDLE, lambda: t_handle().mesh),
     speed=2.0,
     trail_points=2400,
     picture_time=8.0,
+    table_settings=({}, {"epsilon": 1e-8}, {"epsilon": 1e-12}),
 )

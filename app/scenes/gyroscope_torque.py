@@ -29,15 +29,15 @@ import math
 
 import numpy as np
 
-from poinsot.app.elements import Control, Solid
+from poinsot.app.elements import Control
 from poinsot.app.presets import preset_by_key
 from poinsot.app.scene import meshes
-from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.frames import wxyz_from_xyzw
 from poinsot.app.scene.geometry import Geometry
 from poinsot.app.scene.view import View
 from poinsot.app.scenes import colors
-from poinsot.app.scenes.drawing import THIN_ARROW, Parts, arrow_points
+from poinsot.app.scenes.base import TabulatedDrawing, TabulatedModel
+from poinsot.app.scenes.drawing import THIN_ARROW, arrow_points
 from poinsot.app.scenes.spec import (
     Canvas,
     Model,
@@ -48,10 +48,9 @@ from poinsot.app.scenes.spec import (
     Settings,
     Slider,
     number,
-    relative,
 )
 from poinsot.app.scenes.tabulated import Player, Table
-from poinsot.physics import FreeRigidBody, rotations
+from poinsot.physics import rotations
 from poinsot.physics.gyroscope import AttitudeRun, DriftMeasurement, Gyroscope
 
 #: The body: the presets' homogeneous disc (its moments checked against trimesh by
@@ -78,6 +77,12 @@ TORQUE_NODE = f"{ROOT}/body/torque"
 DRIFT_NODE = f"{ROOT}/body/drift"
 PATH_NODE = f"{ROOT}/axis_path"
 OMEGA_NODE = f"{ROOT}/gyro_omega"
+#: Tolerances of the readouts: the attitude is integrated by Magnus-4 (error estimate below
+#: ATTITUDE), the drift is its mean velocity over whole nutation periods, the nutation centre a
+#: circle through ω read off the drawn quaternions by fourth-order differences.
+ATTITUDE = 1e-9
+DRIFT = 1e-8
+CENTRE = 1e-6
 
 
 def omega_from_attitude(quaternions: np.ndarray, dt: float) -> np.ndarray:
@@ -100,7 +105,7 @@ def circle_center(points: np.ndarray) -> tuple[float, float]:
 
 
 @dataclasses.dataclass(frozen=True)
-class GyroModel:
+class GyroModel(TabulatedModel):
     gyro: Gyroscope
     times: np.ndarray  # (N,) the table's grid
     run: AttitudeRun
@@ -108,30 +113,18 @@ class GyroModel:
     mismatch: np.ndarray  # (N,) |ω from the attitude - ω| / |ω| (the two end rows repeated)
     drift: DriftMeasurement
 
-    @property
-    def body(self) -> FreeRigidBody | None:
-        return None  # not torque-free: the scene poses the body itself
-
-    @property
-    def solid(self) -> Solid | None:
-        return None
-
-    @property
-    def span(self) -> float:
-        return len(self.times) * float(self.times[1] - self.times[0])
-
-    def row(self, t: float) -> int:
-        return min(len(self.times) - 1, int(np.searchsorted(self.times, t % self.span)))
-
     def readouts(self, t: float) -> tuple[Readout, ...]:
         g = self.gyro
+        error = float(self.run.error_estimate[self.row(t)])
         return (
             *self.rows,
             Readout(
                 "attitude error estimate now",
                 "—",
-                f"{self.run.error_estimate[self.row(t)]:.1e} rad",
+                f"{error:.1e} rad",
                 f"Magnus-4, {self.run.steps} steps against half as many (Richardson)",
+                gap=error,
+                tolerance=ATTITUDE,
             ),
             Readout("nutation period 2π/|ν|", number(g.nutation_period), "—"),
         )
@@ -140,37 +133,51 @@ class GyroModel:
     def rows(self) -> tuple[Readout, ...]:
         g, d = self.gyro, self.drift
         recovered_center = circle_center(self.recovered()[:, :2])[0]
+        mismatch = float(self.mismatch.max())
         return (
-            Readout(
+            Readout.compare(
                 "drift rate M/((J₃−J)ω₃)",
-                number(g.drift_rate, 9),
-                relative(d.along_torque, g.drift_rate, 9),
+                g.drift_rate,
+                d.along_torque,
+                DRIFT,
                 f"measured: mean velocity of the axis over {d.periods} nutation periods",
+                digits=9,
             ),
-            Readout("drift across the torque", "0", f"{d.across:.1e}"),
-            Readout(
+            Readout.compare(  # in units of the drift along the torque
+                "drift across the torque",
+                0.0,
+                d.across,
+                DRIFT,
+                scale=abs(g.drift_rate) or 1.0,
+                text=("0", f"{d.across:.1e}"),
+            ),
+            Readout.compare(
                 "nutation centre ω₁* = −M/((J₃−J)ω₃)",
-                number(g.nutation_center, 9),
-                relative(recovered_center, g.nutation_center, 9),
+                g.nutation_center,
+                recovered_center,
+                CENTRE,
                 "measured: centre of the circle (ω₁, ω₂) recovered from the integrated attitude",
+                digits=9,
             ),
             Readout(
                 "ω from the attitude vs closed form",
                 "0",
-                f"{float(self.mismatch.max()):.1e} rel.",
+                f"{mismatch:.1e} rel.",
+                gap=mismatch,
+                tolerance=DRIFT,
             ),
         )
 
     def recovered(self) -> np.ndarray:
-        return omega_from_attitude(self.run.quaternions, float(self.times[1] - self.times[0]))
+        return omega_from_attitude(self.run.quaternions, self.dt)
 
     def plot(self, key: str, t: float) -> tuple[np.ndarray, ...]:
-        stride = max(1, len(self.times) // PLOT_SAMPLES)
-        n = max(2, self.row(t) // stride + 1)
-        times = self.times[::stride][:n]
-        error = np.log10(np.maximum(self.run.error_estimate[::stride][:n], ERROR_FLOOR))
-        gap = np.log10(np.maximum(self.mismatch[::stride][:n], ERROR_FLOOR))
-        return times, error, gap
+        times, error, gap = self.plotted(t, PLOT_SAMPLES, self.run.error_estimate, self.mismatch)
+        return (
+            times,
+            np.log10(np.maximum(error, ERROR_FLOOR)),
+            np.log10(np.maximum(gap, ERROR_FLOOR)),
+        )
 
 
 def build(settings: Settings) -> GyroModel:
@@ -188,12 +195,14 @@ def build(settings: Settings) -> GyroModel:
     return GyroModel(gyro, times, run, omega, mismatch, drift)
 
 
-class GyroDrawing:
+class GyroDrawing(TabulatedDrawing):
     """The disc, its axis, the torque and drift arrows (body frame), ω and the axis's path."""
 
+    contact = "path"
+
     def __init__(self, canvas: Canvas) -> None:
-        self.canvas = canvas
-        parts = self.parts = Parts(canvas.api)
+        super().__init__(canvas)
+        parts = self.parts
         mesh = meshes.solid_mesh(DISC.solid) if DISC.solid is not None else None
         assert mesh is not None
         vertices = np.asarray(mesh.vertices) * (DISC_RADIUS / float(np.max(mesh.extents) / 2.0))
@@ -204,9 +213,8 @@ class GyroDrawing:
         self.torque_label = parts.label("torque", f"{TORQUE_NODE}_label", "M", (0, 1, 0))
         self.drift = parts.arrow("drift", DRIFT_NODE, colors.DRIFT, THIN_ARROW)
         self.drift_label = parts.label("drift", f"{DRIFT_NODE}_label", "drift", (0, 0, 1))
-        self.omega = parts.arrow("omega", OMEGA_NODE, colors.OMEGA, THIN_ARROW)
+        self.arrows["omega"] = parts.arrow("omega", OMEGA_NODE, colors.OMEGA, THIN_ARROW)
         self.path = parts.trail("path", PATH_NODE, colors.AXIS_PATH, 3.0, 2400)
-        self.player: Player | None = None
 
     def fit(self, model: Model, geometry: Geometry | None) -> None:
         assert isinstance(model, GyroModel)
@@ -234,24 +242,6 @@ class GyroDrawing:
         self.drift.points = arrow_points((0, 0, AXIS_LENGTH), (0, shift, AXIS_LENGTH))
         self.drift_label.position = (0.0, shift, AXIS_LENGTH + 0.05)
         self.player = Player(table, {"path": self.path})
-
-    def advance(self, t: float, frame: Frame | None) -> Frame:
-        if self.player is None:
-            raise RuntimeError("fit() a model before advance()")
-        table = self.player.table
-        row, samples = self.player.advance(t)
-        self.canvas.body.wxyz = table.wxyz[row]
-        self.omega.points = table.arrows["omega"][row]
-        cycle, _ = table.locate(t)
-        return table.frame(
-            cycle * table.span + row * table.dt, row, table.points["path"][row], samples
-        )
-
-    def set_visible(self, part: str, visible: bool) -> None:
-        self.parts.set_visible(part, visible)
-
-    def remove(self) -> None:
-        self.parts.remove()
 
 
 SPEC = SceneSpec(

@@ -30,23 +30,10 @@ import numpy as np
 import trimesh
 
 from poinsot.app.bodies import MeshBody, body_from_mesh
-from poinsot.app.elements import Control, Element, Solid
-from poinsot.app.scene import meshes
-from poinsot.app.scene.batch import Frame
-from poinsot.app.scene.geometry import Geometry, triple
+from poinsot.app.elements import Control, Element
 from poinsot.app.scenes import colors
-from poinsot.app.scenes.drawing import Parts
-from poinsot.app.scenes.spec import (
-    Canvas,
-    Choice,
-    Model,
-    Part,
-    Readout,
-    SceneSpec,
-    Settings,
-    number,
-    relative,
-)
+from poinsot.app.scenes.base import CONSTRUCTION, OwnSolid, SceneModel, riding_mesh
+from poinsot.app.scenes.spec import Choice, Part, Readout, SceneSpec, Settings, number
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
 from poinsot.physics.family import PolhodeArc
 from poinsot.physics.flip import measure_flips
@@ -64,6 +51,12 @@ LAPSE_VALUES = (1.0, 3.0, 10.0, 30.0, 100.0)
 CHORD_SAMPLES = 4096
 SIZE_SAMPLES = 2048
 CYLINDER_NODE = "/space/body/cylinder"
+CYLINDER = Part("cylinder", "the cylinder", (CYLINDER_NODE,), surface=colors.SOLID)
+#: Tolerances of the readouts: the chord of CHORD_SAMPLES points falls short of the arc by
+#: about (its step's angle)²/24 at the sharpest bend, a fraction of a circuit; the zeros of ω₂
+#: are refined to a few ulps of t.
+CHORD = 1e-3
+EXACT = 1e-12
 
 
 @functools.cache
@@ -77,25 +70,25 @@ def cylinder() -> MeshBody:
 
 
 @dataclasses.dataclass(frozen=True)
-class CylinderModel:
+class CylinderModel(OwnSolid, SceneModel):
     body: FreeRigidBody
     arc: PolhodeArc
     measured_period: float
-
-    @property
-    def solid(self) -> Solid | None:
-        return None  # drawn from its own mesh (CylinderDrawing)
 
     def readouts(self, t: float) -> tuple[Readout, ...]:
         arc = self.arc
         fraction = float(arc.fraction(t)[0])
         circuits = math.floor(float(arc.arc_length(t)[0]) / arc.circuit_length)
+        chord = self.chord_fraction(t)
         return (
-            Readout(
+            Readout.compare(
                 "travelled along the polhode",
-                f"{100.0 * fraction:.2f} %",
-                f"{100.0 * self.chord_fraction(t):.2f} %",
+                fraction,
+                chord,
+                CHORD,
                 "theory: arc length (PolhodeArc); measured: chord length of ω(t) sampled",
+                scale=1.0,  # a fraction of the circuit
+                text=(f"{100.0 * fraction:.2f} %", f"{100.0 * chord:.2f} %"),
             ),
             Readout("circuits of the polhode done", str(circuits), "—"),
             *self.rows,
@@ -106,10 +99,11 @@ class CylinderModel:
         arc = self.arc
         herpolhode, polhode = self.sizes()
         return (
-            Readout(
+            Readout.compare(
                 "one circuit, 4K/λ",
-                number(arc.circuit_time),
-                relative(self.measured_period, arc.circuit_time),
+                arc.circuit_time,
+                self.measured_period,
+                EXACT,
                 "measured: twice the spacing of the zeros of ω₂",
             ),
             Readout(
@@ -144,9 +138,6 @@ class CylinderModel:
         _, _, contact = self.body.sample(self._circuit(SIZE_SAMPLES))
         return float(np.max(np.arctan2(np.hypot(contact[:, 0], contact[:, 1]), contact[:, 2])))
 
-    def plot(self, key: str, t: float) -> tuple[np.ndarray, ...]:
-        raise KeyError(f"the long cylinder has no plot {key!r}")
-
 
 def _chord(points: np.ndarray) -> float:
     """The length of the polyline through ``points`` (N, 3)."""
@@ -163,34 +154,6 @@ def build(settings: Settings) -> CylinderModel:
     return CylinderModel(body, arc, measured)
 
 
-class CylinderDrawing:
-    """The cylinder's own mesh inside the ellipsoid (body frame)."""
-
-    def __init__(self, canvas: Canvas) -> None:
-        self.parts = Parts(canvas.api)
-        shape = cylinder().mesh
-        self.vertices = np.asarray(shape.vertices)
-        self.mesh = self.parts.surface(
-            "cylinder", CYLINDER_NODE, (self.vertices, np.asarray(shape.faces)), colors.SOLID
-        )
-
-    def fit(self, model: Model, geometry: Geometry | None) -> None:
-        if geometry is None:
-            raise ValueError("the cylinder rides in the Poinsot construction")
-        self.mesh.scale = triple(np.full(3, meshes.fit_scale(self.vertices, geometry.semi_axes)))
-
-    def advance(self, t: float, frame: Frame | None) -> Frame:
-        if frame is None:
-            raise RuntimeError("the cylinder rides in the Poinsot construction")
-        return frame
-
-    def set_visible(self, part: str, visible: bool) -> None:
-        self.parts.set_visible(part, visible)
-
-    def remove(self) -> None:
-        self.parts.remove()
-
-
 SPEC = SceneSpec(
     name="long-cylinder",
     label="Scene: long cylinder, stable-looking spin",
@@ -202,20 +165,8 @@ SPEC = SceneSpec(
     body="a homogeneous cylinder 2.4 long with an elliptic section of semi-axes 0.2512 and "
     "0.2488, moments by trimesh, normalised to I₃ = 1",
     motion="FreeRigidBody(I, |ω₀| = 2 at 1° from e₂ towards e₁); PolhodeArc",
-    elements=frozenset(
-        {
-            Element.ELLIPSOID,
-            Element.AXES,
-            Element.PLANE,
-            Element.CONTACT,
-            Element.OMEGA,
-            Element.L,
-            Element.POLHODE,
-            Element.POLHODE_FULL,
-            Element.HERPOLHODE,
-        }
-    ),
-    parts=(Part("cylinder", "the cylinder", (CYLINDER_NODE,), surface=colors.SOLID),),
+    elements=CONSTRUCTION | {Element.POLHODE, Element.POLHODE_FULL},
+    parts=(CYLINDER,),
     controls=(
         Choice(
             "lapse",
@@ -238,7 +189,7 @@ SPEC = SceneSpec(
     ),
     plots=(),
     build=build,
-    draw=CylinderDrawing,
+    draw=riding_mesh(CYLINDER, lambda: cylinder().mesh),
     speed_range=(0.05, 100.0),
     trail_points=3000,
     picture_time=40.0,

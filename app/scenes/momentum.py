@@ -15,6 +15,7 @@ import math
 from collections.abc import Iterable
 
 import numpy as np
+import viser
 from numpy.typing import ArrayLike
 
 from poinsot.app.scene import palette
@@ -43,6 +44,14 @@ KINDS: dict[str, tuple[tuple[Regime, ...], tuple[int, int, int]]] = {
 def family_width(kind: str) -> float:
     """The line width of a family kind [screen px]."""
     return SEPARATRIX_WIDTH_PX if kind == "separatrix" else FAMILY_WIDTH_PX
+
+
+def family_lines(parts: Parts, part: str, root: str) -> dict[str, viser.LineSegmentsHandle]:
+    """One line node per family kind, ``<root>/<kind>``, in its colour and width."""
+    return {
+        kind: parts.lines(part, f"{root}/{kind}", color, family_width(kind))
+        for kind, (_, color) in KINDS.items()
+    }
 
 
 def family_segments(
@@ -125,11 +134,7 @@ class MomentumPicture:
             parts.lines(part, f"{root}/axis{i + 1}", palette.AXES[i], palette.AXIS_WIDTH_PX)
             for i in range(3)
         ]
-        self.family = {
-            kind: parts.lines(part, f"{root}/{kind}", color, family_width(kind))
-            for kind, (_, color) in KINDS.items()
-            if family
-        }
+        self.family = family_lines(parts, part, root) if family else {}
         self.current = (
             parts.lines(part, f"{root}/polhode", colors.CURRENT, CURRENT_WIDTH_PX)
             if current

@@ -32,14 +32,14 @@ from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.geometry import POLHODE_INFLATE, Geometry
 from poinsot.app.scene.view import View
 from poinsot.app.scenes import colors
-from poinsot.app.scenes.drawing import Parts
+from poinsot.app.scenes.base import CONSTRUCTION, PartsDrawing, SceneModel
 from poinsot.app.scenes.momentum import (
     CURRENT_WIDTH_PX,
     KINDS,
     MomentumPicture,
     current_segments,
+    family_lines,
     family_segments,
-    family_width,
     momentum_nodes,
 )
 from poinsot.app.scenes.spec import (
@@ -51,7 +51,6 @@ from poinsot.app.scenes.spec import (
     Settings,
     Slider,
     number,
-    relative,
 )
 from poinsot.physics import FreeRigidBody, Regime
 from poinsot.physics.family import (
@@ -84,10 +83,12 @@ CURRENT_NODE = f"{ROOT}/body/current_polhode"
 LANDAU_ROOT = f"{ROOT}/landau"
 #: Samples of one period used to read the motion's D and its family.
 CHECK_SAMPLES = 64
+#: Tolerance of the readouts: every one is read off the exact motion (rounding only).
+EXACT = 1e-12
 
 
 @dataclasses.dataclass(frozen=True)
-class FamilyModel:
+class FamilyModel(SceneModel):
     """The body on the polhode of D, the family on its ellipsoid, and Landau's view."""
 
     D: float
@@ -97,9 +98,6 @@ class FamilyModel:
     current: list[PolhodeCurve]
     landau: MomentumView
     measured_period: float
-
-    def readouts(self, t: float) -> tuple[Readout, ...]:
-        return self.rows
 
     @functools.cached_property
     def rows(self) -> tuple[Readout, ...]:
@@ -118,22 +116,23 @@ class FamilyModel:
             for c in landau.curves
         )
         return (
-            Readout(
-                "D = G²/2T", number(self.D), relative(D_motion, self.D), "measured: G²/2T of ω(t)"
-            ),
+            Readout.compare("D = G²/2T", self.D, D_motion, EXACT, "measured: G²/2T of ω(t)"),
             Readout("family", _family(body.regime), _kept_sign(w)),
             Readout("k²", number(body.parameter), "—"),
+            _period(body.period, self.measured_period),
             Readout(
-                "period of ω (4K/λ)",
-                number(body.period),
-                relative(self.measured_period, body.period),
-                "measured: twice the spacing of the zeros of ω₂",
+                "|m| on Landau's curve",
+                number(landau.sphere_radius),
+                f"±{on_sphere:.0e} rel.",
+                gap=on_sphere,
+                tolerance=EXACT,
             ),
             Readout(
-                "|m| on Landau's curve", number(landau.sphere_radius), f"±{on_sphere:.0e} rel."
-            ),
-            Readout(
-                "Σ mᵢ²/Iᵢ on Landau's curve", number(landau.two_T), f"±{on_ellipsoid:.0e} rel."
+                "Σ mᵢ²/Iᵢ on Landau's curve",
+                number(landau.two_T),
+                f"±{on_ellipsoid:.0e} rel.",
+                gap=on_ellipsoid,
+                tolerance=EXACT,
             ),
         )
 
@@ -141,8 +140,13 @@ class FamilyModel:
         span = self.body.period if math.isfinite(self.body.period) else 20.0
         return np.linspace(0.0, span, CHECK_SAMPLES, endpoint=False)
 
-    def plot(self, key: str, t: float) -> tuple[np.ndarray, ...]:
-        raise KeyError(f"the polhode family has no plot {key!r}")
+
+def _period(theory: float, measured: float) -> Readout:
+    """The period against the motion's, where the motion returns (else nothing to compare)."""
+    note = "measured: twice the spacing of the zeros of ω₂"
+    if math.isfinite(theory):
+        return Readout.compare("period of ω (4K/λ)", theory, measured, EXACT, note)
+    return Readout("period of ω (4K/λ)", number(theory), number(measured), note)
 
 
 def _family(regime: Regime) -> str:
@@ -184,16 +188,13 @@ def build(settings: Settings) -> FamilyModel:
     return FamilyModel(D, body, BOX.solid, family, current, landau, measured)
 
 
-class FamilyDrawing:
+class FamilyDrawing(PartsDrawing):
     """The family and the current curves on the ellipsoid (body frame), and Landau's view."""
 
     def __init__(self, canvas: Canvas) -> None:
-        self.parts = Parts(canvas.api)
+        super().__init__(canvas)
         self.parts.frame("family", FAMILY_ROOT)
-        self.family = {
-            kind: self.parts.lines("family", f"{FAMILY_ROOT}/{kind}", color, family_width(kind))
-            for kind, (_, color) in KINDS.items()
-        }
+        self.family = family_lines(self.parts, "family", FAMILY_ROOT)
         self.current = self.parts.lines("current", CURRENT_NODE, colors.CURRENT, CURRENT_WIDTH_PX)
         self.landau = MomentumPicture(
             self.parts,
@@ -208,9 +209,7 @@ class FamilyDrawing:
 
     def fit(self, model: Model, geometry: Geometry | None) -> None:
         assert isinstance(model, FamilyModel)
-        if geometry is None:
-            raise ValueError("the polhode family needs the Poinsot construction's geometry")
-        scale = geometry.scale * POLHODE_INFLATE
+        scale = self.geometry(geometry).scale * POLHODE_INFLATE
         family = family_segments(model.family, scale)
         current = current_segments(model.current, scale, momentum=False)
         for kind, segs in family.items():
@@ -221,16 +220,9 @@ class FamilyDrawing:
         self.model = model
 
     def advance(self, t: float, frame: Frame | None) -> Frame:
-        if frame is None:
-            raise RuntimeError("the polhode family rides on the Poinsot construction")
+        frame = super().advance(t, frame)
         self.landau.show_m(np.asarray(INERTIA) * frame.omega)
         return frame
-
-    def set_visible(self, part: str, visible: bool) -> None:
-        self.parts.set_visible(part, visible)
-
-    def remove(self) -> None:
-        self.parts.remove()
 
 
 SPEC = SceneSpec(
@@ -244,18 +236,7 @@ SPEC = SceneSpec(
     ),
     body="the presets' homogeneous 3 × 2 × 1 box, I = (1, 2, 2.6)",
     motion="FreeRigidBody.from_energy(I, D, |ω₀| = 1.2); polhode_family, momentum_view",
-    elements=frozenset(
-        {
-            Element.ELLIPSOID,
-            Element.AXES,
-            Element.PLANE,
-            Element.CONTACT,
-            Element.OMEGA,
-            Element.L,
-            Element.HERPOLHODE,
-            Element.SOLID,
-        }
-    ),
+    elements=CONSTRUCTION | {Element.SOLID},
     parts=(
         Part(
             "family",
@@ -301,4 +282,5 @@ SPEC = SceneSpec(
     speed=1.0,
     trail_points=1600,
     picture_time=6.0,
+    table_settings=({}, {"D": 2.3}, {"D": I2}),
 )

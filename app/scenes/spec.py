@@ -121,12 +121,51 @@ class PlotSpec:
 @dataclasses.dataclass(frozen=True)
 class Readout:
     """One row of the readout table: the theory's value and the value measured from the motion
-    the scene shows (either may be "—" with the reason in ``note``)."""
+    the scene shows (either may be "—" with the reason in ``note``).
+
+    A row that compares two numbers (:meth:`compare`) also carries their gap: ``gap`` is
+    measured/theory − 1 (the relative difference the measured cell shows), or the difference
+    in units of a scale the row names where the theory is 0 or a fraction, or the deviation
+    itself where the theory is "0"; ``tolerance`` is the largest ``|gap|`` the scene states for
+    the row. Both are None where the row compares nothing.
+    """
 
     quantity: str
     theory: str
     measured: str
     note: str = ""
+    gap: float | None = None
+    tolerance: float | None = None
+
+    @classmethod
+    def compare(
+        cls,
+        quantity: str,
+        theory: float,
+        measured: float,
+        tolerance: float,
+        note: str = "",
+        *,
+        digits: int = 6,
+        scale: float | None = None,
+        text: tuple[str, str] | None = None,
+    ) -> Readout:
+        """A row of ``theory`` against ``measured``, shown with ``digits`` significant digits and
+        the relative gap (or as ``text``, the two cells, where the row has its own format);
+        ``scale`` replaces the theory as the unit of the gap."""
+        unit = theory if scale is None else scale
+        gap = (measured - theory) / unit if unit != 0.0 else math.nan
+        theory_text, measured_text = (
+            (number(theory, digits), relative(measured, theory, digits)) if text is None else text
+        )
+        return cls(quantity, theory_text, measured_text, note, gap, tolerance)
+
+    @property
+    def within(self) -> bool | None:
+        """Whether the gap is within the tolerance (None: the row compares nothing)."""
+        if self.gap is None or self.tolerance is None:
+            return None
+        return bool(abs(self.gap) <= self.tolerance)
 
 
 class Model(Protocol):
@@ -204,6 +243,9 @@ class SceneSpec:
     trail_points: int = 1200
     #: Simulation time of ``poinsot screenshot --scene`` (what the picture shows best).
     picture_time: float = 10.0
+    #: The settings (over the defaults) the readout table of the scenes shows, at
+    #: ``picture_time`` (``python -m poinsot.app.scenes.readouts``).
+    table_settings: tuple[Mapping[str, Value], ...] = ({},)
 
     def __post_init__(self) -> None:
         if not self.shared <= SHAREABLE:

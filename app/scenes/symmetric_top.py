@@ -29,10 +29,10 @@ import viser
 
 from poinsot.app.elements import Control, Element, Solid
 from poinsot.app.presets import preset_by_key
-from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.geometry import Geometry
 from poinsot.app.scenes import colors
-from poinsot.app.scenes.drawing import Parts, cone_mesh, segments
+from poinsot.app.scenes.base import CONSTRUCTION, PartsDrawing, SceneModel
+from poinsot.app.scenes.drawing import cone_mesh, segments
 from poinsot.app.scenes.spec import (
     Canvas,
     Choice,
@@ -42,8 +42,6 @@ from poinsot.app.scenes.spec import (
     SceneSpec,
     Settings,
     Slider,
-    number,
-    relative,
 )
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
 from poinsot.physics.symmetric import (
@@ -66,18 +64,18 @@ MEASURE_TURNS = 3.0
 ANGLE_SAMPLES = 256
 BODY_CONE = "/space/body/body_cone"
 SPACE_CONE = "/space/space_cone"
+#: Tolerance of the readouts: the rates are slopes of unwrapped azimuths of the exact motion,
+#: the angles means over its samples (rounding only).
+EXACT = 1e-9
 
 
 @dataclasses.dataclass(frozen=True)
-class TopModel:
+class TopModel(SceneModel):
     shape: str
     tilt: float  # angle of ω₀ from e₃ [rad]
     top: SymmetricTop
     body: FreeRigidBody
     solid: Solid | None
-
-    def readouts(self, t: float) -> tuple[Readout, ...]:
-        return self.rows
 
     @functools.cached_property
     def rows(self) -> tuple[Readout, ...]:
@@ -88,25 +86,25 @@ class TopModel:
         alpha_b, alpha_s, theta = self.measured_angles()
         return (
             Readout("shape", top.shape, "J > I" if body.inertia[2] > body.inertia[0] else "J < I"),
-            Readout(
+            Readout.compare(
                 "precession p = G/I",
-                number(top.precession_rate, 9),
-                relative(p, top.precession_rate, 9),
+                top.precession_rate,
+                p,
+                EXACT,
                 "measured: azimuth of the axis about L",
+                digits=9,
             ),
-            Readout(
+            Readout.compare(
                 "spin s = ((I − J)/I) ω₃",
-                number(top.spin_rate, 9),
-                relative(s, top.spin_rate, 9),
+                top.spin_rate,
+                s,
+                EXACT,
                 "measured: azimuth of ω about e₃",
+                digits=9,
             ),
-            Readout(
-                "body cone α_b (ω to e₃)", _degrees(top.body_cone_half_angle), _degrees(alpha_b)
-            ),
-            Readout(
-                "space cone α_s (ω to L)", _degrees(top.space_cone_half_angle), _degrees(alpha_s)
-            ),
-            Readout("nutation θ (e₃ to L)", _degrees(top.nutation_angle), _degrees(theta)),
+            _angles("body cone α_b (ω to e₃)", top.body_cone_half_angle, alpha_b),
+            _angles("space cone α_s (ω to L)", top.space_cone_half_angle, alpha_s),
+            _angles("nutation θ (e₃ to L)", top.nutation_angle, theta),
         )
 
     def measured_angles(self) -> tuple[float, float, float]:
@@ -124,17 +122,16 @@ class TopModel:
             float(np.mean(_angle(R.apply(e3), Lhat))),
         )
 
-    def plot(self, key: str, t: float) -> tuple[np.ndarray, ...]:
-        raise KeyError(f"the symmetric top has no plot {key!r}")
-
 
 def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Angles [rad] between the rows of ``a`` and the vector ``b`` (atan2: exact at 0)."""
     return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), a @ b)
 
 
-def _degrees(angle: float) -> str:
-    return f"{math.degrees(angle):.6f}°"
+def _angles(quantity: str, theory: float, measured: float) -> Readout:
+    """A row of two angles [rad], shown in degrees."""
+    text = tuple(f"{math.degrees(a):.6f}°" for a in (theory, measured))
+    return Readout.compare(quantity, theory, measured, EXACT, text=(text[0], text[1]))
 
 
 def build(settings: Settings) -> TopModel:
@@ -148,11 +145,11 @@ def build(settings: Settings) -> TopModel:
     return TopModel(shape, tilt, top, top.body(), preset.solid)
 
 
-class ConesDrawing:
+class ConesDrawing(PartsDrawing):
     """The body cone (body frame) and the space cone (space frame), to the tip of ω."""
 
     def __init__(self, canvas: Canvas) -> None:
-        self.parts = Parts(canvas.api)
+        super().__init__(canvas)
         self.cones: dict[str, tuple[viser.MeshHandle, viser.LineSegmentsHandle]] = {}
         for part, name, color in (
             ("body_cone", BODY_CONE, colors.BODY_CONE),
@@ -166,9 +163,7 @@ class ConesDrawing:
 
     def fit(self, model: Model, geometry: Geometry | None) -> None:
         assert isinstance(model, TopModel)
-        if geometry is None:
-            raise ValueError("the cones are drawn in the Poinsot construction")
-        top, scale = model.top, geometry.scale
+        top, scale = model.top, self.geometry(geometry).scale
         # Generators of length |ω|: both rims pass through the tip of ω, on the plane.
         rims = {
             "body_cone": top.body_cone(CONE_SECTIONS, top.omega_norm) * scale,
@@ -183,17 +178,6 @@ class ConesDrawing:
             generators[:, 1] = rim[:: CONE_SECTIONS // GENERATORS]
             line.points = np.concatenate([segments(rim, closed=True), generators])
 
-    def advance(self, t: float, frame: Frame | None) -> Frame:
-        if frame is None:
-            raise RuntimeError("the cones ride on the Poinsot construction")
-        return frame
-
-    def set_visible(self, part: str, visible: bool) -> None:
-        self.parts.set_visible(part, visible)
-
-    def remove(self) -> None:
-        self.parts.remove()
-
 
 SPEC = SceneSpec(
     name="symmetric-top",
@@ -206,19 +190,7 @@ SPEC = SceneSpec(
     body="the presets' homogeneous disc (r 1, thickness 0.25) or rod (r 0.35, length 2)",
     motion="symmetric_top(I, J, ω₀, R₀ with L along z).body(); measure_precession_rate, "
     "measure_spin_rate",
-    elements=frozenset(
-        {
-            Element.ELLIPSOID,
-            Element.AXES,
-            Element.PLANE,
-            Element.CONTACT,
-            Element.OMEGA,
-            Element.L,
-            Element.POLHODE,
-            Element.HERPOLHODE,
-            Element.SOLID,
-        }
-    ),
+    elements=CONSTRUCTION | {Element.POLHODE, Element.SOLID},
     parts=(
         Part(
             "body_cone",
@@ -259,4 +231,5 @@ SPEC = SceneSpec(
     draw=ConesDrawing,
     speed=1.0,
     picture_time=4.0,
+    table_settings=({}, {"shape": "oblate (a disc)"}),
 )

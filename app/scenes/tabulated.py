@@ -24,6 +24,18 @@ from poinsot.app.scene.trail import Trail
 MAX_ROWS_PER_FRAME = 64
 
 
+def grid_cycle_row(t: float, dt: float, rows: int) -> tuple[int, int]:
+    """(cycle, row) of clock time ``t`` >= 0 on a grid of ``rows`` steps ``dt``, looped."""
+    k = max(0, math.floor(float(t) / dt + 1e-9))
+    cycle, row = divmod(k, rows)
+    return int(cycle), int(row)
+
+
+def grid_row(t: float, dt: float, rows: int) -> int:
+    """The row of clock time ``t`` (see :func:`grid_cycle_row`)."""
+    return grid_cycle_row(t, dt, rows)[1]
+
+
 @dataclasses.dataclass(frozen=True)
 class Table:
     """The motion on the grid ``t_k = k dt``, ``k = 0 … N-1`` (looped with period ``N dt``).
@@ -61,12 +73,14 @@ class Table:
 
     def locate(self, t: float) -> tuple[int, int]:
         """(cycle, row) shown at clock time ``t`` >= 0."""
-        k = max(0, math.floor(float(t) / self.dt + 1e-9))
-        cycle, row = divmod(k, self.rows)
-        return int(cycle), int(row)
+        return grid_cycle_row(t, self.dt, self.rows)
 
     def frame(self, t: float, row: int, contact: np.ndarray, samples: int) -> Frame:
-        return Frame(float(t), self.omega[row], self.wxyz[row], contact, samples)
+        """The frame of ``row`` shown at clock time ``t``: its time is the grid time of that
+        row in the current cycle."""
+        cycle, _ = self.locate(t)
+        time = cycle * self.span + row * self.dt
+        return Frame(time, self.omega[row], self.wxyz[row], contact, samples)
 
 
 class Player:

@@ -20,6 +20,7 @@ from poinsot.app.live.display import PROJECTOR_TEXT_PERCENT, browser_camera
 from poinsot.app.live.legend import CAPTIONS
 from poinsot.app.presets import CUSTOM, preset_by_key
 from poinsot.app.scene import palette
+from poinsot.app.scene.view import VIEWS
 from poinsot.physics import Regime
 
 pytestmark = pytest.mark.browser
@@ -329,7 +330,16 @@ def test_labels_stand_apart_and_off_the_contact_point(poinsot_app, open_page, vi
     session = started(poinsot_app, frames=40)
     pause(page, session)
     page.click_button(view)
-    page.page.wait_for_timeout(1500)
+    # The layout is for the camera the browser reports: wait until the view has settled there
+    # (under load the animation to it outlasts any fixed wait).
+    target, camera_handle = VIEWS[view], session.client.camera
+    assert wait_until(
+        lambda: (
+            np.allclose(camera_handle.position, target.position, atol=1e-3)
+            and np.allclose(camera_handle.look_at, target.look_at, atol=1e-3)
+        ),
+        20,
+    ), (view, camera_handle.position, camera_handle.look_at)
     session.lecture.display.lay_out_labels()
     page.page.wait_for_timeout(800)
     shown = page.screenshot_rgb().astype(int)

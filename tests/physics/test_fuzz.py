@@ -17,8 +17,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from poinsot.physics.fuzz import CLEAN, TARGETS, Call, case, template
-from poinsot.physics.fuzz_harness import build, run_case
-from poinsot.physics.fuzz_values import RandomSource
+from poinsot.physics.fuzz.harness import build, run_case
+from poinsot.physics.fuzz.values import RandomSource
 
 pytestmark = pytest.mark.filterwarnings("error")
 
@@ -81,7 +81,7 @@ def test_errors_of_libraries_warnings_and_bad_results_are_unclean() -> None:
     assert _outcome(lambda: [][1]) == "UNCLEAN"
 
     def not_finite(result):
-        from poinsot.physics.fuzz_checks import finite
+        from poinsot.physics.fuzz.checks import finite
 
         finite(result)
 
@@ -100,3 +100,30 @@ def test_outcomes_are_grouped_by_their_message_without_numbers() -> None:
 def test_a_random_source_is_reproducible() -> None:
     a, b = (RandomSource(np.random.default_rng([1, 2])) for _ in range(2))
     assert [a.index(10) for _ in range(5)] == [b.index(10) for _ in range(5)]
+
+
+def test_a_value_error_raised_by_the_fuzz_itself_is_no_refusal() -> None:
+    from poinsot.physics.fuzz import harness
+
+    def raise_in(folder: str) -> None:
+        code = "raise ValueError('a message long enough to say what to change')"
+        exec(compile(code, folder + "fake_room.py", "exec"))
+
+    assert _outcome(lambda: raise_in(harness._FUZZ)) == "UNCLEAN"
+    assert harness._FUZZ.startswith(harness._PHYSICS) and harness._FUZZ != harness._PHYSICS
+
+
+def test_the_benchmark_counts_a_short_run(capsys: pytest.CaptureFixture[str]) -> None:
+    from poinsot.physics.fuzz import main
+
+    assert main(["--cases", "60", "--only", "FreeRigidBody"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("60 cases in") and "UNCLEAN                                   0" in out
+
+
+def test_from_energy_with_the_default_omega_norm_passed_as_none_is_checked_cleanly() -> None:
+    # Case 67051 of seed 0: from_energy(..., omega_norm=None) builds a body with the default
+    # |ω0|; the check read float(None) and called the valid body unclean.
+    o = case(67051, 0, list(TARGETS))
+    assert o.target == "FreeRigidBody.from_energy" and "omega_norm=None" in o.call
+    assert o.clean, o.detail

@@ -132,6 +132,16 @@ def test_flip_clock_of_extreme_spins() -> None:
     assert all(map(math.isfinite, (clock.first_flip_time, clock.time_between_flips)))
 
 
+def test_growth_from_a_subnormal_perturbation() -> None:
+    """hi/p0 overflowed (a warning) for a start p0 ~1e-319 off e2; the growth is measurable."""
+    inertia = np.array([1.06544994e150, 2.63342978e150, 3.00559270e150])
+    w0 = np.array([3.765205e-318, -26.53780275071176, 0.0])
+    I1, I2, I3 = inertia / inertia[2]
+    sigma = abs(w0[1]) * math.sqrt((I2 - I1) * (I3 - I2) / (I1 * I3))
+    fit = measure_growth_rate(FreeRigidBody(inertia, w0))
+    assert fit.rate == pytest.approx(sigma, rel=1e-3) and fit.e_folds > 700
+
+
 def test_measuring_grids_are_bounded() -> None:
     """A grid sized by the input: a MemoryError (738 TiB) or a run of hours."""
     body = FreeRigidBody((1.0, 2.0, 3.0), (1e-3, 1.0, 0.0))

@@ -15,12 +15,12 @@ from poinsot.physics import (
     check_real_body,
     omega_from_energy,
 )
-from poinsot.physics import fuzz_values as values
 from poinsot.physics.fit import fit_angular_velocity, synthetic_toss
-from poinsot.physics.fuzz_checks import Invariants, finite, require, rotation
-from poinsot.physics.fuzz_free_body import energy_parameter, short
-from poinsot.physics.fuzz_harness import Call
-from poinsot.physics.fuzz_values import Source, pick
+from poinsot.physics.fuzz import values
+from poinsot.physics.fuzz.checks import Invariants, finite, require, rotation
+from poinsot.physics.fuzz.free_body import energy_parameter, short
+from poinsot.physics.fuzz.harness import Call
+from poinsot.physics.fuzz.values import Source, pick
 from poinsot.physics.integrators import INTEGRATORS, Propagation, integrate
 
 __all__ = ["TARGETS"]

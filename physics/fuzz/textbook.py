@@ -10,11 +10,11 @@ from typing import Any
 import numpy as np
 
 from poinsot.physics import FreeRigidBody, dissipation, family, flip, gyroscope, symmetric
-from poinsot.physics import fuzz_values as values
-from poinsot.physics.fuzz_checks import finite, number, require, rotation
-from poinsot.physics.fuzz_free_body import body_maker, energy_parameter, short
-from poinsot.physics.fuzz_harness import Call
-from poinsot.physics.fuzz_values import Source, pick
+from poinsot.physics.fuzz import values
+from poinsot.physics.fuzz.checks import finite, number, require, rotation
+from poinsot.physics.fuzz.free_body import body_maker, energy_parameter, short
+from poinsot.physics.fuzz.harness import Call
+from poinsot.physics.fuzz.values import Source, pick
 
 __all__ = ["TARGETS"]
 

@@ -1,63 +1,18 @@
-"""A fuzz of the whole public API of :mod:`poinsot.physics`: odd input must end cleanly.
-
-    python -m poinsot.physics.fuzz --cases 100000
-
-Every call ends in a ``ValueError`` or ``TypeError`` raised by the package with a sentence
-that says what to change, or in a finite result that keeps the invariants of the motion
-(:mod:`~poinsot.physics.fuzz_checks`). The benchmark prints the count of each outcome per
-target and shows the unclean ones by kind; its exit status is 1 if any case ended uncleanly.
-Case ``i`` draws its choices from ``numpy.random.default_rng([seed, i])`` and calls target
-``i mod (number of targets)``: any case can be replayed alone (``--replay i``).
-
-Rooms: :mod:`~.fuzz_values` (odd arguments from a source of choices), :mod:`~.fuzz_harness`
-(one case and its outcome), :mod:`~.fuzz_checks` (the invariants), :mod:`~.fuzz_free_body`,
-:mod:`~.fuzz_textbook` and :mod:`~.fuzz_tools` (the targets), this module (the registry and
-the benchmark). The tests drive the same targets from hypothesis
-(``tests/physics/test_fuzz.py``). Only numpy, scipy and the standard library: the choices come
-from numpy's Generator here.
-"""
+"""The fuzz's benchmark on the command line (``python -m poinsot.physics.fuzz``): a run of
+cases, the count of each outcome per target, the kinds of refusal and the unclean cases."""
 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from collections import Counter, defaultdict
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
-import numpy as np
+from poinsot.physics.fuzz import checks
+from poinsot.physics.fuzz.harness import CLEAN, Outcome
+from poinsot.physics.fuzz.registry import TARGETS, case, run
 
-from poinsot.physics import fuzz_checks, fuzz_free_body, fuzz_textbook, fuzz_tools
-from poinsot.physics.fuzz_harness import CLEAN, Call, Outcome, build, run_case
-from poinsot.physics.fuzz_values import RandomSource, Source
-
-__all__ = ["CLEAN", "TARGETS", "Call", "Outcome", "case", "main", "run", "template"]
-
-#: Every target by name: the public API, one entry a kind of call.
-TARGETS: dict[str, Callable[[Source], Call]] = {
-    **fuzz_free_body.TARGETS,
-    **fuzz_textbook.TARGETS,
-    **fuzz_tools.TARGETS,
-}
-
-
-def case(index: int, seed: int, names: Sequence[str]) -> Outcome:
-    """Case ``index`` of a run over the targets ``names``."""
-    name = names[index % len(names)]
-    src = RandomSource(np.random.default_rng([seed, index]))
-    return run_case(name, build(TARGETS[name], src))
-
-
-def run(cases: int, seed: int, names: Sequence[str], progress: bool = False) -> list[Outcome]:
-    outcomes = []
-    start = time.perf_counter()
-    for i in range(cases):
-        outcomes.append(case(i, seed, names))
-        if progress and (i + 1) % 5000 == 0:
-            bad = sum(not o.clean for o in outcomes)
-            rate = (i + 1) / (time.perf_counter() - start)
-            print(f"  {i + 1} cases, {bad} unclean, {rate:.0f}/s", file=sys.stderr, flush=True)
-    return outcomes
+__all__ = ["main", "template"]
 
 
 def template(text: str) -> str:
@@ -132,7 +87,11 @@ def _print_messages(outcomes: list[Outcome]) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m poinsot.physics.fuzz", description=__doc__)
+    from poinsot.physics import fuzz  # the package's docstring, once it is imported
+
+    parser = argparse.ArgumentParser(
+        prog="python -m poinsot.physics.fuzz", description=fuzz.__doc__
+    )
     parser.add_argument("--cases", type=int, default=100_000)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--only", default="", help="targets whose name contains this text")
@@ -153,14 +112,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     slowest = max(outcomes, key=lambda o: o.seconds)
     print(f"\nslowest case: {slowest.seconds:.2f} s, {slowest.target}: {slowest.call[:200]}")
     print(
-        f"largest relative errors (tolerance {fuzz_checks.TOL:g}): "
-        + ", ".join(f"{k} {v:.1e}" for k, v in sorted(fuzz_checks.worst.items()))
+        f"largest relative errors (tolerance {checks.TOL:g}): "
+        + ", ".join(f"{k} {v:.1e}" for k, v in sorted(checks.worst.items()))
     )
     if args.messages:
         _print_messages(outcomes)
     _print_unclean(outcomes, args.examples)
     return 1 if any(not o.clean for o in outcomes) else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

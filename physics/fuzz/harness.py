@@ -6,7 +6,7 @@ A call ends *cleanly* in one of three ways:
   (not by numpy, scipy or Python underneath), with a message of a sentence;
 * ``TypeError``: the same for a TypeError (a wrong kind of argument);
 * ``finite``: a result whose checks pass (finite numbers, and the invariants of the motion to
-  :data:`~poinsot.physics.fuzz_checks.TOL`).
+  :data:`~poinsot.physics.fuzz.checks.TOL`).
 
 Anything else is *unclean*: another exception, an error raised inside a library or with an
 internal message, an escaped warning, a non-finite number, a broken invariant.
@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from poinsot.physics.fuzz_checks import InvariantError
-from poinsot.physics.fuzz_values import Source
+from poinsot.physics.fuzz.checks import InvariantError
+from poinsot.physics.fuzz.values import Source
 
 __all__ = ["CLEAN", "Call", "Outcome", "Target", "run_case"]
 
@@ -32,9 +32,9 @@ CLEAN = ("ValueError", "TypeError", "finite")
 #: A refusal shorter than this cannot say what is wrong and what to change.
 _SHORTEST_MESSAGE = 20
 
-_PHYSICS = __file__.replace("\\", "/").rsplit("/", 1)[0] + "/"
-#: The fuzz's own modules (physics/fuzz*.py): an error raised there is no refusal.
-_FUZZ = _PHYSICS + "fuzz"
+#: The fuzz's own modules (physics/fuzz/): an error raised there is no refusal.
+_FUZZ = __file__.replace("\\", "/").rsplit("/", 1)[0] + "/"
+_PHYSICS = _FUZZ.rstrip("/").rsplit("/", 1)[0] + "/"
 _LINES: dict[str, list[str]] = {}
 
 

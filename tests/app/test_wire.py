@@ -1,0 +1,302 @@
+"""Nothing from the wire is trusted: origins, raw widget values, floods, pending uploads."""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from typing import Any
+
+import numpy as np
+import pytest
+from conftest import session_of, wait_until
+from uploading import MESH
+from viser import _messages
+
+from poinsot.app.live import guard
+from poinsot.app.live import transfers as transfers_module
+from poinsot.app.live.budget import MessageBudget
+from poinsot.app.live.guard import POLICY_VIOLATION, origin_allowed
+from poinsot.app.live.motion_window import PLOT_SAMPLES, MotionWindow
+from poinsot.app.live.probe import Probe
+from poinsot.app.live.transfers import handle_id
+from poinsot.app.live.widgets import checked
+from poinsot.app.parameters import TRAIL_RANGE, Parameters
+from poinsot.app.presets import DEFAULT_PRESET, MESH_BODY
+
+# -- origins ---------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("origin", "host", "allowed", "expected"),
+    [
+        (None, "127.0.0.1:8080", (), True),  # not a browser
+        ("http://127.0.0.1:8080", "127.0.0.1:8080", (), True),
+        ("https://Room.Example:8443/", "room.example:8443", (), True),
+        ("http://evil.example", "127.0.0.1:8080", (), False),
+        ("http://127.0.0.1:8081", "127.0.0.1:8080", (), False),  # another port is another site
+        ("null", "127.0.0.1:8080", (), False),  # a local file, a sandboxed frame
+        ("http://127.0.0.1:8080", None, (), False),
+        ("http://slides.example", "127.0.0.1:8080", ("http://slides.example/",), True),
+        ("file://", "127.0.0.1:8080", (), False),
+    ],
+)
+def test_which_origins_may_connect(origin, host, allowed, expected):
+    assert origin_allowed(origin, host, allowed) is expected
+
+
+def _session_built(app, probe: Probe) -> bool:
+    return wait_until(lambda: probe.closed or len(app.sessions()) == 1, 15) and not probe.closed
+
+
+@pytest.mark.parametrize(
+    ("origin", "served"),
+    [
+        ("http://evil.example", False),
+        ("same", True),
+        ("http://slides.example", True),  # given to --allow-origin
+        (None, True),  # the probe, curl, the load test: no Origin header
+    ],
+)
+def test_a_page_from_another_origin_gets_no_session(make_app, make_probe, origin, served):
+    app = make_app(allow_origins=["http://slides.example"])
+    if origin == "same":
+        origin = f"http://127.0.0.1:{app.port}"
+    probe = make_probe(app, origin=origin)
+    if served:
+        assert _session_built(app, probe)
+        assert app.guard.refused == 0
+    else:
+        assert wait_until(lambda: probe.closed, 10)
+        assert probe.close_code == POLICY_VIOLATION
+        time.sleep(0.5)  # a session built late would show now
+        assert len(app.sessions()) == 0 and app.guard.refused == 1
+        assert not any(n.startswith("/space/body") for n in probe.nodes)
+
+
+# -- raw values --------------------------------------------------------------------------------
+def _non_finite(value: Any) -> bool:
+    if isinstance(value, float):
+        return not math.isfinite(value)
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind == "f" and not bool(np.isfinite(value).all())
+    if isinstance(value, dict):
+        return any(_non_finite(v) for v in value.values())
+    if isinstance(value, list | tuple):
+        return any(_non_finite(v) for v in value)
+    return False
+
+
+JUNK = [math.nan, math.inf, -math.inf, 1e300, -1e300, 99_999_999, "abc", None, [1, 2], "Nope"]
+INPUTS = ("GuiSliderMessage", "GuiNumberMessage", "GuiDropdownMessage", "GuiButtonGroupMessage")
+
+
+def _inputs(probe: Probe) -> dict[str, Any]:
+    _, widgets = probe.snapshot()
+    return {uuid: w for uuid, w in widgets.items() if w.type in INPUTS}
+
+
+def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(
+    poinsot_app, probe, caplog
+):
+    """Every value input of the panel gets what no browser sends: numbers are clamped into the
+    widget's range, the rest refused (the widget shows its last value again); no frame fails,
+    no NaN is sent, and a valid edit afterwards still works."""
+    session = session_of(poinsot_app)
+    sent_nan: list[str] = []
+    probe.add_listener(lambda m, _: _non_finite(m) and sent_nan.append(m["type"]))
+    inputs = _inputs(probe)
+    assert {"I₁", "D = |L|²/2T", "|ω₀|", "Speed", "Trail length", "Preset"} <= {
+        w.props.get("label") for w in inputs.values()
+    }
+    for uuid in inputs:
+        for junk in JUNK:
+            probe.set_value(uuid, junk)
+    # a valid value after the junk: once it has arrived, so have the junk's callbacks
+    trail_uuid, _ = probe.widget("Trail length")
+    probe.set_value(trail_uuid, 1234)
+    assert wait_until(lambda: session.scene.trail_points == 1234, 15)
+    for handle in (session.panel.preset, session.panel.widgets.speed):
+        assert handle.value == checked(handle, handle.value)
+    # then valid edits: a preset (the junk made a sphere of the moments), and D
+    preset_uuid, _ = probe.widget("Preset")
+    probe.set_value(preset_uuid, DEFAULT_PRESET.label)
+    assert wait_until(lambda: session.params == Parameters.from_preset(DEFAULT_PRESET), 15)
+    d_uuid = handle_id(session.panel.widgets.energy)  # the one shown (others are kept hidden)
+    assert probe.wait_for(lambda p: p.widgets[d_uuid].props["max"] > p.widgets[d_uuid].props["min"])
+    d = probe.widgets[d_uuid]
+    target = round(0.3 * d.props["min"] + 0.7 * d.props["max"], 2)
+    probe.set_value(d_uuid, target)
+    assert wait_until(lambda: abs(session.params.D - target) < 0.02, 15), (
+        poinsot_app.guard.dropped,
+        poinsot_app.guard.malformed,
+        len(inputs),
+        session.params,
+        target,
+    )
+    frames = session.stats.frames
+    assert wait_until(lambda: session.stats.frames > frames + 10, 10), "the frames stopped"
+    assert session.stats.errors == 0, session.stats.last_error
+    assert not sent_nan
+    # a value viser could not even convert (a text for a slider) never reaches it
+    assert poinsot_app.guard.malformed > 0
+    assert not [r for r in caplog.records if r.levelname == "ERROR"], caplog.text[:2000]
+    assert math.isfinite(session.clock.speed) and math.isfinite(session.clock.now())
+    for widget in _inputs(probe).values():
+        if "min" in widget.props and widget.value is not None:
+            assert widget.props["min"] <= widget.value <= widget.props["max"], widget.props
+        if "options" in widget.props:
+            assert widget.value in widget.props["options"], widget.props
+
+
+def test_a_number_beyond_the_range_is_clamped_and_shown_clamped(poinsot_app, probe):
+    session = session_of(poinsot_app)
+    uuid, widget = probe.widget("|ω₀|")
+    top = widget.props["max"]
+    probe.set_value(uuid, 99_999_999.0)
+    assert probe.wait_for(lambda p: p.widgets[uuid].value == top, 10)
+    assert wait_until(lambda: abs(session.params.omega_norm - top) < 1e-9, 10)
+    uuid, widget = probe.widget("Speed")
+    before = session.clock.speed
+    probe.set_value(uuid, math.nan)
+    assert probe.wait_for(lambda p: p.widgets[uuid].value == before, 10)  # set back
+    probe.set_value(uuid, -1e300)
+    assert probe.wait_for(lambda p: p.widgets[uuid].value == widget.props["min"], 10)
+    assert wait_until(lambda: session.clock.speed == widget.props["min"], 10)
+    assert session.stats.errors == 0, session.stats.last_error
+
+
+def test_a_gui_update_naming_another_property_is_dropped(poinsot_app, probe):
+    """A browser sends only values; viser would set any attribute named (the callbacks)."""
+    session = session_of(poinsot_app)
+    uuid, widget = probe.widget("Speed")
+    probe.send(_messages.GuiUpdateMessage(uuid, {"max": 1e300, "update_cb": []}))
+    assert wait_until(lambda: poinsot_app.guard.malformed == 1, 10)
+    probe.set_value(uuid, 1e300)
+    assert wait_until(lambda: session.clock.speed == widget.props["max"], 10)
+
+
+# -- floods ------------------------------------------------------------------------------------
+FLOOD_RATE = 10_000.0
+WINDOW = 6.0  # seconds of frames counted, quiet and flooded (compared as a ratio)
+
+
+@pytest.mark.slow
+def test_a_flooding_client_is_cut_off_and_the_others_keep_their_frames(make_app, make_probe):
+    """A raw client (its own process) sends 10k camera messages a second: beyond its budget
+    they are dropped unread by viser, then it is disconnected; another client's frames during
+    the flood stay >= 80 % of its frames in as long a quiet window, measured just before."""
+    from poinsot.app.load.flood import Flooder
+
+    app = make_app()
+    make_probe(app)
+    quiet_session = session_of(app)
+    assert wait_until(lambda: quiet_session.stats.frames > 30, 15)
+
+    def frames_in(seconds: float) -> int:
+        start = quiet_session.stats.frames
+        time.sleep(seconds)
+        return quiet_session.stats.frames - start
+
+    with Flooder(app.port, FLOOD_RATE, WINDOW, lifetime=120.0) as flooder:
+        assert len(app.sessions()) == 2
+        quiet = frames_in(WINDOW)
+        flooder.begin()
+        flooded = frames_in(WINDOW)
+        sent = flooder.end()
+    assert sent["sent"] > 2 * guard.MESSAGE_BURST
+    assert app.guard.dropped > guard.MESSAGE_BURST, (app.guard.dropped, sent)
+    assert app.guard.disconnected == 1 and sent["closed_by_server"], sent
+    assert wait_until(lambda: len(app.sessions()) == 1, 10)
+    assert quiet_session.stats.errors == 0
+    assert flooded >= 0.8 * quiet, (flooded, quiet, sent)
+
+
+# -- bounded: uploads --------------------------------------------------------------------------
+MB = 1_000_000
+
+
+def _peak_while(measure, action) -> int:
+    """The largest ``measure()`` seen while ``action()`` runs (polled from another thread)."""
+    peak, done = [0], threading.Event()
+
+    def poll() -> None:
+        while not done.is_set():
+            peak[0] = max(peak[0], measure())
+            time.sleep(0.005)
+
+    poller = threading.Thread(target=poll, daemon=True)
+    poller.start()
+    try:
+        action()
+    finally:
+        done.set()
+        poller.join()
+    return max(peak[0], measure())
+
+
+def test_pending_uploads_stay_bounded_and_are_freed_when_the_client_leaves(poinsot_app, probe):
+    """A raw client sends 200 MB of upload parts: ten transfers of 19 MB announced at once to
+    the mesh button, parts sent round robin, and parts "uploaded" to a slider. The parts held
+    stay within one client's pending cap (plus a part), and are freed when it leaves."""
+    session = session_of(poinsot_app)
+    probe.set_value(probe.widget("Preset")[0], MESH_BODY.label)
+    assert probe.wait_for(lambda p: MESH in p.labels(), 10)
+    guard_ = session.uploads.guard
+    button, _ = probe.widget(MESH)
+    slider, _ = probe.widget("Speed")
+    part = b"\0" * MB
+
+    def send_200_mb() -> None:
+        transfers = [f"t{k}" for k in range(10)]
+        for t in transfers:
+            probe.send(_messages.FileTransferStartUpload(button, t, f"{t}.stl", "x", 19, 19 * MB))
+        probe.send(_messages.FileTransferStartUpload(slider, "s", "s.stl", "x", 10, 10 * MB))
+        for k in range(19):
+            for t in transfers:
+                probe.send(_messages.FileTransferPart(button, t, k, part))
+        for k in range(9):  # the slider's, and the first transfer's last part, never come
+            probe.send(_messages.FileTransferPart(slider, "s", k, part))
+        probe.widget(MESH)  # the probe's own model: nothing to wait for on the server
+
+    peak = _peak_while(guard_.pending_bytes, send_200_mb)
+    states = session.client.gui._current_file_upload_states
+    assert wait_until(lambda: guard_.pending_bytes() == 19 * MB or not states, 20)
+    assert peak <= transfers_module.MAX_PENDING_BYTES + MB, peak
+    assert set(states) <= {"t0"}  # one transfer in progress at most, the first
+    assert poinsot_app.guard.dropped == 0  # within the message budget: the caps held it
+    probe.close()
+    assert wait_until(lambda: guard_.pending_bytes() == 0 and not states, 10)
+
+
+# -- bounded: trails, the plot, what a client may queue -----------------------------------------
+def test_a_client_cannot_lengthen_the_trails_beyond_their_cap(poinsot_app, probe):
+    """The trail length a client sends is clamped to the slider's top (the ring of chunks
+    itself holds its length: tests/app/test_parts.py)."""
+    session = session_of(poinsot_app)
+    probe.set_value(probe.widget("Trail length")[0], 10**12)
+    assert wait_until(lambda: session.scene.trail_points == TRAIL_RANGE[1], 10)
+    assert all(t.max_points == TRAIL_RANGE[1] for t in session.scene._trails.values())
+
+
+def test_the_plot_keeps_a_window_of_samples(poinsot_app):
+    motion = MotionWindow(poinsot_app.server.gui, order=0.0)
+    motion.add_plot()
+    for k in range(3 * PLOT_SAMPLES):
+        motion.record_plot(0.01 * k, np.array([1.0, 2.0, 3.0]))
+    assert motion.send_plot()
+    assert motion.plot is not None
+    assert all(len(series) == PLOT_SAMPLES for series in motion.plot.data)
+
+
+def test_what_a_client_gets_through_is_bounded_by_its_budget():
+    """The budget admits at most its burst at once and its rate after; a second within the
+    budget ends a streak of excess."""
+    budget = MessageBudget(rate=100.0, burst=50.0, excess_seconds=2.0)
+    t = time.monotonic()
+    admitted = sum(budget.admit(t) for _ in range(1000))  # 1000 at once
+    assert admitted == 50 and budget.dropped == 950 and not budget.sustained(t)
+    flood = [t + 0.001 * k for k in range(1, 3001)]  # 3 s at 1000 messages a second
+    admitted = sum(budget.admit(now) for now in flood)
+    assert admitted <= 100.0 * 3.0 + 1 and budget.sustained(flood[-1])
+    assert not budget.sustained(flood[-1] + 1.5)  # it paused
