@@ -17,7 +17,7 @@ queued (:meth:`Pacer.may_draw`): with more than MAX_IN_FLIGHT, or more than MAX_
 not acknowledged, the frame is skipped (the time
 shown jumps forward at the next one; the traces are filled from the exact solution) and the
 client's rate is halved; a frame taken on time lets the rate climb back to ``max_fps``. A
-client that reads nothing gets no new frames, so its queue holds at most MAX_IN_FLIGHT frames
+client that reads nothing gets no new frames, so its queue holds at most MAX_IN_FLIGHT + 1 frames
 however long it stalls, while the other sessions (each its own thread and queue) go on.
 
 Nothing here caps the server as a whole: with many clients on few cores, the frames simply
@@ -35,8 +35,11 @@ from typing import Any
 
 import viser
 
-#: Frames a client may have queued, not yet taken, before the next frame is skipped.
-MAX_IN_FLIGHT = 1
+#: Frames a client may have queued, not yet taken, before the next frame is skipped. 0: a
+#: frame is drawn only once the one before was taken; with 1, under a busy event loop, a
+#: third of the frames drawn were never seen (two frames taken together, the older pose
+#: replaced by the newer in viser's queue), work for nothing.
+MAX_IN_FLIGHT = 0
 #: Bytes written to a client but not yet acknowledged by it before the next frame is skipped
 #: (a few frames' worth; a client that keeps up has about one frame's bytes in flight).
 MAX_UNACKED = 32 * 1024
