@@ -138,7 +138,14 @@ def test_bad_input_keeps_the_last_scene_and_says_why(make_app, make_probe):
     model = showcase.showcase.model
     generation = session.generation
     uuid, _ = probe.widget("spin ω₃")
-    probe.set_value(uuid, 0.0)  # the slider stops at 0.5; a message from elsewhere may not
+    # From the wire, a value below the slider's range is clamped into it, as the browser would.
+    probe.set_value(uuid, 0.0)
+    assert wait_until(lambda: session.generation > generation, 10)
+    assert session.status == "" and showcase.showcase.model is not model
+    assert wait_until(lambda: showcase.showcase.settings["spin"] == 0.5, 10)
+    model, generation = showcase.showcase.model, session.generation
+    # A value the model refuses (here from the server's side) keeps the scene and says why.
+    session.configure_scene("spin", 0.0)
     assert wait_until(lambda: session.generation > generation, 10)
     assert "a gyroscope must spin" in session.status
     assert showcase.showcase.model is model  # the last valid scene is kept

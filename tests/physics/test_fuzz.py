@@ -122,7 +122,7 @@ def test_the_benchmark_counts_a_short_run(capsys: pytest.CaptureFixture[str]) ->
 
 
 def test_from_energy_with_the_default_omega_norm_passed_as_none_is_checked_cleanly() -> None:
-    # Case 67051 of seed 0: from_energy(..., omega_norm=None) builds a body with the default
+    # The fuzz's case 67051: from_energy(..., omega_norm=None) builds a body with the default
     # |ω0|; the check read float(None) and called the valid body unclean.
     o = case(67051, 0, list(TARGETS))
     assert o.target == "FreeRigidBody.from_energy" and "omega_norm=None" in o.call
