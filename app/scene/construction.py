@@ -325,6 +325,11 @@ class PoinsotScene:
         self._frame = frame
         return frame
 
+    @property
+    def traces_complete(self) -> bool:
+        """Every trace point drawn so far has been sent (none wait for the next flush)."""
+        return not self._pending
+
     def flush_trails(self) -> None:
         """Send the trace points gathered since the last flush."""
         if self._pending:
