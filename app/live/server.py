@@ -8,7 +8,7 @@ from collections.abc import Iterable
 
 import viser
 
-from poinsot.app.live.budget import FrameBudget
+from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.guard import WireGuard
 from poinsot.app.live.session import MAX_FPS, Session
 from poinsot.app.presets import DEFAULT_PRESET, Preset
@@ -44,7 +44,7 @@ class PoinsotApp:
         #: Sessions built for a client that had already left, closed before they started.
         self.discarded = 0
         self._connected = threading.Condition(self._lock)
-        self.budget = FrameBudget(max_fps=max_fps)
+        self.budget = RebuildGate()
         self.server = viser.ViserServer(host=host, port=port, verbose=verbose)
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
         self.server.scene.world_axes.visible = False
@@ -96,7 +96,6 @@ class PoinsotApp:
             else:
                 left = False
                 self._sessions[client.client_id] = session
-                self.budget.set_sessions(len(self._sessions))
                 session.start()
                 self._connected.notify_all()
         if left:
@@ -107,7 +106,6 @@ class PoinsotApp:
             session = self._sessions.pop(client.client_id, None)
             if session is None:  # its connect handler has not registered it (yet)
                 self._departed.add(client.client_id)
-            self.budget.set_sessions(len(self._sessions))
         if session is not None:
             session.close()
 

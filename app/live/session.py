@@ -21,7 +21,7 @@ import viser
 
 from poinsot.app.elements import ALL_ELEMENTS, Element, Solid
 from poinsot.app.live import readouts
-from poinsot.app.live.budget import FrameBudget
+from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.clock import SimClock
 from poinsot.app.live.ghost_controls import add_ghost_controls
 from poinsot.app.live.lecture import add_lecture_controls
@@ -65,15 +65,15 @@ class Session:
         *,
         max_fps: float = MAX_FPS,
         view: View = DEFAULT_VIEW,
-        budget: FrameBudget | None = None,
+        budget: RebuildGate | None = None,
         scene: SceneSpec | None = None,
     ) -> None:
-        """``budget``: the server's shared budget, through which a rebuild goes first (one per
+        """``budget``: the server's rebuild gate, through which a rebuild goes first (one per
         session if None); ``scene``: start with this scene (:mod:`poinsot.app.scenes`) instead
         of ``preset``. Frames: as many as the client takes, up to ``max_fps`` (:attr:`pacer`)."""
         self.client = client
         self.max_fps = float(max_fps)
-        self.budget = budget if budget is not None else FrameBudget(max_fps=max_fps)
+        self.budget = budget if budget is not None else RebuildGate()
         self.pacer = Pacer(Outbox(client), max_fps=self.max_fps)
         self.stats = SessionStats()
         self.clock = SimClock(speed=preset.speed)

@@ -342,24 +342,3 @@ def test_a_rebuild_holds_the_other_sessions_frames_for_a_bounded_time(probe, poi
     before = session.stats.frames
     time.sleep(0.5)
     assert session.stats.frames - before > held  # free again
-
-
-def test_frame_budget_shares_one_cpu_among_sessions():
-    from poinsot.app.live.budget import FrameBudget
-
-    budget = FrameBudget(max_fps=60, min_fps=10, share=0.5, recalibrate_seconds=0.0)
-    assert budget.fps == 60
-    budget._cost = 1e-3  # as if measured: 1 ms per client-frame
-    budget.set_sessions(1)
-    assert budget.fps == 60  # 1 client x 60 fps x 1 ms = 6 % of a CPU
-    budget.set_sessions(20)
-    assert budget.fps == pytest.approx(25)  # 0.5 CPU / (20 x 1 ms)
-    budget.set_sessions(200)
-    assert budget.fps == 10  # never below min_fps
-    budget.set_sessions(1)
-    start = time.process_time()
-    while time.process_time() - start < 0.05:
-        pass
-    for _ in range(20):
-        budget.frame_done()
-    assert budget.cost > 0.0 and budget.fps == 60
