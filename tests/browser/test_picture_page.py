@@ -301,7 +301,7 @@ def test_the_sphere_shows_omega_and_L_apart(poinsot_app, open_page):
     assert omega.sum() > 150 and momentum.sum() > 150, (omega.sum(), momentum.sum())
     # L's colour reaches higher on screen than ω's (L goes on above the plane).
     assert bounding_box(momentum)[1] < bounding_box(omega)[1] - 20
-    placed = session.lecture.display.lay_out_labels()
+    placed = lay_out_on_the_frame_thread(session)
     assert {"omega", "L"} <= placed.keys()
     assert not boxes_overlap(placed["omega"].box, placed["L"].box)
     assert page.errors == []
@@ -313,6 +313,22 @@ def boxes_overlap(a, b) -> bool:
 
 # -- 8. labels do not pile up ----------------------------------------------------------------
 LABEL_ELEMENTS = (Element.L, Element.OMEGA, Element.AXES, Element.POLHODE, Element.HERPOLHODE)
+
+
+def lay_out_on_the_frame_thread(session) -> dict:
+    """Lay the labels out now, on the session's own frame thread: the frame loop lays them out
+    too, and two layouts at once could mix one's anchor with the other's position."""
+    import threading
+
+    done, placed = threading.Event(), {}
+
+    def lay_out() -> None:
+        placed.update(session.lecture.display.lay_out_labels())
+        done.set()
+
+    session.post(lay_out)
+    assert done.wait(20), "the session never laid the labels out"
+    return placed
 
 
 def label_handles(session):
@@ -343,7 +359,7 @@ def test_labels_stand_apart_and_off_the_contact_point(poinsot_app, open_page, vi
         ),
         20,
     ), (view, camera_handle.position, camera_handle.look_at)
-    session.lecture.display.lay_out_labels()
+    lay_out_on_the_frame_thread(session)
     page.page.wait_for_timeout(800)
     shown = page.screenshot_rgb().astype(int)
     handles = label_handles(session)
