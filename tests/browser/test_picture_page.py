@@ -507,20 +507,39 @@ def test_two_views_show_the_body_frame_beside_the_space_frame(poinsot_app, open_
     session = started(poinsot_app, frames=40)
     page.set_checkbox("Two views: space | body", True)
     assert wait_until(lambda: session.lecture.display.body_view is not None, 10)
-    page.page.wait_for_timeout(2500)
     pause(page, session)
-    page.page.wait_for_timeout(800)
-    rgb, box = canvas_slice(page)
-    x0, x1 = int(box["x"]), int(box["x"] + box["width"])
-    middle = (x0 + x1) // 2
     look = session.scene.look
-    herpolhode, polhode = hue_mask(rgb, look.herpolhode), hue_mask(rgb, look.polhode)
-    # The translucent ellipsoid comes out a dim amber on the dark background.
-    ellipsoid = hue_mask(rgb, look.ellipsoid, tolerance=12.0, saturation=0.4, brightness=0.12)
-    left, right = slice(x0, middle), slice(middle, x1)
-    assert herpolhode[:, left].sum() > 100 and herpolhode[:, right].sum() < 20
-    assert polhode[:, left].sum() > 50 and polhode[:, right].sum() > 50
-    assert ellipsoid[:, right].sum() > 2000, ellipsoid[:, right].sum()
+
+    def halves() -> tuple[int, int, int, int, int]:
+        """Herpolhode left and right, polhode left and right, ellipsoid right [pixels]."""
+        rgb, box = canvas_slice(page)
+        x0, x1 = int(box["x"]), int(box["x"] + box["width"])
+        left, right = slice(x0, (x0 + x1) // 2), slice((x0 + x1) // 2, x1)
+        herpolhode, polhode = hue_mask(rgb, look.herpolhode), hue_mask(rgb, look.polhode)
+        # The translucent ellipsoid comes out a dim amber on the dark background.
+        ellipsoid = hue_mask(rgb, look.ellipsoid, tolerance=12.0, saturation=0.4, brightness=0.12)
+        return (
+            int(herpolhode[:, left].sum()),
+            int(herpolhode[:, right].sum()),
+            int(polhode[:, left].sum()),
+            int(polhode[:, right].sum()),
+            int(ellipsoid[:, right].sum()),
+        )
+
+    def both_drawn(h: tuple[int, int, int, int, int]) -> bool:
+        """The herpolhode in the space frame only (on the body side no more than stray pixels
+        of a like hue: a quarter of the space side's), polhode in both, the ellipsoid on the
+        right. While the single view gives way to the two, the herpolhode crosses the middle."""
+        return h[0] > 100 and h[1] < 0.25 * h[0] and h[2] > 50 and h[3] > 50 and h[4] > 2000
+
+    # A software-WebGL browser under load takes its time to draw the second view: poll.
+    seen = halves()
+    for _ in range(40):
+        if both_drawn(seen):
+            break
+        page.page.wait_for_timeout(500)
+        seen = halves()
+    assert both_drawn(seen), seen
     # The pictures' titles say which frame is which.
     assert session.lecture.display.body_view.titles[1].text.startswith("body frame")
     page.page.keyboard.press("v")  # key V: back to one view
