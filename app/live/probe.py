@@ -181,6 +181,18 @@ class Probe:
         self.send(_messages.GuiUpdateMessage(uuid, {"value": value}))
 
     # -- receiving -----------------------------------------------------------------------
+    def wait_frames(self, count: int, timeout: float = 60.0) -> bool:
+        """Wait until ``count`` more frames (poses of the body) have arrived."""
+        seen = threading.Semaphore(0)
+        self.add_listener(
+            lambda m, _t: (
+                seen.release()
+                if m["type"] == "SetOrientationMessage" and m.get("name") == "/space/body"
+                else None
+            )
+        )
+        return all(seen.acquire(timeout=timeout) for _ in range(count))
+
     def add_listener(self, listener: Callable[[dict[str, Any], float], None]) -> None:
         """``listener(message, arrival_time)`` for every decoded message (receiver thread)."""
         self._listeners.append(listener)

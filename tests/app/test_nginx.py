@@ -14,7 +14,6 @@ import re
 import shutil
 import socket
 import subprocess
-import threading
 import urllib.request
 from collections.abc import Iterator
 from pathlib import Path
@@ -111,18 +110,6 @@ def probe_from(source: str, port: int) -> Probe:
         return Probe(port)
 
 
-def _frames(probe: Probe, count: int) -> bool:
-    seen = threading.Semaphore(0)
-    probe.add_listener(
-        lambda m, _t: (
-            seen.release()
-            if m["type"] == "SetOrientationMessage" and m.get("name") == "/space/body"
-            else None
-        )
-    )
-    return all(seen.acquire(timeout=60) for _ in range(count))
-
-
 def _arrive(apps: list[PoinsotApp], source: str, port: int, probes: list[Probe]) -> int:
     """Connect a client from ``source``; the index of the server that got its session."""
     before = [len(app.sessions()) for app in apps]
@@ -142,7 +129,7 @@ def test_sessions_spread_over_servers_behind_nginx_and_stay_put(balancer):
         server_of = {source: _arrive(apps, source, port, probes) for source in SOURCES}
         assert set(server_of.values()) == {0, 1}, "every client reached the same server"
         for probe in probes:  # each session plays, on the one server that holds it
-            assert _frames(probe, 3), "a client behind nginx received no frames"
+            assert probe.wait_frames(3), "a client behind nginx received no frames"
         counts = [len(app.sessions()) for app in apps]
         assert counts == [list(server_of.values()).count(i) for i in (0, 1)]
         for probe in probes:

@@ -148,19 +148,6 @@ def _running(pid: int) -> bool:
     return state != "Z"
 
 
-def _frames(probe: Probe, count: int) -> bool:
-    """Wait until ``probe`` has received ``count`` more frames (poses of the body)."""
-    seen = threading.Semaphore(0)
-    probe.add_listener(
-        lambda m, _t: (
-            seen.release()
-            if m["type"] == "SetOrientationMessage" and m.get("name") == "/space/body"
-            else None
-        )
-    )
-    return all(seen.acquire(timeout=60) for _ in range(count))
-
-
 @pytest.mark.slow
 def test_landing_sends_new_browsers_to_the_least_loaded_worker(classroom: Classroom):
     first, second = classroom.worker_ports
@@ -176,7 +163,7 @@ def test_landing_sends_new_browsers_to_the_least_loaded_worker(classroom: Classr
             assert wait_until(lambda e=expected: classroom.clients() == e, 60), classroom.clients()
         assert arrived == [second, second, first, second]
         for probe in probes:  # each session lives on its worker and plays
-            assert _frames(probe, 3), "a client received no frames"
+            assert probe.wait_frames(3), "a client received no frames"
     finally:
         for probe in probes:
             probe.close()
