@@ -15,6 +15,7 @@ time, readouts and the plot of ω are in the floating "Motion" window
 
 from __future__ import annotations
 
+import asyncio
 import dataclasses
 import math
 from collections.abc import Callable, Iterable
@@ -33,6 +34,7 @@ from poinsot.app.live.widgets import (
     on_user,
     set_marks,
     set_value,
+    write_unless_newer,
 )
 from poinsot.app.parameters import (
     INERTIA_RANGE,
@@ -171,7 +173,11 @@ class ControlPanel:
             self.source = gui.add_markdown(self._source_text(preset))
             self.status = gui.add_markdown("")
         self.motion = MotionWindow(gui, order=_ORDER["readouts"])
-        self._on_user(self.preset, self._choose_preset)
+        #: The browser's choices in the menu (a preset shown for an older one is not written
+        #: over a newer one: :meth:`show_preset`).
+        self.menu = Sent(preset.label)
+        self._loop: asyncio.AbstractEventLoop = gui._event_loop  # viser's; runs the menu's writes
+        on_user(self.preset, self._choose_preset, self.actions.report, self.menu)
 
     def _on_user(self, handle: H, callback: Callable[[Sent], None]) -> H:
         """Run ``callback(sent)`` for changes made in the browser only (:func:`on_user`)."""
@@ -438,8 +444,10 @@ class ControlPanel:
         return lambda handle: self.actions.set_visible(element, bool(handle.value))
 
     # -- mirroring the session's state ---------------------------------------------------
-    def show_preset(self, preset: Preset) -> None:
-        set_value(self.preset, preset.label)
+    def show_preset(self, preset: Preset, menu_count: int | None = None) -> None:
+        """Show ``preset`` as the scene's source; in the menu too, unless the browser has chosen
+        again since ``menu_count`` (``menu.count`` read when the change was asked for)."""
+        write_unless_newer(self.preset, preset.label, self.menu, menu_count, self._loop)
         self.source.content = self._source_text(preset)
         self.motion.legend.show_caption(caption(preset))
 

@@ -145,8 +145,11 @@ class Session:
         self._actions.put(action)
         self._wake.set()
 
+    # A change asked for reads the count of the browser's menu choices, so that the menu is
+    # not set back to what it showed then if the user has chosen again since (Panel.show_preset).
     def choose_preset(self, preset: Preset) -> None:
-        self._post(lambda: self._apply_preset(preset))
+        count = self.panel.menu.count
+        self._post(lambda: self._apply_preset(preset, count))
 
     @functools.cached_property
     def uploads(self) -> UploadControls:
@@ -158,7 +161,8 @@ class Session:
         self._post(action)
 
     def choose_scene(self, scene: SceneSpec) -> None:
-        self._post(lambda: self._apply_scene(scene))
+        count = self.panel.menu.count
+        self._post(lambda: self._apply_scene(scene, count))
 
     def configure_scene(self, key: str, value: Value) -> None:
         """A control of the current scene moved."""
@@ -177,7 +181,8 @@ class Session:
         self._post(action)
 
     def edit(self, change: Callable[[Parameters], Parameters]) -> None:
-        self._post(lambda: self._edit(change))
+        count = self.panel.menu.count
+        self._post(lambda: self._edit(change, count))
 
     def set_speed(self, speed: float) -> None:
         speed = min(max(float(speed), self.speed_range[0]), self.speed_range[1])
@@ -330,7 +335,7 @@ class Session:
         self.status = message
         self.panel.show_status(message)
 
-    def _apply_preset(self, preset: Preset) -> None:
+    def _apply_preset(self, preset: Preset, menu_count: int | None = None) -> None:
         # The menu's "Fitted toss" and "Body from a mesh": this session's own, if it has one.
         preset = self.uploads.resolve(preset)
         self._leave_scene()
@@ -352,10 +357,10 @@ class Session:
             self.scene.trail_points,
             self.scene.is_visible,
         )
-        self.panel.show_preset(preset)
+        self.panel.show_preset(preset, menu_count)
         self._show_playback()
 
-    def _apply_scene(self, scene: SceneSpec) -> None:
+    def _apply_scene(self, scene: SceneSpec, menu_count: int | None = None) -> None:
         """Show ``scene``: the construction's elements it declares, the panel's groups it shares
         (speed, playback, trail, show/hide), and its own controls, parts, readouts and plots."""
         self._leave_scene()
@@ -375,7 +380,7 @@ class Session:
             self.scene.trail_points,
             self.scene.is_visible,
         )
-        self.panel.show_preset(self.preset)
+        self.panel.show_preset(self.preset, menu_count)
         self._show_playback()
         scene.view.apply(self.client.camera)
         self._dirty = True
@@ -399,7 +404,9 @@ class Session:
                 ghost.configure(enabled=False)
             ghost.folder.visible = self.body is not None
 
-    def _edit(self, change: Callable[[Parameters], Parameters]) -> None:
+    def _edit(
+        self, change: Callable[[Parameters], Parameters], menu_count: int | None = None
+    ) -> None:
         new = change(self._desired)
         if new == self._desired:
             return
@@ -419,7 +426,7 @@ class Session:
                 self.scene.trail_points,
                 self.scene.is_visible,
             )
-            self.panel.show_preset(CUSTOM)
+            self.panel.show_preset(CUSTOM, menu_count)
 
     def _solid(self, params: Parameters) -> Solid | None:
         """The base preset's solid while the moments are still the preset's, otherwise the

@@ -116,12 +116,41 @@ class Sent:
     """The value a browser last sent for one widget, recorded on viser's event loop as its
     message arrives. A callback runs later on a worker thread; by then the server may have
     written the widget again (a preset shown, a slider snapped), and ``handle.value`` would
-    hand it the server's stale value instead of the user's choice. ``Sent`` never does."""
+    hand it the server's stale value instead of the user's choice. ``Sent`` never does.
+    ``count`` is the number of values the browser has sent (see :meth:`newer_than`)."""
 
-    __slots__ = ("value",)
+    __slots__ = ("count", "value")
 
     def __init__(self, value: Any) -> None:
         self.value = value
+        self.count = 0
+
+    def newer_than(self, count: int | None) -> bool:
+        """True if the browser has sent a value since ``count`` was read: a server write meant
+        for the state of then would overwrite a newer choice, still on its way to the frame
+        thread (and viser, comparing the browser's next message with that stale value, could
+        drop it as "unchanged")."""
+        return count is not None and self.count != count
+
+
+def write_unless_newer(
+    handle: Any, value: Any, sent: Sent, count: int | None, loop: asyncio.AbstractEventLoop
+) -> None:
+    """Write ``value`` into a widget the browser writes too (from any thread), unless the
+    browser has chosen again: since ``count`` was read (``sent.count``, when the change being
+    shown was asked for), or so lately that its callbacks have not yet recorded it. viser
+    stores a browser's value in the handle on its event loop, then runs the callbacks; a write
+    from another thread landing in between would replace the user's value, and viser, finding
+    the user's next message "unchanged", could drop it. So the check and the write run on the
+    event loop, where nothing lands between them."""
+
+    def write() -> None:
+        if sent.newer_than(count) or handle.value != sent.value:
+            return  # the newer choice is on its way to the frame thread; it is shown then
+        set_value(handle, value)
+        sent.value = value
+
+    loop.call_soon_threadsafe(write)
 
 
 class Refused(ValueError):
@@ -183,11 +212,15 @@ def _accepted(handle: Any, sent: Sent, last: Sent) -> bool:
     if value != handle.value:
         handle.value = value  # the browser shows the clamped value
     sent.value = last.value = value
+    sent.count += 1
     return True
 
 
 def on_user(
-    handle: Any, callback: Callable[[Sent], None], report: Callable[[Exception], None]
+    handle: Any,
+    callback: Callable[[Sent], None],
+    report: Callable[[Exception], None],
+    sent: Sent | None = None,
 ) -> Any:
     """Run ``callback(sent)`` for changes made in a browser only (a value set by the server
     fires the same viser callbacks, with no client). The callback runs on a worker thread,
@@ -197,8 +230,9 @@ def on_user(
     Nothing a client sends is trusted: a value is first :func:`checked` against the widget, as
     the browser would (a number clamped into the slider's range, an option among the options);
     a value no widget could send (NaN, an option not offered) never reaches the callback, and
-    the widget shows its last valid value again."""
-    sent = Sent(getattr(handle, "value", None))
+    the widget shows its last valid value again. ``sent``: the record to keep the browser's
+    values in (one is made if not given)."""
+    sent = Sent(getattr(handle, "value", None)) if sent is None else sent
     last = Sent(sent.value)  # the last valid value, the server's or the browser's
 
     def run() -> None:

@@ -5,6 +5,8 @@ the labels' layout keeps boxes apart."""
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 import pytest
 from conftest import session_of, wait_until
@@ -116,7 +118,8 @@ def test_switching_sphere_and_custom_deletes_no_panel_widget(poinsot_app, probe)
     for _ in range(4):
         for preset in (preset_by_key("sphere"), CUSTOM):
             probe.set_value(uuid, preset.label)
-            assert wait_until(lambda p=preset: session.preset is p, 10)
+            shown = (session.preset.key, session.panel.preset.value)
+            assert wait_until(lambda p=preset: session.preset is p, 10), shown
     assert probe.wait_for(lambda p: "D = |L|²/2T" in p.labels(), 10)
     assert removed == []
     assert session.stats.errors == 0, session.stats.last_error
@@ -153,6 +156,43 @@ def test_a_callback_reads_the_users_value_not_a_later_server_write(make_probe):
             release.set()
             assert wait_until(lambda: seen != [], 10)
         assert seen == ["Custom"] and errors == []
+    finally:
+        server.stop()
+
+
+def test_a_preset_shown_late_does_not_overwrite_the_users_newer_choice():
+    """The menu shows the preset being applied, unless the browser has chosen again: a choice
+    recorded since the change was asked for (its count moved on), or one viser has stored in
+    the handle whose callbacks have not yet recorded it. Overwriting the latter, the callback
+    read the server's value, and viser dropped the user's next choice as "unchanged"."""
+    import viser
+
+    from poinsot.app.live.widgets import Sent, on_user, write_unless_newer
+
+    server = viser.ViserServer("127.0.0.1", 0, verbose=False)
+    try:
+        loop = server.get_event_loop()
+        options = ("Sphere", "Custom", "Major")
+        dropdown = server.gui.add_dropdown("Preset", options, initial_value="Sphere")
+        menu, errors = Sent("Sphere"), []
+        on_user(dropdown, lambda _sent: None, errors.append, menu)
+
+        def written(value, count):
+            write_unless_newer(dropdown, value, menu, count, loop)
+            done = threading.Event()
+            loop.call_soon_threadsafe(done.set)  # after the write, on the same loop
+            assert done.wait(10)
+
+        written("Custom", menu.count)  # nothing newer: shown
+        assert dropdown.value == "Custom" and menu.value == "Custom"
+        count = menu.count
+        menu.count += 1  # the browser chose again since (recorded)
+        written("Major", count)
+        assert dropdown.value == "Custom"
+        dropdown._impl.value = "Sphere"  # stored by viser, not yet recorded by the callback
+        written("Major", menu.count)
+        assert dropdown._impl.value == "Sphere"
+        assert errors == []
     finally:
         server.stop()
 
