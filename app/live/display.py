@@ -37,12 +37,17 @@ from poinsot.app.scene.view import DEFAULT_VIEW, View, configure_theme
 LARGE_TEXT_PERCENT = 130
 #: ... and of the projector mode.
 PROJECTOR_TEXT_PERCENT = 150
-#: Labels are laid out this often [Hz] (their boxes ride on their frames in between; a
-#: layout costs about a millisecond), and only when the camera or the time has changed; and
-#: at most every LABEL_MIN_FRAMES frames, so that a client whose frame rate is lowered (a busy
-#: server, a slow browser) gets fewer layouts too: at most a fifth of its frames carry one.
+#: Labels are laid out this often [Hz] while the browser's camera moves (the user turns the
+#: view: the boxes follow it), at most every LABEL_MIN_FRAMES frames; under a still camera,
+#: when only the time runs, LABEL_STILL_HZ and every LABEL_STILL_FRAMES frames at most (the boxes
+#: ride on their frames in between: only their anchors wait for the next layout); never for
+#: the same camera and time. A layout costs about a millisecond, so a client whose frame rate
+#: is lowered (a busy server, a slow browser) gets fewer layouts too: at most a fifth of its
+#: frames carry one while its camera moves, a thirtieth otherwise.
 LABEL_HZ = 6.0
 LABEL_MIN_FRAMES = 5
+LABEL_STILL_HZ = 2.0
+LABEL_STILL_FRAMES = 30
 #: The two-view camera: from the front (x runs across the screen, the body frame's picture on
 #: the right), this high above the plane [degrees] and this far from the middle between the
 #: pictures [display units].
@@ -107,6 +112,11 @@ def browser_camera(client: viser.ClientHandle) -> Camera | None:
     )
 
 
+def _camera_key(camera: Camera) -> tuple[float, ...]:
+    """What a layout depends on of the camera."""
+    return (*camera.position, *camera.look_at, *camera.up, camera.fov, camera.width)
+
+
 class Display:
     """The look of one session's picture (see the module's docstring)."""
 
@@ -121,9 +131,9 @@ class Display:
         self._wanted = Style()
         self._lock = threading.Lock()
         self.body_view: BodyView | None = None
-        self._next_layout = 0.0
-        self._frames_since_layout = LABEL_MIN_FRAMES
-        self._laid_out: tuple | None = None  # (camera, time) of the last layout
+        self._last_layout = -math.inf  # monotonic time of the last layout
+        self._frames_since_layout = LABEL_STILL_FRAMES
+        self._laid_out: tuple = (None,)  # (*camera, time) of the last layout
 
     # -- wishes (any thread) ---------------------------------------------------------------
     def request(self, **changes: bool) -> None:
@@ -149,18 +159,27 @@ class Display:
                 view.fit(scene.geometry, self._attitude0(frame))
             view.advance(frame)
         self._frames_since_layout += 1
-        if now >= self._next_layout and self._frames_since_layout >= LABEL_MIN_FRAMES:
-            self._next_layout = now + 1.0 / LABEL_HZ
-            self._frames_since_layout = 0
-            self.lay_out_labels(None if frame is None else frame.t)
-
-    def lay_out_labels(self, t: float | None = None) -> dict:
-        """Lay the labels out for the browser's camera (not again for the same camera and
-        time ``t``, when given: a paused, unmoved picture)."""
+        if now < self._last_layout + 1.0 / LABEL_HZ or self._frames_since_layout < LABEL_MIN_FRAMES:
+            return
         camera = browser_camera(self.client)
+        if camera is None:
+            return
+        if _camera_key(camera) == self._laid_out[:-1] and (
+            now < self._last_layout + 1.0 / LABEL_STILL_HZ
+            or self._frames_since_layout < LABEL_STILL_FRAMES
+        ):
+            return  # a still camera: the next layout for the time alone comes later
+        if self.lay_out_labels(None if frame is None else frame.t, camera):
+            self._last_layout = now
+            self._frames_since_layout = 0
+
+    def lay_out_labels(self, t: float | None = None, camera: Camera | None = None) -> dict:
+        """Lay the labels out for the browser's camera (or ``camera``), not again for the same
+        camera and time ``t``, when given (a paused, unmoved picture)."""
+        camera = browser_camera(self.client) if camera is None else camera
         if camera is None or not all(math.isfinite(v) for v in camera.position):
             return {}
-        key = (*camera.position, *camera.look_at, *camera.up, camera.fov, camera.width, t)
+        key = (*_camera_key(camera), t)
         if t is not None and key == self._laid_out:
             return {}
         self._laid_out = key

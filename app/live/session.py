@@ -248,6 +248,7 @@ class Session:
                 self._drain()
                 if self._dirty:
                     self._rebuild()
+                    self.client.flush()
                 now = time.monotonic()
                 if now >= next_frame and self.budget.rebuilding and now - due < HOLD_SECONDS:
                     next_frame = now + YIELD_SECONDS  # a slider move elsewhere goes first
@@ -270,6 +271,7 @@ class Session:
         with self.client.atomic():
             self._advance()
             self._refresh(now)
+        self.client.flush()  # out now, not at viser's next 1/60 s window
         self.pacer.sent()
         return True
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import viser
 
-from poinsot.app.scene import meshes, palette
+from poinsot.app.scene import meshes, palette, updates
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.frames import rotation_from_wxyz, wxyz
 from poinsot.app.scene.geometry import (
@@ -148,12 +148,13 @@ class BodyView:
         if geometry is None:
             return
         tip = np.asarray(frame.omega, dtype=np.float64) * geometry.scale
-        self.omega.points = np.array([[[0.0, 0.0, 0.0], tip]], np.float32)
-        self.tip.position = tip
+        updates.set_points(self.omega, np.array([[[0.0, 0.0, 0.0], tip]], np.float32))
+        updates.set_position(self.tip, tip)
         inverse = rotation_from_wxyz(frame.wxyz).inv()
-        self.space.wxyz = wxyz(inverse)
+        updates.set_wxyz(self.space, wxyz(inverse))
         # The plane's patch round the contact point: in the turned frame, at height h.
-        self.patch.position = (*inverse.inv().apply(tip)[:2], geometry.plane_height)
+        patch = inverse.inv().apply(tip)
+        updates.set_position(self.patch, np.array([patch[0], patch[1], geometry.plane_height]))
 
     def restyle(self, look: Look) -> None:
         self.ellipsoid.color, self.ellipsoid.opacity = look.ellipsoid, look.ellipsoid_opacity

@@ -37,7 +37,7 @@ import numpy as np
 import viser
 
 from poinsot.app.elements import Element, Solid
-from poinsot.app.scene import palette
+from poinsot.app.scene import palette, updates
 from poinsot.app.scene.batch import Frame, FrameBatch
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.geometry import L_OVERSHOOT, Geometry
@@ -312,10 +312,10 @@ class PoinsotScene:
                 trail.clear()
             self._pending.clear()
         frame = batch.frame(i, j)
-        self.body_frame.wxyz = frame.wxyz
-        self.tip.position = frame.contact
+        updates.set_wxyz(self.body_frame, frame.wxyz)
+        updates.set_position(self.tip, frame.contact)
         if self._omega_arrow is not None:
-            self._omega_arrow.points = batch.arrow[j]
+            updates.set_points(self._omega_arrow, batch.arrow[j])
         if self._trails:
             self._pending.append((batch, i, j + 1, restart))
         self._frames_since_flush += 1

@@ -41,7 +41,7 @@ import numpy as np
 import viser
 import viser.uplot
 
-from poinsot.app.scene import meshes, palette
+from poinsot.app.scene import meshes, palette, updates
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.frames import rotation_from_wxyz, wxyz_from_xyzw, xyzw_from_wxyz
 from poinsot.app.scene.geometry import Geometry, triple
@@ -265,8 +265,8 @@ class GhostCage:
         self.rings.points = principal_sections(semi * GHOST_INFLATE, GHOST_RING_SEGMENTS)
 
     def pose(self, wxyz: np.ndarray, tip: tuple[float, float, float]) -> None:
-        self.node.wxyz = wxyz
-        self.tip.position = tip
+        updates.set_wxyz(self.node, wxyz)
+        updates.set_position(self.tip, np.asarray(tip))
 
     def remove(self) -> None:
         for handle in (self.shell, self.axes, self.rings, self.tip, self.node):

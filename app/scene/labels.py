@@ -33,6 +33,8 @@ import numpy as np
 import viser
 from scipy.spatial.transform import Rotation
 
+from poinsot.app.scene import updates
+
 #: CSS pixels of a label's em at font scale 1 (viser's screen-size labels).
 EM_PX = 12.0
 #: A label box: the line height and the padding of viser's label, in ems, and the mean
@@ -427,7 +429,7 @@ class LabelNode:
             position = np.asarray(base, float) + offset
             if np.max(np.abs(position - self.position)) > POSITION_TOLERANCE:
                 self.position = position
-                self.handle.position = position
+                updates.set_position(self.handle, position)
 
 
 def screen_right_in_plane(pose: Pose) -> np.ndarray:
