@@ -10,7 +10,7 @@ comparison and with one copy:
 
 - :func:`set_wxyz` and :func:`set_position`: a node's pose (``SetOrientationMessage``,
   ``SetPositionMessage``);
-- :func:`set_points`: a line-segments node's ``points`` (``SceneNodeUpdateMessage``).
+- :func:`set_points`: a line-segments or arrows node's ``points`` (``SceneNodeUpdateMessage``).
 
 They use viser 1.1's handle internals (the handle's ``_impl`` and its scene API's
 ``_queue_scene_message``), kept in this one module. ``tests/app/test_updates.py`` checks that
@@ -52,8 +52,8 @@ def set_position(handle: viser.SceneNodeHandle, position: np.ndarray) -> None:
     impl.api._queue_scene_message(_messages.SetPositionMessage(impl.name, value))
 
 
-def set_points(handle: viser.LineSegmentsHandle, points: np.ndarray) -> None:
-    """Set a line-segments node's segments, shape (N, 2, 3) (cast to float32)."""
+def set_points(handle: viser.LineSegmentsHandle | viser.ArrowsHandle, points: np.ndarray) -> None:
+    """Set a line-segments or arrows node's segments, shape (N, 2, 3) (cast to float32)."""
     impl = _impl(handle)
     value = np.array(points, dtype=np.float32)  # the message's own copy
     stored = impl.props.points

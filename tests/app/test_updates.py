@@ -74,13 +74,13 @@ def test_a_pose_write_matches_the_setter(
     assert getattr(handle, name) is handle_value  # stored in place, as the setter does
 
 
+@pytest.mark.parametrize("kind", ["line_segments", "arrows"])
 @pytest.mark.parametrize("segments", [3, 5])
 def test_a_points_write_matches_the_setter(
-    monkeypatch: pytest.MonkeyPatch, server: viser.ViserServer, segments: int
+    monkeypatch: pytest.MonkeyPatch, server: viser.ViserServer, segments: int, kind: str
 ) -> None:
-    handle = server.scene.add_line_segments(
-        f"/points_{segments}", np.zeros((3, 2, 3), np.float32), (255, 0, 0)
-    )
+    add = getattr(server.scene, f"add_{kind}")
+    handle = add(f"/{kind}_{segments}", np.zeros((3, 2, 3), np.float32), (255, 0, 0))
     value = np.random.default_rng(segments).normal(size=(segments, 2, 3))  # float64 in
     (by_setter,) = _recorded(monkeypatch, server, _set(handle, "points", value))
     state = handle.points.copy()
