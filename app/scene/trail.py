@@ -19,8 +19,6 @@ import collections
 import numpy as np
 import viser
 
-from poinsot.app.scene import updates
-
 #: Segments per chunk: the most a frame resends (24 segments x 2 x 3 float32 = 576 bytes).
 CHUNK_SEGMENTS = 24
 #: Spare chunks kept for reuse (a shorter trail removes the rest).
@@ -158,7 +156,7 @@ class Trail:
     def _send_head(self) -> None:
         if self._head is None and self._spare:
             self._head = self._spare.pop()
-            updates.set_points(self._head, self._buffer[: self._n])
+            self._head.points = self._buffer[: self._n]
         elif self._head is None:
             self._counter += 1
             self._head = self._api.add_line_segments(
@@ -170,7 +168,7 @@ class Trail:
                 scale=self._scale,
             )
         else:
-            updates.set_points(self._head, self._buffer[: self._n])  # sent as a copy
+            self._head.points = self._buffer[: self._n]  # a points update casts (copies)
 
     def _freeze_head(self) -> None:
         if self._head is not None:

@@ -12,6 +12,12 @@ comparison and with one copy:
   ``SetPositionMessage``);
 - :func:`set_points`: a line-segments or arrows node's ``points`` (``SceneNodeUpdateMessage``).
 
+Making a node costs viser 0.3-0.5 ms, most of it ``typing.get_type_hints`` on the node's
+properties class, looked up anew for every handle (a ``functools.cached_property`` of the
+instance, whose first computation also takes a lock shared by every handle). The hints depend
+on the class alone: :func:`cache_property_hints` (run when this module is imported) keeps them
+per class, and a trail's new chunk or a label costs a third.
+
 They use viser 1.1's handle internals (the handle's ``_impl`` and its scene API's
 ``_queue_scene_message``), kept in this one module. ``tests/app/test_updates.py`` checks that
 each one leaves the handle and the queued message exactly as the public setter does, so a viser
@@ -22,11 +28,13 @@ colour, a style) keep using the setters.
 
 from __future__ import annotations
 
+import functools
+import typing
 from typing import Any
 
 import numpy as np
 import viser
-from viser import _messages
+from viser import _assignable_props_api, _messages
 
 
 def _impl(handle: viser.SceneNodeHandle) -> Any:
@@ -62,3 +70,23 @@ def set_points(handle: viser.LineSegmentsHandle | viser.ArrowsHandle, points: np
     else:
         impl.props.points = value.copy()
     impl.api._queue_scene_message(_messages.SceneNodeUpdateMessage(impl.name, {"points": value}))
+
+
+@functools.cache
+def _hints(props_class: Any) -> dict[str, Any]:
+    return typing.get_type_hints(props_class)
+
+
+def cache_property_hints() -> None:
+    """Make viser look a handle's property type hints up once per properties class, not once
+    per handle (viser only reads them). Idempotent."""
+    base: Any = _assignable_props_api.AssignablePropsBase
+    base._prop_hints = property(_prop_hints)  # a plain property: no per-instance lock either
+
+
+def _prop_hints(handle: Any) -> dict[str, Any]:
+    props_class: Any = type(handle._impl.props)
+    return _hints(props_class)
+
+
+cache_property_hints()

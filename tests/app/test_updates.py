@@ -106,3 +106,21 @@ def test_a_write_to_a_removed_node_is_refused(server: viser.ViserServer) -> None
         updates.set_position(frame, np.zeros(3))
     with pytest.raises(RuntimeError, match="removed"):
         updates.set_points(lines, np.zeros((1, 2, 3)))
+
+
+def test_property_hints_are_looked_up_once_per_class(server: viser.ViserServer) -> None:
+    """Handles of one kind share their properties' type hints, equal to what viser computes."""
+    import typing
+
+    from viser import _assignable_props_api
+
+    base = _assignable_props_api.AssignablePropsBase
+    assert base.__dict__["_prop_hints"].fget is updates._prop_hints
+    a = server.scene.add_label("/hints_a", "a")
+    b = server.scene.add_label("/hints_b", "b")
+    lines = server.scene.add_line_segments("/hints_c", np.zeros((1, 2, 3)), (0, 0, 0))
+    assert a._prop_hints is b._prop_hints
+    assert a._prop_hints == typing.get_type_hints(type(a._impl.props))
+    assert lines._prop_hints == typing.get_type_hints(type(lines._impl.props))
+    updates.cache_property_hints()  # again: no change
+    assert base.__dict__["_prop_hints"].fget is updates._prop_hints
