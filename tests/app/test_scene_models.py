@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import pathlib
 import re
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -15,7 +16,10 @@ from poinsot.app.cli import build_parser
 from poinsot.app.elements import Control
 from poinsot.app.exports.html import scene_html
 from poinsot.app.exports.screenshot import resolve_scene
+from poinsot.app.exports.stage import ServedStage, Stage
+from poinsot.app.live.probe import Probe
 from poinsot.app.presets import MENU, preset_by_key
+from poinsot.app.scene import palette
 from poinsot.app.scene.geometry import SceneDataError
 from poinsot.app.scenes import (
     SCENES,
@@ -205,6 +209,43 @@ def test_the_offline_stage_draws_each_scene(spec):
         frame = stage.seek(min(spec.picture_time, 6.0))
         assert np.all(np.isfinite(frame.wxyz)) and np.all(np.isfinite(frame.omega))
         assert frame.t == pytest.approx(min(spec.picture_time, 6.0), abs=0.06)
+
+
+#: Nodes of the construction whose colour the theme changes, and the colour each takes.
+THEMED: dict[str, Callable[[palette.Look], palette.RGB]] = {
+    "/space/body/ellipsoid": lambda look: look.ellipsoid,
+    "/space/body/axis1": lambda look: look.axes[0],
+    "/space/tip/contact": lambda look: look.contact,
+    "/space/plane/rim": lambda look: look.plane_rim,
+    "/space/omega": lambda look: look.omega,
+}
+
+
+def sent_colours(probe: Probe) -> dict[str, palette.RGB | None]:
+    """The colour the browser was sent for each of :data:`THEMED` (None: no such node yet)."""
+    out: dict[str, palette.RGB | None] = {}
+    for name in THEMED:
+        node = probe.nodes.get(name)
+        props = {} if node is None else node.props
+        rgb = [int(c) for c in np.ravel(props.get("color", props.get("colors", ())))[:3]]
+        out[name] = (rgb[0], rgb[1], rgb[2]) if len(rgb) == 3 else None
+    return out
+
+
+@pytest.mark.parametrize("dark", [True, False], ids=["dark", "light"])
+@pytest.mark.parametrize("stage_of", ["preset", "scene"])
+def test_both_stages_draw_the_construction_in_the_themes_colours(stage_of, dark):
+    """The offline stages (screenshot, HTML export) colour the construction as the app does on
+    the same theme: a preset's stage and a scene's alike."""
+    if stage_of == "preset":
+        stage: ServedStage = Stage.from_preset(preset_by_key("major"), dark_mode=dark)
+    else:
+        stage = SceneStage(scene_by_name("dzhanibekov"), dark_mode=dark)
+    look = palette.look(dark)
+    wanted = {name: colour(look) for name, colour in THEMED.items()}
+    assert look is (palette.DARK if dark else palette.LIGHT)
+    with stage, Probe(stage.server.get_port()) as probe:
+        assert probe.wait_for(lambda p: sent_colours(p) == wanted, 20), sent_colours(probe)
 
 
 def test_export_html_and_the_command_line_take_a_scene(tmp_path):
