@@ -49,52 +49,52 @@ def _number(text: str, kind: type[int] | type[float]) -> float:
     return value
 
 
+def in_bounds(
+    text: str,
+    kind: type[int] | type[float],
+    low: float,
+    high: float = math.inf,
+    *,
+    open_low: bool = False,
+    wanted: str,
+) -> float:
+    """``text`` as a finite ``kind`` in [low, high] (or (low, high] with ``open_low``); else
+    :class:`argparse.ArgumentTypeError` ``'<text>': <wanted>``. Every numeric converter is one
+    call of this."""
+    value = _number(text, kind)
+    if value > high or value < low or (open_low and value == low):
+        raise argparse.ArgumentTypeError(f"{text!r}: {wanted}")
+    return value
+
+
 def positive_int(text: str) -> int:
     """A whole number >= 1."""
-    value = int(_number(text, int))
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r}: give a whole number >= 1")
-    return value
+    return int(in_bounds(text, int, 1, wanted="give a whole number >= 1"))
 
 
 def port_number(text: str) -> int:
     """A TCP port: a whole number from 0 (any free port) to 65535."""
-    value = int(_number(text, int))
-    if not 0 <= value <= 65535:
-        raise argparse.ArgumentTypeError(f"{text!r}: a port is a whole number from 0 to 65535")
-    return value
+    return int(in_bounds(text, int, 0, 65535, wanted="a port is a whole number from 0 to 65535"))
 
 
 def non_negative_int(text: str) -> int:
     """A whole number >= 0."""
-    value = int(_number(text, int))
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{text!r}: give a whole number >= 0")
-    return value
+    return int(in_bounds(text, int, 0, wanted="give a whole number >= 0"))
 
 
 def positive_float(text: str) -> float:
     """A finite number > 0."""
-    value = float(_number(text, float))
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"{text!r}: give a finite number > 0")
-    return value
+    return float(in_bounds(text, float, 0, open_low=True, wanted="give a finite number > 0"))
 
 
 def non_negative_float(text: str) -> float:
     """A finite number >= 0."""
-    value = float(_number(text, float))
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{text!r}: give a finite number >= 0")
-    return value
+    return float(in_bounds(text, float, 0, wanted="give a finite number >= 0"))
 
 
 def fraction(text: str) -> float:
     """A number between 0 and 1 (a share, a tolerance)."""
-    value = float(_number(text, float))
-    if not 0 <= value <= 1:
-        raise argparse.ArgumentTypeError(f"{text!r}: give a number between 0 and 1")
-    return value
+    return float(in_bounds(text, float, 0, 1, wanted="give a number between 0 and 1"))
 
 
 def bounded_float(low: float, high: float, *, open_low: bool = False) -> Callable[[str], float]:
@@ -102,10 +102,8 @@ def bounded_float(low: float, high: float, *, open_low: bool = False) -> Callabl
     shown = f"{'(' if open_low else '['}{low:g}, {high:g}]"
 
     def convert(text: str) -> float:
-        value = float(_number(text, float))
-        if value > high or value < low or (open_low and value == low):
-            raise argparse.ArgumentTypeError(f"{text!r}: give a number in {shown}")
-        return value
+        wanted = f"give a number in {shown}"
+        return float(in_bounds(text, float, low, high, open_low=open_low, wanted=wanted))
 
     convert.__name__ = f"number in {shown}"  # argparse names the type in some messages
     return convert

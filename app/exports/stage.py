@@ -53,6 +53,16 @@ def open_server(host: str, port: int, dark_mode: bool) -> viser.ViserServer:
     return server
 
 
+def themed_construction(
+    server: viser.ViserServer, elements: frozenset[Element], trail_points: int, dark_mode: bool
+) -> PoinsotScene:
+    """The app's construction on the server's shared scene, in the theme's colours (the look a
+    browser of the app gets on that theme): what every stage draws on."""
+    scene = PoinsotScene(server.scene, elements, trail_points, atomic=server.atomic)
+    scene.restyle(palette.look(dark_mode))
+    return scene
+
+
 def stop_server(server: viser.ViserServer) -> None:
     with contextlib.redirect_stdout(io.StringIO()):
         server.stop()
@@ -130,10 +140,7 @@ class Stage(ServedStage):
         self.dark_mode = dark_mode
         self.server = open_server(host, port, dark_mode)
         try:
-            self.scene = PoinsotScene(
-                self.server.scene, elements, trail_points, atomic=self.server.atomic
-            )
-            self.scene.restyle(palette.look(dark_mode))  # the theme's colours, as in the app
+            self.scene = themed_construction(self.server, elements, trail_points, dark_mode)
             self.frame: Frame = self.scene.load(body, solid, t=0.0)
         except BaseException:
             self.stop()

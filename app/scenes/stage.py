@@ -8,9 +8,8 @@ T or a clip of S seconds is reproducible.
 
 from __future__ import annotations
 
-from poinsot.app.exports.stage import ServedStage, open_server
+from poinsot.app.exports.stage import ServedStage, open_server, themed_construction
 from poinsot.app.scene.batch import Frame
-from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scenes.runtime import Showcase
 from poinsot.app.scenes.spec import SceneSpec, Settings
 
@@ -32,8 +31,8 @@ class SceneStage(ServedStage):
         self.dark_mode = dark_mode
         self.server = open_server(host, port, dark_mode)
         try:
-            self.poinsot = PoinsotScene(
-                self.server.scene, frozenset(), spec.trail_points, atomic=self.server.atomic
+            self.poinsot = themed_construction(
+                self.server, frozenset(), spec.trail_points, dark_mode
             )
             self.showcase = Showcase(spec, self.poinsot, atomic=self.server.atomic)
             self.frame = self.showcase.load(settings, t=0.0)
