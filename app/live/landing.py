@@ -7,7 +7,7 @@ each worker reports them, plus the browsers sent to it that have not connected y
 arriving at once would otherwise all land on the worker that looked empty a moment ago).
 
 ``GET /poinsot-status`` answers the workers' ports, clients and health as JSON (the load test
-and the tests read it).
+and the tests read it); their process ids only to a client on the same machine (loopback).
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from __future__ import annotations
 import collections
 import http.client
 import http.server
+import ipaddress
 import json
 import socket
 import threading
@@ -97,6 +98,16 @@ class Balancer:
             ]
 
 
+def _loopback(address: str) -> bool:
+    """True for a client on this machine (127.0.0.0/8, ::1, or IPv4-mapped 127.x)."""
+    try:
+        ip = ipaddress.ip_address(address)
+    except ValueError:
+        return False
+    mapped = getattr(ip, "ipv4_mapped", None)
+    return bool((mapped or ip).is_loopback)
+
+
 def _host_name(header: str | None, fallback: str) -> str:
     """The host part of a ``Host`` header (``[::1]:8080`` -> ``[::1]``), else ``fallback``."""
     if not header:
@@ -111,7 +122,10 @@ class _Handler(http.server.BaseHTTPRequestHandler):
 
     def do_GET(self) -> None:  # noqa: N802 (the name http.server calls)
         if urllib.parse.urlsplit(self.path).path == STATUS_PATH:
-            self._reply(200, "application/json", json.dumps(self.server.balancer.status()))
+            status = self.server.balancer.status()
+            if not _loopback(self.client_address[0]):  # the LAN sees no process ids
+                status = [{k: v for k, v in entry.items() if k != "pid"} for entry in status]
+            self._reply(200, "application/json", json.dumps(status))
             return
         backend = self.server.balancer.choose()
         if backend is None:

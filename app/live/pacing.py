@@ -53,6 +53,7 @@ class Outbox:
     """How far one client's send queue has been taken (viser's per-client message buffer)."""
 
     def __init__(self, client: viser.ClientHandle) -> None:
+        self.client = client
         self.client_id = client.client_id
         self._buffer: Any = _message_buffer(client)
         self._transport: Any = _transport(client)
@@ -104,13 +105,18 @@ def _message_buffer(client: viser.ClientHandle) -> Any:
     return buffer if all(hasattr(buffer, name) for name in needed) else None
 
 
-def _transport(client: viser.ClientHandle) -> Any:
-    """The asyncio transport of the client's websocket (viser 1.1 keeps the live connections
-    on its websocket server), or None."""
+def connection_of(client: viser.ClientHandle) -> tuple[Any, Any]:
+    """The client's websocket connection and the event loop it runs on (viser 1.1 keeps the
+    live connections and the loop on its websocket server), or Nones."""
     server = getattr(getattr(client, "_viser_server", None), "_websock_server", None)
     connections = getattr(server, "_live_connections", None)
     connection = connections.get(client.client_id) if isinstance(connections, dict) else None
-    transport = getattr(connection, "transport", None)
+    return connection, getattr(server, "_background_event_loop", None)
+
+
+def _transport(client: viser.ClientHandle) -> Any:
+    """The asyncio transport of the client's websocket, or None."""
+    transport = getattr(connection_of(client)[0], "transport", None)
     return transport if hasattr(transport, "get_write_buffer_size") else None
 
 

@@ -8,6 +8,7 @@ from collections.abc import Iterable
 
 import viser
 
+from poinsot.app.live.backlog import BacklogLimit, BacklogWatch
 from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.guard import WireGuard
 from poinsot.app.live.session import MAX_FPS, Session
@@ -28,10 +29,13 @@ class PoinsotApp:
         max_fps: float = MAX_FPS,
         verbose: bool = False,
         allow_origins: Iterable[str] = (),
+        backlog: BacklogLimit | None = None,
     ) -> None:
         """Each new browser starts with ``preset``, or with ``scene`` if one is given. A
         browser's websocket is refused unless it comes from a page this server served, or from
-        one of ``allow_origins`` (``scheme://host[:port]``); see :mod:`.guard`."""
+        one of ``allow_origins`` (``scheme://host[:port]``); see :mod:`.guard`. A browser that
+        leaves more than ``backlog`` untaken for longer than its grace is disconnected
+        (:mod:`.backlog`; its defaults if None)."""
         self.preset = preset
         self.scene = scene
         self.max_fps = max_fps
@@ -56,6 +60,8 @@ class PoinsotApp:
         warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection")
         self.server.on_client_connect(self._connect)
         self.server.on_client_disconnect(self._disconnect)
+        #: Closes the connection of a client that leaves too much untaken (:mod:`.backlog`).
+        self.backlog = BacklogWatch(self.sessions, backlog).start()
 
     @property
     def port(self) -> int:
@@ -115,6 +121,7 @@ class PoinsotApp:
             return len(self._departed)
 
     def stop(self) -> None:
+        self.backlog.stop()
         for session in self.sessions().values():
             session.close(timeout=2.0)
         self.server.stop()

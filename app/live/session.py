@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import functools
 import logging
-import queue
 import threading
 import time
 from collections.abc import Callable
@@ -21,6 +20,7 @@ import viser
 
 from poinsot.app.elements import ALL_ELEMENTS, Element, Solid
 from poinsot.app.live import readouts
+from poinsot.app.live.actions import MAX_ACTIONS, ActionQueue
 from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.clock import SimClock
 from poinsot.app.live.ghost_controls import add_ghost_controls
@@ -67,10 +67,12 @@ class Session:
         view: View = DEFAULT_VIEW,
         budget: RebuildGate | None = None,
         scene: SceneSpec | None = None,
+        max_actions: int = MAX_ACTIONS,
     ) -> None:
         """``budget``: the server's rebuild gate, through which a rebuild goes first (one per
         session if None); ``scene``: start with this scene (:mod:`poinsot.app.scenes`) instead
-        of ``preset``. Frames: as many as the client takes, up to ``max_fps`` (:attr:`pacer`)."""
+        of ``preset``. Frames: as many as the client takes, up to ``max_fps`` (:attr:`pacer`).
+        At most ``max_actions`` actions queued (:mod:`.actions`)."""
         self.client = client
         self.max_fps = float(max_fps)
         self.budget = budget if budget is not None else RebuildGate()
@@ -86,7 +88,7 @@ class Session:
         self.body: FreeRigidBody | None = None
         self.frame: Frame | None = None
         self.status = ""
-        self._actions: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        self.actions = ActionQueue(max_actions)
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._applied = threading.Condition()
@@ -141,8 +143,10 @@ class Session:
         return self._thread is not None and self._thread.is_alive()
 
     # -- actions (any thread; never block) -----------------------------------------------
-    def _post(self, action: Callable[[], None]) -> None:
-        self._actions.put(action)
+    def _post(self, action: Callable[[], None], key: object = None) -> None:
+        """Queue ``action``; one with a ``key`` replaces the one queued with the same key (it
+        sets the same thing). Refused if the queue is full (:meth:`_drain` says so)."""
+        self.actions.put(action, key)
         self._wake.set()
 
     # A change asked for reads the count of the browser's menu choices, so that the menu is
@@ -171,14 +175,14 @@ class Session:
             if self.showcase is not None and self.showcase.configure(key, value):
                 self._dirty = True
 
-        self._post(action)
+        self._post(action, ("configure", key))
 
     def set_part_visible(self, part: str, visible: bool) -> None:
         def action() -> None:
             if self.showcase is not None:
                 self.showcase.set_visible(part, visible)
 
-        self._post(action)
+        self._post(action, ("part", part))
 
     def edit(self, change: Callable[[Parameters], Parameters]) -> None:
         count = self.panel.menu.count
@@ -191,7 +195,7 @@ class Session:
             self.clock.speed = speed
             self.scene.set_frame_time(self.frame_time)
 
-        self._post(action)
+        self._post(action, "speed")
 
     @property
     def frame_time(self) -> float:
@@ -213,10 +217,10 @@ class Session:
         def action() -> None:
             self.scene.trail_points = points
 
-        self._post(action)
+        self._post(action, "trail")
 
     def set_visible(self, element: Element, visible: bool) -> None:
-        self._post(lambda: self.scene.set_visible(element, visible))
+        self._post(lambda: self.scene.set_visible(element, visible), ("element", element))
 
     def report(self, error: BaseException) -> None:
         """Show an error raised outside the frame thread (a GUI callback)."""
@@ -297,17 +301,19 @@ class Session:
             self.showcase.refresh(now, self.frame.t)  # its readouts and plots, at their rates
 
     def _drain(self) -> None:
-        if self._actions.empty():  # the usual frame: no exception raised and caught
+        if not len(self.actions):  # the usual frame
             return
-        while True:
-            try:
-                action = self._actions.get_nowait()
-            except queue.Empty:
-                return
-            try:
-                action()
-            except Exception as exc:
-                self._report(exc)
+        while actions := self.actions.take():
+            for action in actions:
+                try:
+                    action()
+                except Exception as exc:
+                    self._report(exc)
+        refused = self.actions.refused()
+        if refused:  # said after the rebuild they ask for (which clears the status line)
+            if self._dirty:
+                self._rebuild()
+            self._set_status(f"Too many changes at once: {refused} were ignored; please redo them.")
 
     def _advance(self) -> None:
         showcase = self.showcase

@@ -25,7 +25,7 @@ import segno
 
 from poinsot.app import cli
 from poinsot.app.live import network
-from poinsot.app.live.landing import Balancer, resolve, status
+from poinsot.app.live.landing import Balancer, _loopback, resolve, status
 from poinsot.app.live.probe import Probe
 from tests.conftest import wait_until
 
@@ -338,3 +338,9 @@ def test_the_load_test_takes_workers_for_the_soak_only(capsys):
     with pytest.raises(SystemExit):
         load_cli.main(["--phase", "storm", "--workers", "2"])
     assert "only with --phase soak" in capsys.readouterr().err
+
+
+def test_only_a_client_on_this_machine_is_shown_the_workers_process_ids():
+    """/poinsot-status gives pids to loopback clients (the tests, the load test) only."""
+    assert all(_loopback(a) for a in ("127.0.0.1", "127.8.0.1", "::1", "::ffff:127.0.0.1"))
+    assert not any(_loopback(a) for a in ("192.168.1.5", "10.0.0.1", "::ffff:10.0.0.1", "fe80::1"))
