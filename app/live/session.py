@@ -252,7 +252,6 @@ class Session:
                 self._drain()
                 if self._dirty:
                     self._rebuild()
-                    self.client.flush()
                 now = time.monotonic()
                 if now >= next_frame and self.budget.rebuilding and now - due < HOLD_SECONDS:
                     next_frame = now + YIELD_SECONDS  # a slider move elsewhere goes first

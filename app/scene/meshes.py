@@ -90,13 +90,19 @@ def solid_mesh(solid: Solid) -> trimesh.Trimesh:
     return mesh
 
 
+@functools.cache
+def _unit_cube() -> trimesh.Trimesh:
+    """The cube of side 1 every box is drawn from (made once: it is only read, or copied)."""
+    return trimesh.creation.box(extents=(1.0, 1.0, 1.0))
+
+
 def solid_shape(solid: Solid) -> tuple[tuple, trimesh.Trimesh, np.ndarray]:
     """``(key, mesh, scale)``: the mesh to send for ``solid`` and the node scale that turns it
     into the solid. Boxes share one unit cube scaled by their sides, so a box that changes
     with a slider costs a scale update, not a new mesh; other solids are sent as they are.
     ``key`` is equal for solids that share a mesh."""
     if solid.kind == "box":
-        return ("box",), trimesh.creation.box(extents=(1.0, 1.0, 1.0)), np.asarray(solid.dims)
+        return ("box",), _unit_cube(), np.asarray(solid.dims)
     if solid.mesh is not None:
         return ("mesh", solid.mesh.digest), solid_mesh(solid), np.ones(3)
     return (solid.kind, solid.dims, solid.axis, solid.offset), solid_mesh(solid), np.ones(3)

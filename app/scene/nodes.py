@@ -19,7 +19,7 @@ import viser
 from scipy.spatial.transform import Rotation
 
 from poinsot.app.elements import Element
-from poinsot.app.scene import meshes, palette
+from poinsot.app.scene import meshes, palette, updates
 from poinsot.app.scene.geometry import (
     CONTACT_RADIUS,
     GRID_SPACING,
@@ -150,7 +150,7 @@ class PrincipalAxes(Drawing):
         for line, node, end in zip(self.lines, self.nodes, self.ends, strict=True):
             line.points = np.array([[-end, end]], dtype=np.float32)
             node.position = end * (1.0 + BEYOND)  # beyond the axis's tip, on the axis
-            node.handle.position = node.position
+            updates.set_position(node.handle, node.position)
 
     def restyle(self, look: Look) -> None:
         for line, color in zip(self.lines, look.axes, strict=True):
@@ -209,7 +209,7 @@ class InvariablePlane(Drawing):
         super().__init__([self.frame, disc, grid, rim])
 
     def fit(self, geometry: Geometry) -> None:
-        self.frame.position = (0.0, 0.0, geometry.plane_height)
+        updates.set_position(self.frame, np.array([0.0, 0.0, geometry.plane_height]))
 
     def restyle(self, look: Look) -> None:
         self.disc.color, self.disc.opacity = look.plane, look.plane_opacity
@@ -295,9 +295,9 @@ class MomentumArrow(Drawing):
 
     def fit(self, geometry: Geometry) -> None:
         self.top = top = geometry.plane_height + L_OVERSHOOT
-        self.arrow.points = np.array([[[0.0, 0.0, 0.0], [0.0, 0.0, top]]], np.float32)
+        updates.set_points(self.arrow, np.array([[[0.0, 0.0, 0.0], [0.0, 0.0, top]]]))
         self.node.position = np.array([0.0, 0.0, top + BEYOND])
-        self.label.position = self.node.position  # beyond the tip, on the axis
+        updates.set_position(self.label, self.node.position)  # beyond the tip, on the axis
 
     def restyle(self, look: Look) -> None:
         self.arrow.colors = np.array(look.angular_momentum, dtype=np.uint8)
@@ -397,11 +397,11 @@ class Trace(Drawing):
             radius = float(np.linalg.norm(self.point))
             outward = self.point / radius if radius > 0 else np.zeros(3)
             self.node.position = self.point * POLHODE_INFLATE + BEYOND * outward
-            self.node.handle.position = self.node.position
+            updates.set_position(self.node.handle, self.node.position)
         else:  # the ring's near side in the default view, until the layout turns it
             self.ring = (geometry.herpolhode_radius, geometry.plane_height)
             self.node.position = self._on_ring(np.array([0.93, 0.37]), BEYOND)
-            self.node.handle.position = self.node.position
+            updates.set_position(self.node.handle, self.node.position)
 
     def _on_ring(self, direction: np.ndarray, beyond: float = 0.0) -> np.ndarray:
         radius, height = self.ring
