@@ -177,11 +177,12 @@ class ControlPanel:
         #: over a newer one: :meth:`show_preset`).
         self.menu = Sent(preset.label)
         self._loop: asyncio.AbstractEventLoop = gui._event_loop  # viser's; runs the menu's writes
-        on_user(self.preset, self._choose_preset, self.actions.report, self.menu)
+        on_user(self.preset, self._choose_preset, self.actions.report, self.menu, inline=True)
 
     def _on_user(self, handle: H, callback: Callable[[Sent], None]) -> H:
-        """Run ``callback(sent)`` for changes made in the browser only (:func:`on_user`)."""
-        return on_user(handle, callback, self.actions.report)
+        """Run ``callback(sent)`` for changes made in the browser only (:func:`on_user`), on
+        viser's event loop: the panel's callbacks only post to the session's queue."""
+        return on_user(handle, callback, self.actions.report, inline=True)
 
     def _choose_preset(self, handle: Sent) -> None:
         for p in MENU:
