@@ -354,3 +354,34 @@ def test_help_shows_the_defaults_and_no_backticks(command, capsys):
     if command == ["screenshot"]:
         assert "(default: 1920x1080)" in text and "(default: default)" in text
         assert "Preset(" not in text
+
+
+def test_an_inline_callback_sees_every_value_in_the_order_sent():
+    """The panel's callbacks run on viser's event loop as each value arrives (they only post):
+    a quick run of slider values reaches them all, in order, none read twice."""
+    import viser
+
+    from poinsot.app.live.probe import Probe
+    from poinsot.app.live.widgets import on_user
+
+    server = viser.ViserServer("127.0.0.1", 0, verbose=False)
+    try:
+        slider = server.gui.add_slider("I₁", 0.0, 100.0, 1.0, 0.0)
+        seen, threads, errors = [], set(), []
+
+        def callback(sent) -> None:
+            seen.append(sent.value)
+            threads.add(threading.current_thread().name)
+
+        on_user(slider, callback, errors.append, inline=True)
+        values = [float(v) for v in range(1, 41)]
+        with Probe(server.get_port()) as probe:
+            assert probe.wait_for(lambda p: "I₁" in p.labels(), 10)
+            uuid, _ = probe.widget("I₁")
+            for value in values:
+                probe.set_value(uuid, value)
+            assert wait_until(lambda: len(seen) >= len(values), 10)
+        assert seen == values and errors == []
+        assert len(threads) == 1  # one thread: viser's event loop
+    finally:
+        server.stop()
