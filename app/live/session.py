@@ -143,30 +143,25 @@ class Session:
         return self._thread is not None and self._thread.is_alive()
 
     # -- actions (any thread; never block) -----------------------------------------------
-    def _post(self, action: Callable[[], None], key: object = None) -> None:
-        """Queue ``action``; one with a ``key`` replaces the one queued with the same key (it
-        sets the same thing). Refused if the queue is full (:meth:`_drain` says so)."""
+    def post(self, action: Callable[[], None], key: object = None) -> None:
+        """Run ``action`` on the frame thread (from any thread; never blocks). One with a
+        ``key`` replaces the one queued with the same key (it sets the same thing). Refused if
+        the queue is full (:meth:`_drain` says so)."""
         self.actions.put(action, key)
         self._wake.set()
 
-    # A change asked for reads the count of the browser's menu choices, so that the menu is
-    # not set back to what it showed then if the user has chosen again since (Panel.show_preset).
     def choose_preset(self, preset: Preset) -> None:
-        count = self.panel.menu.count
-        self._post(lambda: self._apply_preset(preset, count))
+        count = self.panel.menu.count  # the menu's choices so far (Panel.show_preset)
+        self.post(lambda: self._apply_preset(preset, count))
 
     @functools.cached_property
     def uploads(self) -> UploadControls:
         """The toss and mesh folders (made before the panel's first declaration)."""
         return UploadControls(self)
 
-    def post(self, action: Callable[[], None]) -> None:
-        """Run ``action`` on the frame thread (from any thread; never blocks)."""
-        self._post(action)
-
     def choose_scene(self, scene: SceneSpec) -> None:
         count = self.panel.menu.count
-        self._post(lambda: self._apply_scene(scene, count))
+        self.post(lambda: self._apply_scene(scene, count))
 
     def configure_scene(self, key: str, value: Value) -> None:
         """A control of the current scene moved."""
@@ -175,18 +170,18 @@ class Session:
             if self.showcase is not None and self.showcase.configure(key, value):
                 self._dirty = True
 
-        self._post(action, ("configure", key))
+        self.post(action, ("configure", key))
 
     def set_part_visible(self, part: str, visible: bool) -> None:
         def action() -> None:
             if self.showcase is not None:
                 self.showcase.set_visible(part, visible)
 
-        self._post(action, ("part", part))
+        self.post(action, ("part", part))
 
     def edit(self, change: Callable[[Parameters], Parameters]) -> None:
         count = self.panel.menu.count
-        self._post(lambda: self._edit(change, count))
+        self.post(lambda: self._edit(change, count))
 
     def set_speed(self, speed: float) -> None:
         speed = min(max(float(speed), self.speed_range[0]), self.speed_range[1])
@@ -195,7 +190,7 @@ class Session:
             self.clock.speed = speed
             self.scene.set_frame_time(self.frame_time)
 
-        self._post(action, "speed")
+        self.post(action, "speed")
 
     @property
     def frame_time(self) -> float:
@@ -203,13 +198,13 @@ class Session:
         return self.clock.speed / self.max_fps
 
     def toggle_pause(self) -> None:
-        self._post(self._toggle_pause)
+        self.post(self._toggle_pause)
 
     def step(self) -> None:
-        self._post(self._step)
+        self.post(self._step)
 
     def reset(self) -> None:
-        self._post(self._reset)
+        self.post(self._reset)
 
     def set_trail(self, points: int) -> None:
         points = min(max(int(points), TRAIL_RANGE[0]), TRAIL_RANGE[1])
@@ -217,14 +212,14 @@ class Session:
         def action() -> None:
             self.scene.trail_points = points
 
-        self._post(action, "trail")
+        self.post(action, "trail")
 
     def set_visible(self, element: Element, visible: bool) -> None:
-        self._post(lambda: self.scene.set_visible(element, visible), ("element", element))
+        self.post(lambda: self.scene.set_visible(element, visible), ("element", element))
 
     def report(self, error: BaseException) -> None:
         """Show an error raised outside the frame thread (a GUI callback)."""
-        self._post(lambda: self._report(error))
+        self.post(lambda: self._report(error))
 
     def wait_applied(self, generation: int, timeout: float = 5.0) -> int:
         """Block (tests, benchmark) until a rebuild after ``generation`` was applied."""
@@ -265,9 +260,8 @@ class Session:
                 self.stats.frame_cpu_seconds.append(time.thread_time() - cpu0)
 
     def _frame_if_taken(self, now: float) -> bool:
-        """Draw a frame, unless the browser has not yet taken the frames sent before
-        (:class:`Pacer`: the frame is skipped and this client's rate lowered). One frame's
-        messages (poses, traces, labels, plot, readouts) go out as one atomic window."""
+        """Draw a frame, unless the browser has not yet taken the one before (:class:`Pacer`:
+        skipped, the rate lowered). A frame's messages go out at once, in one atomic window."""
         if not self.pacer.may_draw():
             self.stats.skipped += 1
             return False
@@ -281,9 +275,8 @@ class Session:
     _frames_since_plot = PLOT_MIN_FRAMES  # frames drawn since the plot was last sent
 
     def _refresh(self, now: float) -> None:
-        """After a frame: a plot sample at PLOT_HZ, sent at most every PLOT_MIN_FRAMES frames
-        (the whole window is resent: a client at a lowered frame rate gets it less often),
-        the time readout (and retired widgets) at TIME_HZ."""
+        """After a frame: a plot sample at PLOT_HZ, the whole window sent at most every
+        PLOT_MIN_FRAMES frames; the time readout (and retired widgets) at TIME_HZ."""
         motion = self.panel.motion
         self._frames_since_plot += 1
         if now - self._last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
