@@ -10,8 +10,14 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from poinsot.app.elements import Solid
 from poinsot.app.presets import Preset
-from poinsot.physics import FreeRigidBody, attitude_with_L_along_z, check_real_body
+from poinsot.physics import (
+    FreeRigidBody,
+    attitude_with_L_along_z,
+    box_dimensions,
+    check_real_body,
+)
 
 #: Slider ranges.
 INERTIA_RANGE = (0.1, 5.0)
@@ -159,3 +165,14 @@ def _body(p: Parameters) -> FreeRigidBody:
             p.inertia, p.D, omega_norm=p.omega_norm, pole_sign=p.pole_sign
         )
     return FreeRigidBody(p.inertia, p.omega0, attitude_with_L_along_z(p.inertia, p.omega0))
+
+
+def drawn_solid(inertia: Vector, base: Preset, base_inertia: Vector) -> Solid | None:
+    """The solid drawn for the moments ``inertia``: the preset ``base``'s own solid while they
+    are still its moments (``base_inertia``), otherwise the homogeneous box with the same
+    moments (:func:`poinsot.physics.box_dimensions`); a flat lamina is drawn with a thin (2 %)
+    side."""
+    if base.solid is not None and inertia == base_inertia:
+        return base.solid
+    sides = box_dimensions(inertia)
+    return Solid("box", tuple(float(max(a, 0.02 * sides.max())) for a in sides))

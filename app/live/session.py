@@ -18,7 +18,7 @@ from collections.abc import Callable
 
 import viser
 
-from poinsot.app.elements import ALL_ELEMENTS, Element, Solid
+from poinsot.app.elements import ALL_ELEMENTS, Element
 from poinsot.app.live import readouts
 from poinsot.app.live.actions import MAX_ACTIONS, ActionQueue
 from poinsot.app.live.budget import RebuildGate
@@ -30,13 +30,13 @@ from poinsot.app.live.panel import ControlPanel
 from poinsot.app.live.showcase import LiveShowcase
 from poinsot.app.live.uploads import UploadControls
 from poinsot.app.live.widgets import Retirement
-from poinsot.app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters
+from poinsot.app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters, drawn_solid
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, Preset
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.view import DEFAULT_VIEW, View, apply_theme
 from poinsot.app.scenes.spec import SceneSpec, Value
-from poinsot.physics import FreeRigidBody, box_dimensions
+from poinsot.physics import FreeRigidBody
 
 log = logging.getLogger(__name__)
 
@@ -428,15 +428,6 @@ class Session:
             )
             self.panel.show_preset(CUSTOM, menu_count)
 
-    def _solid(self, params: Parameters) -> Solid | None:
-        """The base preset's solid while the moments are still the preset's, otherwise the
-        homogeneous box with the same moments (:func:`poinsot.physics.box_dimensions`); a flat
-        lamina is drawn with a thin (2 %) side."""
-        if self._base.solid is not None and params.inertia == self._base_inertia:
-            return self._base.solid
-        sides = box_dimensions(params.inertia)
-        return Solid("box", tuple(float(max(a, 0.02 * sides.max())) for a in sides))
-
     def _rebuild(self) -> None:
         """Build the body for the desired parameters and load it; on a ValueError keep the
         last valid scene and say why."""
@@ -444,18 +435,19 @@ class Session:
             start = time.perf_counter()
             desired = self._desired
             self._dirty = False
-            try:
-                if self.showcase is not None:
-                    self._load_scene(self.showcase)
-                else:
-                    body = desired.build()
-                    self.clock.reset(0.0)
-                    frame = self.scene.load(body, self._solid(desired), frame_time=self.frame_time)
-                    self._show_body(body, desired, frame)
-            except ValueError as exc:
-                reason = str(exc)
-                self._set_status(f"{reason[:1].upper()}{reason[1:]}. Showing the last valid body.")
-            self._fit_ghost()
+            with self.client.atomic():  # one window: the browser shows the new body at once
+                try:
+                    if self.showcase is not None:
+                        self._load_scene(self.showcase)
+                    else:
+                        self._load_body(desired)
+                except ValueError as exc:
+                    reason = str(exc)
+                    self._set_status(
+                        f"{reason[:1].upper()}{reason[1:]}. Showing the last valid body."
+                    )
+                self._fit_ghost()
+            self.client.flush()  # out now, not at viser's next 1/60 s window
             self.stats.rebuild_seconds.append(time.perf_counter() - start)
             self.stats.rebuilds += 1
         with self._applied:
@@ -469,10 +461,14 @@ class Session:
         self.body = showcase.body
         self.panel.motion.clear_plot()
         self._set_status("")
-        self.client.flush()
 
-    def _show_body(self, body: FreeRigidBody, params: Parameters, frame: Frame) -> None:
-        """The new body is on screen: mirror it into the panel and the "Motion" window."""
+    def _load_body(self, params: Parameters) -> None:
+        """Build the body of ``params`` (a ValueError keeps the last one), load it at t = 0 and
+        mirror it into the panel and the "Motion" window."""
+        body = params.build()
+        self.clock.reset(0.0)
+        solid = drawn_solid(params.inertia, self._base, self._base_inertia)
+        frame = self.scene.load(body, solid, frame_time=self.frame_time)
         self.body, self.params, self.frame = body, params, frame
         self.panel.show_parameters(params)
         motion = self.panel.motion
@@ -480,8 +476,6 @@ class Session:
         motion.clear_plot()
         motion.record_plot(0.0, frame.omega)
         self._set_status("")
-        # Send now: viser otherwise batches outgoing messages for up to a frame (1/60 s).
-        self.client.flush()
 
     def _toggle_pause(self) -> None:
         self.clock.paused = not self.clock.paused
