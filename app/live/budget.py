@@ -3,9 +3,11 @@
 All sessions share one Python process (one GIL). How many frames each draws is its own
 client's business (:mod:`~poinsot.app.live.pacing`: as many as that browser takes). What is
 shared is precedence: while any session rebuilds its scene (:meth:`RebuildGate.rebuild`, a
-slider moved), the other sessions hold their next frame (:attr:`RebuildGate.rebuilding`), so
-the rebuild has the interpreter to itself and the student who moved the slider sees the new
-body at once; the others lose at most a frame or two.
+slider moved), the other sessions hold their next frame (:meth:`RebuildGate.hold`), so the
+rebuild has the interpreter to itself and the student who moved the slider sees the new body
+at once; the others lose at most a frame or two. A held session sleeps until the rebuild ends
+(the gate wakes it): it does not poll, which under load took the interpreter from the rebuild
+it was waiting for.
 
 :class:`MessageBudget` is the other direction: how many messages one client may send.
 """
@@ -25,6 +27,7 @@ class RebuildGate:
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._rebuilding = 0
+        self._held: set[threading.Event] = set()  # the wakes of the sessions holding a frame
 
     @contextlib.contextmanager
     def rebuild(self) -> Iterator[None]:
@@ -36,6 +39,20 @@ class RebuildGate:
         finally:
             with self._lock:
                 self._rebuilding -= 1
+                held = self._held if self._rebuilding == 0 else set()
+                if held:
+                    self._held = set()
+            for wake in held:
+                wake.set()
+
+    def hold(self, wake: threading.Event) -> bool:
+        """Before a frame: True if some session rebuilds (hold the frame); ``wake`` is then set
+        when the last rebuild ends. False: draw."""
+        with self._lock:
+            if self._rebuilding == 0:
+                return False
+            self._held.add(wake)
+            return True
 
     @property
     def rebuilding(self) -> bool:

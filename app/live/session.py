@@ -48,9 +48,8 @@ TIME_HZ = 5.0
 PLOT_MIN_FRAMES = 6
 #: "Step" advances this many wall seconds' worth of simulation time.
 STEP_SECONDS = 0.1
-#: While another session rebuilds, a due frame is retried after this long [s], and held for
-#: at most HOLD_SECONDS (so that many students dragging sliders never freeze the others).
-YIELD_SECONDS = 0.002
+#: While another session rebuilds, a due frame is held until the rebuild ends, for at most
+#: HOLD_SECONDS (so that many students dragging sliders never freeze the others).
 HOLD_SECONDS = 0.05
 
 
@@ -234,10 +233,11 @@ class Session:
     # -- frame thread --------------------------------------------------------------------
     def _run(self) -> None:
         next_frame = due = time.monotonic()
+        held = False  # a due frame waits for another session's rebuild (RebuildGate.hold)
         while not self._stop.is_set():
             delay = next_frame - time.monotonic()
-            if delay > 0:
-                self._wake.wait(delay)
+            if delay > 0 and not (held and not self.budget.rebuilding):
+                self._wake.wait(delay)  # set by an action, or by the rebuild's end if held
                 self._wake.clear()
             if self._stop.is_set():
                 break
@@ -248,9 +248,12 @@ class Session:
                 if self._dirty:
                     self._rebuild()
                 now = time.monotonic()
-                if now >= next_frame and self.budget.rebuilding and now - due < HOLD_SECONDS:
-                    next_frame = now + YIELD_SECONDS  # a slider move elsewhere goes first
+                if held and not self.budget.rebuilding:
+                    next_frame = now  # the rebuild that held this frame is over
+                if now >= next_frame and now - due < HOLD_SECONDS and self.budget.hold(self._wake):
+                    held, next_frame = True, due + HOLD_SECONDS  # a slider move elsewhere first
                 elif now >= next_frame:
+                    held = False
                     drawn = self._frame_if_taken(now)
                     next_frame = due = now + self.pacer.interval
             except Exception as exc:  # the loop must survive anything; the user sees it

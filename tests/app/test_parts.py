@@ -342,3 +342,26 @@ def test_a_rebuild_holds_the_other_sessions_frames_for_a_bounded_time(probe, poi
     before = session.stats.frames
     time.sleep(0.5)
     assert session.stats.frames - before > held  # free again
+
+
+def test_a_held_frame_is_woken_when_the_last_rebuild_ends():
+    """A session holding its frame sleeps on its own wake, which the gate sets when no rebuild
+    is left (not before); with no rebuild on, nothing is held."""
+    import threading
+
+    from poinsot.app.live.budget import RebuildGate
+
+    gate, wake = RebuildGate(), threading.Event()
+    assert not gate.hold(wake)
+    first, second = gate.rebuild(), gate.rebuild()
+    first.__enter__()
+    second.__enter__()
+    assert gate.hold(wake) and not wake.is_set()
+    first.__exit__(None, None, None)
+    assert not wake.is_set()  # the other rebuild still runs
+    second.__exit__(None, None, None)
+    assert wake.is_set()
+    wake.clear()
+    with gate.rebuild():
+        pass
+    assert not wake.is_set()  # woken once: a later rebuild does not wake a frame not held
