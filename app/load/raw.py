@@ -107,8 +107,9 @@ class RawClient:
     # -- sending -------------------------------------------------------------------------------
     def send(self, data: bytes, deadline: float) -> int:
         """Write ``data`` (whole frames) before ``deadline`` (monotonic); the bytes written.
-        Fewer than ``len(data)`` only when the server stopped reading until the deadline; the
-        connection is then unusable (a frame was cut) and the caller stops sending."""
+        Fewer than ``len(data)`` only when the server stopped reading until the deadline, or
+        closed the connection (``closed_by_server``); the connection is then unusable (a frame
+        was cut) and the caller stops sending."""
         view = memoryview(data)
         sent = 0
         with self._send_lock:
@@ -123,6 +124,9 @@ class RawClient:
                     sent += self.sock.send(view[sent:])
                 except BlockingIOError:
                     continue
+                except (ConnectionResetError, BrokenPipeError):  # the server cut us off
+                    self.closed_by_server = True
+                    break
         return sent
 
     # -- receiving -----------------------------------------------------------------------------
