@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import logging
 import threading
 import warnings
 from collections.abc import Iterable
+from concurrent.futures import Future
 
 import viser
 
@@ -12,8 +14,17 @@ from poinsot.app.live.backlog import BacklogLimit, BacklogWatch
 from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.guard import WireGuard
 from poinsot.app.live.session import MAX_FPS, Session
+from poinsot.app.live.upkeep import MemoryTrim, fixed_pool
 from poinsot.app.presets import DEFAULT_PRESET, Preset
 from poinsot.app.scenes.spec import SceneSpec
+
+log = logging.getLogger(__name__)
+
+
+def _log_failure(future: Future[None]) -> None:
+    exc = future.exception() if not future.cancelled() else None
+    if exc is not None:
+        log.error("a session could not be built", exc_info=exc)
 
 
 class PoinsotApp:
@@ -58,8 +69,14 @@ class PoinsotApp:
         # disconnect callback stopping it; viser then warns once that the message is dropped.
         # That is expected here, not a leak: the thread stops right after.
         warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection")
-        self.server.on_client_connect(self._connect)
-        self.server.on_client_disconnect(self._disconnect)
+        # Sessions are built on a fixed pool (:mod:`.upkeep`), which also runs the widgets'
+        # worker-thread callbacks; a departure is handled on viser's event loop (it only
+        # stops a thread) and, once quiet, memory is handed back.
+        self.pool = fixed_pool()
+        self.server.get_event_loop().set_default_executor(self.pool)
+        self.memory = MemoryTrim()
+        self.server.on_client_connect(self._on_connect)
+        self.server.on_client_disconnect(self._on_disconnect)
         #: Closes the connection of a client that leaves too much untaken (:mod:`.backlog`).
         self.backlog = BacklogWatch(self.sessions, backlog).start()
 
@@ -82,6 +99,14 @@ class PoinsotApp:
         with self._connected:
             self._connected.wait_for(lambda: len(self._sessions) >= count, timeout)
             return list(self._sessions.values())
+
+    async def _on_connect(self, client: viser.ClientHandle) -> None:
+        # Not awaited: viser goes on with the socket. A failure is logged, as viser's would be.
+        self.pool.submit(self._connect, client).add_done_callback(_log_failure)
+
+    async def _on_disconnect(self, client: viser.ClientHandle) -> None:
+        self._disconnect(client)
+        self.memory.departed()
 
     def _connect(self, client: viser.ClientHandle) -> None:
         """Build the session outside the lock (30-300 ms), then register and start it under
@@ -122,6 +147,8 @@ class PoinsotApp:
 
     def stop(self) -> None:
         self.backlog.stop()
+        self.memory.stop()
         for session in self.sessions().values():
             session.close(timeout=2.0)
         self.server.stop()
+        self.pool.shutdown(wait=False, cancel_futures=True)
