@@ -179,11 +179,15 @@ class BrowserPage:
         return self.page.locator("label").filter(has_text=exact).count()
 
     def press_slider(self, label: str, key: str, times: int = 1) -> None:
-        """Move a slider with the keyboard (each press = one step, like a user would)."""
+        """Move a slider with the keyboard (each press = one step, like a user would): the
+        thumb is focused once, then the keys go to it as typed (no locator round trip per key,
+        which costs a busy software-WebGL page over half a second); it must still hold the
+        focus after the last one."""
         thumb = self.page.locator(f"[id='{self.widget_id(label)}'] [role=slider]")
         thumb.focus()
         for _ in range(times):
-            thumb.press(key)
+            self.page.keyboard.press(key)
+        assert thumb.evaluate("e => e === document.activeElement"), f"{label!r} lost the focus"
 
     def slider_value(self, label: str) -> float:
         thumb = self.page.locator(f"[id='{self.widget_id(label)}'] [role=slider]")
