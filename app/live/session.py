@@ -80,16 +80,14 @@ class Session:
         self.clock = SimClock(speed=preset.speed)
         self.preset = preset
         self._base = preset  # the last named preset: it supplies the solid
-        self._base_inertia = Parameters.from_preset(preset).inertia
-        self.params = Parameters.from_preset(preset)
-        self._desired = self.params
+        self.params = self._desired = Parameters.from_preset(preset)
+        self._base_inertia = self.params.inertia
         self._dirty = True
         self.body: FreeRigidBody | None = None
         self.frame: Frame | None = None
         self.status = ""
         self.actions = ActionQueue(max_actions)
-        self._wake = threading.Event()
-        self._stop = threading.Event()
+        self._wake, self._stop = threading.Event(), threading.Event()
         self._applied = threading.Condition()
         self._generation = 0  # bumped after each rebuild (tests wait on it)
         self._thread: threading.Thread | None = None
