@@ -13,6 +13,7 @@ import viser
 from poinsot.app.live.backlog import BacklogLimit, BacklogWatch
 from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.guard import WireGuard
+from poinsot.app.live.pacing import frame_share
 from poinsot.app.live.session import MAX_FPS, Session
 from poinsot.app.live.upkeep import MemoryTrim, fixed_pool
 from poinsot.app.presets import DEFAULT_PRESET, Preset
@@ -127,6 +128,7 @@ class PoinsotApp:
             else:
                 left = False
                 self._sessions[client.client_id] = session
+                self._share_frames()
                 session.start()
                 self._connected.notify_all()
         if left:
@@ -137,8 +139,15 @@ class PoinsotApp:
             session = self._sessions.pop(client.client_id, None)
             if session is None:  # its connect handler has not registered it (yet)
                 self._departed.add(client.client_id)
+            self._share_frames()
         if session is not None:
             session.close()
+
+    def _share_frames(self) -> None:
+        """Under ``_lock``: each browser's frame-rate cap for this many sharing the process."""
+        cap = frame_share(self.max_fps, len(self._sessions))
+        for session in self._sessions.values():
+            session.pacer.max_fps = cap
 
     def pending_departures(self) -> int:
         """Clients that left before their session was registered, not yet reconciled."""

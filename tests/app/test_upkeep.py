@@ -53,3 +53,23 @@ def test_a_server_builds_sessions_on_its_fixed_pool(make_app, make_probe):
         probe.close()
     assert wait_until(lambda: not app.sessions(), 30)
     assert wait_until(lambda: app.memory.trims >= 1, 30)
+
+
+def test_a_process_shares_its_frames_among_its_browsers(make_app, make_probe):
+    """Up to the cap each while few share a process, fewer as more join, never below the
+    floor; a departure gives the others their share back."""
+    from poinsot.app.live.pacing import PROCESS_FRAMES, SHARED_MIN_FPS, frame_share
+
+    assert frame_share(60.0, 1) == 60.0
+    assert frame_share(60.0, 9) == 60.0
+    assert frame_share(60.0, 15) == PROCESS_FRAMES / 15 < 60.0
+    assert frame_share(60.0, 100) == SHARED_MIN_FPS
+    app = make_app()
+    probes = [make_probe(app) for _ in range(12)]
+    sessions = app.wait_for_sessions(12, 60)
+    assert wait_until(lambda: len(app.sessions()) == 12, 30)
+    assert {s.pacer.max_fps for s in sessions} == {frame_share(app.max_fps, 12)}
+    for probe in probes[:6]:
+        probe.close()
+    assert wait_until(lambda: len(app.sessions()) == 6, 30)
+    assert {s.pacer.max_fps for s in app.sessions().values()} == {app.max_fps}
