@@ -52,7 +52,7 @@ MIN_FPS = 2.0
 RAISE = 1.25
 #: Frames a second one process shares among its browsers [frames/s], and the least each gets.
 PROCESS_FRAMES = 540.0
-SHARED_MIN_FPS = 30.0
+SHARED_MIN_FPS = 32.0
 
 
 def frame_share(max_fps: float, browsers: int) -> float:
