@@ -294,6 +294,17 @@ def test_a_label_goes_beyond_its_tip():
     assert x0 >= px - 1e-6 and x1 > x0
 
 
+def test_a_label_box_is_as_wide_as_the_browser_draws_it():
+    """ω is wider than a Latin letter: Chromium draws ω's box at font scale 1.4 18-19 CSS px
+    wide (the mean advance of a letter gave 13.3 px, and ω's box then touched the herpolhode's
+    label beside it); a Latin letter's stays at the mean."""
+    from poinsot.app.scene.labels import box_size
+
+    assert box_size("ω", 1.4)[0] >= 19.0
+    assert box_size("L", 1.4)[0] == pytest.approx(13.272)
+    assert box_size("Lω", 1.4)[0] > box_size("LL", 1.4)[0]
+
+
 # -- the legend and the caption --------------------------------------------------------------
 def test_the_legend_lists_the_declared_elements_in_the_looks_colours():
     from poinsot.app.elements import ALL_ELEMENTS, TRACE_ELEMENTS
