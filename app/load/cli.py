@@ -18,7 +18,7 @@ from poinsot.app.arguments import (
     positive_int,
     run_guarded,
 )
-from poinsot.app.load.config import Config, Report
+from poinsot.app.load.config import Config, Report, server_processes
 from poinsot.app.load.figures import Bounds, exit_status, format_table, missed
 from poinsot.app.load.phases import PHASES, run_phase
 
@@ -34,7 +34,12 @@ def build_parser() -> argparse.ArgumentParser:
     add = parser.add_argument
     add("--phase", nargs="+", choices=PHASES, default=list(PHASES), help="phases to run, in order")
     add("--clients", type=positive_int, default=cfg.clients, help="clients in each phase")
-    add("--workers", type=positive_int, default=cfg.workers, help="server processes (soak only)")
+    add(
+        "--workers",
+        type=positive_int,
+        default=cfg.workers or None,
+        help="server processes of the soak (default: one per core, as poinsot serve)",
+    )
     add("--seconds", type=positive_float, default=cfg.seconds, help="length of the soak [s]")
     add("--slider-period", type=positive_float, default=cfg.slider_period, help="slider every [s]")
     add("--storm", type=positive_int, default=cfg.storm, help="connects and departures")
@@ -56,7 +61,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _options(args: argparse.Namespace) -> tuple[list[str], Config, Bounds]:
-    fields = vars(args)
+    fields = dict(vars(args))
+    fields["workers"] = fields["workers"] or 0  # 0: as many as poinsot serve starts
     bounds = Bounds(**{f.name: fields[f.name] for f in dataclasses.fields(Bounds)})
     names = {f.name for f in dataclasses.fields(Config)} - {"settle_tolerance"}
     cfg = Config(**{name: fields[name] for name in names}, settle_tolerance=bounds.storm_tolerance)
@@ -100,8 +106,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _run(phases: list[str], cfg: Config, bounds: Bounds) -> int:
     print(
-        f"Poinsot load test: {' '.join(phases)}; {cfg.clients} clients, {cfg.workers} server "
-        f"process(es), soak {cfg.seconds:g} s, "
+        f"Poinsot load test: {' '.join(phases)}; {cfg.clients} clients, "
+        f"{server_processes(cfg, 'soak')} server process(es) in the soak, soak {cfg.seconds:g} s, "
         f"storm {cfg.storm}; python {sys.version.split()[0]}, {os.cpu_count()} CPUs, "
         f"load average {_load_average()} (1, 5, 15 min)",
         flush=True,

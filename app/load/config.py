@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import statistics
 from collections.abc import Callable
 
@@ -24,7 +25,9 @@ class Config:
     """The sizes of the phases (each has a command-line option)."""
 
     clients: int = 30  # in the soak, the stall and the flood
-    workers: int = 1  # server processes (behind a landing port if more than one)
+    #: Server processes (behind a landing port if more than one); 0: the soak with as many as
+    #: ``poinsot serve`` starts here (one per core), the other phases with one.
+    workers: int = 0
     seconds: float = 300.0  # the soak
     slider_period: float = 1.0  # a slider move every this many seconds during the soak
     storm: int = 200  # connects and departures
@@ -74,3 +77,10 @@ def fps_text(values: list[float]) -> str:
     if not values:
         return "no clients"
     return f"p50 {statistics.median(values):.1f}, min {min(values):.1f} fps"
+
+
+def server_processes(cfg: Config, phase: str) -> int:
+    """The server processes a phase runs against (see :attr:`Config.workers`)."""
+    if cfg.workers:
+        return cfg.workers
+    return (os.cpu_count() or 1) if phase == "soak" else 1

@@ -13,7 +13,7 @@ import time
 from collections.abc import Callable
 
 from poinsot.app.load import contention, procfs, soak, storm
-from poinsot.app.load.config import Config, Report, Say
+from poinsot.app.load.config import Config, Report, Say, server_processes
 from poinsot.app.load.figures import COMPLETES, Figure, at_most, info
 from poinsot.app.load.server_process import ServerProcess
 
@@ -32,7 +32,7 @@ def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:
     not start, clients that never get their scene) misses its "completed" goal; the server's
     log is read in every case, and judged in the soak."""
     try:
-        server = ServerProcess(cfg.lifetime, workers=cfg.workers)
+        server = ServerProcess(cfg.lifetime, workers=server_processes(cfg, name))
     except Exception as exc:
         report.add(Figure(name, "completed", 0.0, f"failed: {exc}", COMPLETES))
         return

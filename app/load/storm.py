@@ -207,13 +207,18 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
 
 
 def _settle(server: ServerProcess, before: _Look, cfg: Config) -> tuple[_Look, float]:
-    """Look every half second until everything is back within the tolerance, or the settle
-    time is up; the last look and the seconds waited."""
+    """Look every half second until everything is back within the tolerance and every
+    departed session's thread has ended, or the settle time is up; the last look and the
+    seconds waited."""
     start = time.monotonic()
     while True:
         after = _Look.take(server)
         waited = time.monotonic() - start
-        if max(after.deviations(before)) <= cfg.settle_tolerance or waited >= cfg.settle_seconds:
+        status = after.status
+        departed = status["session_threads"] == status["sessions"]
+        departed = departed and status["pending_departures"] == 0
+        within = max(after.deviations(before)) <= cfg.settle_tolerance
+        if (within and departed) or waited >= cfg.settle_seconds:
             return after, waited
         time.sleep(0.5)
 

@@ -13,6 +13,7 @@ import struct
 import pytest
 
 from poinsot.app.load import PHASES, Bounds, Config, Report, cli, exit_status, run
+from poinsot.app.load.config import server_processes
 from poinsot.app.load.figures import COMPLETES, Figure, at_least, at_most, percentile
 from poinsot.app.load.procfs import usage
 from poinsot.app.load.raw import client_frame
@@ -21,6 +22,7 @@ from poinsot.app.load.storm import KINDS
 
 TINY = Config(
     clients=3,
+    workers=1,
     seconds=3.0,
     slider_period=0.5,
     storm=15,
@@ -163,6 +165,21 @@ def test_a_figure_not_measured_misses_its_goal():
     )
     assert Figure("x", "y", 31.0, "", at_least("min_fps", "")).verdict(Bounds()) == "met"
     assert Figure("x", "y", 29.0, "", at_least("min_fps", "")).verdict(Bounds()) == "MISSED"
+
+
+def test_the_soak_runs_on_as_many_processes_as_poinsot_serve_starts(monkeypatch):
+    """No ``--workers``: the soak runs against one process per core (as a lecturer's ``poinsot
+    serve``), the other phases against one; ``--workers N`` is the soak's N."""
+    seen = {}
+    monkeypatch.setattr(cli, "run", lambda phases, cfg: seen.setdefault("cfg", cfg) and Report())
+    cli.main(["--phase", "soak"])
+    cfg = seen.pop("cfg")
+    cores = os.cpu_count() or 1
+    assert cfg.workers == 0
+    assert server_processes(cfg, "soak") == cores
+    assert all(server_processes(cfg, phase) == 1 for phase in PHASES if phase != "soak")
+    cli.main(["--phase", "soak", "--workers", "3"])
+    assert server_processes(seen.pop("cfg"), "soak") == 3
 
 
 def test_stall_and_flood_need_two_clients():
