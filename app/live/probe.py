@@ -107,6 +107,9 @@ class Probe:
             max_size=None,
             compression=None,
             open_timeout=10,
+            # No keepalive pings of its own: a probe told to stop reading (a stalled client)
+            # would miss the pong and print a traceback; the server's pings watch the line.
+            ping_interval=None,
             origin=None if origin is None else websockets.Origin(origin),
         )
         self._closed = False
