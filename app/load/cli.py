@@ -37,7 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
     add(
         "--workers",
         type=positive_int,
-        default=cfg.workers or None,
+        default=cfg.workers,
         help="server processes of the soak (default: one per core, as poinsot serve)",
     )
     add("--seconds", type=positive_float, default=cfg.seconds, help="length of the soak [s]")
@@ -61,8 +61,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _options(args: argparse.Namespace) -> tuple[list[str], Config, Bounds]:
-    fields = dict(vars(args))
-    fields["workers"] = fields["workers"] or 0  # 0: as many as poinsot serve starts
+    fields = vars(args)
     bounds = Bounds(**{f.name: fields[f.name] for f in dataclasses.fields(Bounds)})
     names = {f.name for f in dataclasses.fields(Config)} - {"settle_tolerance"}
     cfg = Config(**{name: fields[name] for name in names}, settle_tolerance=bounds.storm_tolerance)

@@ -12,7 +12,8 @@ browser runs on a machine of its own. The others share one process (a fleet): a 
 of them waits there behind the other clients' frames for that process's one interpreter lock,
 which a classroom does not have. Measured in the fleet, 30 clients on one server process gave a
 slider p95 of 64 ms, of which 30 ms between the server's send and the fleet's decoding; measured
-by the sensor, 38 ms (both on this 2-core machine, the clients' processes on the same cores).
+by the sensor, 38-57 ms over two runs (on this 2-core machine, the clients' processes on the same
+cores).
 """
 
 from __future__ import annotations
