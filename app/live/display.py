@@ -9,7 +9,8 @@ view, and the labels' layout for the browser's camera.
   (:class:`~poinsot.app.scene.body_view.BodyView`), the camera stepped back to frame both and
   the left column folded (its strip opens it again) for a wide picture.
 - Labels: a few times a second the scene's labels are laid out for the camera the browser
-  reports (:meth:`~poinsot.app.scene.construction.PoinsotScene.lay_out_labels`).
+  reports (:meth:`~poinsot.app.scene.construction.PoinsotScene.label_steps`), one step of the
+  layout per frame, on frames that send no traces: no frame carries a whole layout.
 
 Frame thread only, except :meth:`Display.request`, which records a wish for the frame thread.
 """
@@ -30,7 +31,7 @@ from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.body_view import OFFSET, BodyView
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.frames import wxyz
-from poinsot.app.scene.labels import Camera
+from poinsot.app.scene.labels import Camera, Steps, finish
 from poinsot.app.scene.view import DEFAULT_VIEW, View, configure_theme
 
 #: Root font size of the large-text mode: every panel size is in rem, so all text scales.
@@ -41,9 +42,9 @@ PROJECTOR_TEXT_PERCENT = 150
 #: view: the boxes follow it), at most every LABEL_MIN_FRAMES frames; under a still camera,
 #: when only the time runs, LABEL_STILL_HZ and every LABEL_STILL_FRAMES frames at most (the boxes
 #: ride on their frames in between: only their anchors wait for the next layout); never for
-#: the same camera and time. A layout costs about a millisecond, so a client whose frame rate
-#: is lowered (a busy server, a slow browser) gets fewer layouts too: at most a fifth of its
-#: frames carry one while its camera moves, a thirtieth otherwise.
+#: the same camera and time. A layout costs 1-2 ms, taken in five steps over as many frames
+#: (one at a time: the next layout begins once the last has ended), so a client whose frame
+#: rate is lowered (a busy server, a slow browser) gets fewer layouts too.
 LABEL_HZ = 6.0
 LABEL_MIN_FRAMES = 5
 LABEL_STILL_HZ = 2.0
@@ -134,6 +135,8 @@ class Display:
         self._last_layout = -math.inf  # monotonic time of the last layout
         self._frames_since_layout = LABEL_STILL_FRAMES
         self._laid_out: tuple = (None,)  # (*camera, time) of the last layout
+        self._steps: Steps[dict] | None = None  # the layout under way
+        self.laid_out_now = False  # this frame took a step of a layout
 
     # -- wishes (any thread) ---------------------------------------------------------------
     def request(self, **changes: bool) -> None:
@@ -159,6 +162,12 @@ class Display:
                 view.fit(scene.geometry, self._attitude0(frame))
             view.advance(frame)
         self._frames_since_layout += 1
+        self.laid_out_now = False
+        if self.session.scene.sent_traces:
+            return  # this frame is heavier than most already: the labels wait for the next
+        if self._steps is not None:
+            self._step()
+            return
         if now < self._last_layout + 1.0 / LABEL_HZ or self._frames_since_layout < LABEL_MIN_FRAMES:
             return
         camera = browser_camera(self.client)
@@ -169,21 +178,42 @@ class Display:
             or self._frames_since_layout < LABEL_STILL_FRAMES
         ):
             return  # a still camera: the next layout for the time alone comes later
-        if self.lay_out_labels(None if frame is None else frame.t, camera):
+        self._steps = self._begin_layout(None if frame is None else frame.t, camera)
+        if self._steps is not None:
             self._last_layout = now
             self._frames_since_layout = 0
+            self._step()
 
-    def lay_out_labels(self, t: float | None = None, camera: Camera | None = None) -> dict:
-        """Lay the labels out for the browser's camera (or ``camera``), not again for the same
-        camera and time ``t``, when given (a paused, unmoved picture)."""
-        camera = browser_camera(self.client) if camera is None else camera
-        if camera is None or not all(math.isfinite(v) for v in camera.position):
-            return {}
+    def _step(self) -> None:
+        """One step of the layout under way (:attr:`laid_out_now`: a step was taken)."""
+        assert self._steps is not None
+        self.laid_out_now = True
+        try:
+            next(self._steps)
+        except StopIteration:
+            self._steps = None
+
+    def _begin_layout(self, t: float | None, camera: Camera) -> Steps[dict] | None:
+        """The steps of a layout for ``camera``; None for a camera with no finite position,
+        or the same camera and time ``t``, when given, as the last layout (a paused, unmoved
+        picture)."""
+        if not all(math.isfinite(v) for v in camera.position):
+            return None
         key = (*_camera_key(camera), t)
         if t is not None and key == self._laid_out:
-            return {}
+            return None
         self._laid_out = key
-        return self.session.scene.lay_out_labels(camera)
+        return self.session.scene.label_steps(camera)
+
+    def lay_out_labels(self, t: float | None = None, camera: Camera | None = None) -> dict:
+        """Lay the labels out at once for the browser's camera (or ``camera``), not again for
+        the same camera and time ``t``, when given; a layout under way is dropped."""
+        camera = browser_camera(self.client) if camera is None else camera
+        steps = None if camera is None else self._begin_layout(t, camera)
+        if steps is None:
+            return {}
+        self._steps = None
+        return finish(steps)
 
     def _attitude0(self, frame: Frame) -> np.ndarray:
         """The attitude at t = 0 (the body-frame picture is the body as it was then)."""

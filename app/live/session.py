@@ -277,13 +277,14 @@ class Session:
 
     def _refresh(self, now: float) -> None:
         """After a frame: a plot sample at PLOT_HZ, the whole window sent at most every
-        PLOT_MIN_FRAMES frames; the time readout (and retired widgets) at TIME_HZ."""
+        PLOT_MIN_FRAMES frames, on a frame that is not busy already; the time readout (and
+        retired widgets) at TIME_HZ."""
         motion = self.panel.motion
         self._frames_since_plot += 1
         if now - self._last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
             self._last_plot = now
             motion.record_plot(self.frame.t, self.frame.omega)
-            if self._frames_since_plot >= PLOT_MIN_FRAMES:
+            if self._frames_since_plot >= PLOT_MIN_FRAMES and not self._busy_frame():
                 self._frames_since_plot = 0
                 motion.send_plot()
         if now - self._last_time >= 1.0 / TIME_HZ:
@@ -292,6 +293,10 @@ class Session:
             self.retirement.collect(now)
         if self.showcase is not None and self.frame is not None:
             self.showcase.refresh(now, self.frame.t)  # its readouts and plots, at their rates
+
+    def _busy_frame(self) -> bool:
+        """This frame sent the traces or took a step of the labels' layout (the plot waits)."""
+        return self.scene.sent_traces or self.lecture.display.laid_out_now
 
     def _drain(self) -> None:
         if not len(self.actions):  # the usual frame

@@ -41,7 +41,8 @@ from poinsot.app.scene import palette, updates
 from poinsot.app.scene.batch import Frame, FrameBatch
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.geometry import L_OVERSHOOT, Geometry
-from poinsot.app.scene.labels import Camera, Placement, Pose, lay_out
+from poinsot.app.scene.label_nodes import Pose
+from poinsot.app.scene.labels import Camera, Placement, Steps, finish, lay_out_in_steps
 from poinsot.app.scene.nodes import Drawing, OmegaArrow, Trace, draw
 from poinsot.app.scene.palette import Look
 from poinsot.app.scene.sampling import FIRST_BATCH, MotionSampler
@@ -104,6 +105,8 @@ class PoinsotScene:
         # Rows drawn since the last trail flush: (batch, first row, end row, force last row).
         self._pending: list[tuple[FrameBatch, int, int, bool]] = []
         self._frames_since_flush = 0
+        self._sent_traces = False  # by the last advance()
+        self._label_epoch = 0  # a layout begun before a change of it sends nothing
         self._look: Look = palette.DARK
         self.space = api.add_frame(root, show_axes=False)
         self.body_frame = api.add_frame(f"{root}/body", show_axes=False)
@@ -124,6 +127,7 @@ class PoinsotScene:
                 drawing.remove()
         added = elements - self._elements
         self._elements = elements
+        self._label_epoch += 1
         if self._geometry is not None:
             for element in sorted(added):
                 self._create(element).fit(self._geometry)
@@ -173,16 +177,24 @@ class PoinsotScene:
     def restyle(self, look: Look) -> None:
         """Draw in the colours, widths and label sizes of ``look`` (theme, projector)."""
         self._look = look
+        self._label_epoch += 1
         for drawing in self._drawings.values():
             drawing.restyle(look)
 
     def lay_out_labels(self, camera: Camera) -> dict[str, Placement]:
         """Place the labels of the shown elements for ``camera`` (see
         :mod:`poinsot.app.scene.labels`) and send what changed; returns the placements."""
-        frame, geometry = self._frame, self._geometry
+        return finish(self.label_steps(camera))
+
+    def label_steps(self, camera: Camera) -> Steps[dict[str, Placement]]:
+        """:meth:`lay_out_labels` in five steps, a ``yield`` between two (the labels' points,
+        the three of :func:`~poinsot.app.scene.labels.lay_out_in_steps`, the messages), so
+        that a caller resuming it once per frame spreads a layout over frames. A layout that
+        the scene outdates before its end (a new body, elements or look) sends nothing."""
+        frame, geometry, epoch = self._frame, self._geometry, self._label_epoch
         if frame is None or geometry is None:
             return {}
-        pose = Pose(rotation_from_wxyz(frame.wxyz), np.asarray(frame.contact), camera)
+        pose = Pose(rotation_from_wxyz(frame.wxyz).as_matrix(), np.asarray(frame.contact), camera)
         shown = [self._drawings[e] for e in LABEL_ORDER if self.is_visible(e)]
         slots = [slot for drawing in shown for slot in drawing.slots(pose)]
         markers = [(pose.contact, MARKER_RADIUS_PX)] if self.is_visible(Element.CONTACT) else []
@@ -194,7 +206,11 @@ class PoinsotScene:
             )
             if self.is_visible(element)
         ]
-        placements = lay_out(slots, camera, markers, arrows)
+        yield
+        placements = yield from lay_out_in_steps(slots, camera, markers, arrows)
+        yield
+        if epoch != self._label_epoch:
+            return {}
         for drawing in shown:
             drawing.place(placements)
         return placements
@@ -231,6 +247,7 @@ class PoinsotScene:
         batch = FrameBatch.convert(source, geometry.scale, sampler.stride)
         with self._atomic():
             self._body, self._geometry = body, geometry
+            self._label_epoch += 1
             self._sampler, self._batch = sampler, batch
             for element in sorted(self._elements):
                 drawing = self._drawings.get(element) or self._create(element)
@@ -248,6 +265,7 @@ class PoinsotScene:
         self._pending.clear()
         self._body = self._geometry = self._sampler = self._batch = None
         self._k_last, self._frame = None, None
+        self._label_epoch += 1
 
     def set_frame_time(self, frame_time: float) -> None:
         """The clock's speed changed: re-grid the motion from the time now shown."""
@@ -276,6 +294,7 @@ class PoinsotScene:
             raise RuntimeError("load() a body before advance()")
         k = sampler.index(float(t))
         last = self._k_last
+        self._sent_traces = False
         if k == last and self._frame is not None:
             if self._pending:  # the time stands still: complete the traces
                 with self._atomic():
@@ -326,6 +345,12 @@ class PoinsotScene:
         return frame
 
     @property
+    def sent_traces(self) -> bool:
+        """Whether the last frame drawn sent the traces (a frame heavier than most: other
+        periodic work, the labels' layout, waits for the next one)."""
+        return self._sent_traces
+
+    @property
     def traces_complete(self) -> bool:
         """Every trace point drawn so far has been sent (none wait for the next flush)."""
         return not self._pending
@@ -333,6 +358,7 @@ class PoinsotScene:
     def flush_trails(self) -> None:
         """Send the trace points gathered since the last flush."""
         if self._pending:
+            self._sent_traces = True
             for element, trail in self._trails.items():
                 parts = [b.trace(element, i, j, last) for b, i, j, last in self._pending]
                 points = parts[0] if len(parts) == 1 else np.concatenate(parts)

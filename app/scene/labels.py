@@ -26,14 +26,14 @@ Only anchors and these offsets change, and only when they do: a label rides on i
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
-from collections.abc import Sequence
+from collections.abc import Generator, Sequence
+from typing import TypeVar
 
 import numpy as np
-import viser
-from scipy.spatial.transform import Rotation
 
-from poinsot.app.scene import updates
+T = TypeVar("T")
 
 #: CSS pixels of a label's em at font scale 1 (viser's screen-size labels).
 EM_PX = 12.0
@@ -81,14 +81,15 @@ class Camera:
 
     def _compute_axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         forward = np.asarray(self.look_at, float) - np.asarray(self.position, float)
-        forward /= np.linalg.norm(forward)
-        right = np.cross(forward, self.up)
-        norm = np.linalg.norm(right)
+        forward /= math.sqrt(forward @ forward)
+        right = _cross(forward, np.asarray(self.up, float))
+        norm = math.sqrt(right @ right)
         if norm < 1e-9:  # looking along "up": any right angle will do
-            right = np.cross(forward, (1.0, 0.0, 0.0) if abs(forward[0]) < 0.9 else (0, 1.0, 0))
-            norm = np.linalg.norm(right)
+            other = (1.0, 0.0, 0.0) if abs(forward[0]) < 0.9 else (0.0, 1.0, 0.0)
+            right = _cross(forward, np.array(other))
+            norm = math.sqrt(right @ right)
         right /= norm
-        return forward, right, np.cross(right, forward)
+        return forward, right, _cross(right, forward)
 
     def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Screen positions (N, 2) [CSS px, y down] and depths (N,) of world points (N, 3)."""
@@ -106,6 +107,13 @@ class Camera:
         return 2.0 * depth * math.tan(0.5 * self.fov) / self.height
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b of two 3-vectors (``np.cross`` costs ten times as much on one pair)."""
+    (a0, a1, a2), (b0, b1, b2) = a.tolist(), b.tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
+@functools.lru_cache(maxsize=256)
 def box_size(text: str, scale: float) -> tuple[float, float]:
     """(width, height) [CSS px] of a one-line label's box at font scale ``scale``."""
     em = EM_PX * scale
@@ -154,24 +162,19 @@ def _overlap_costs(boxes: np.ndarray, placed: np.ndarray) -> np.ndarray:
 def _disc_costs(
     boxes: np.ndarray, centres: np.ndarray, radii: np.ndarray, weights: np.ndarray
 ) -> np.ndarray:
-    """The weighted reach of each candidate box (K, 4) into the discs (D): it does not depend
-    on the other labels, so every label's candidates are costed in one pass. A box farther
-    than a disc's radius from it along x or y cannot reach it (cost 0): only the boxes near
-    some disc get the exact sum."""
+    """The weighted reach of each candidate box (K, 4) into the discs (D): the sum over the
+    discs of weight x (radius + GAP_PX - distance from box to centre)^2 where positive. It
+    does not depend on the other labels, so every label's candidates are costed in one pass;
+    the root is taken only for the (few) pairs that touch."""
     cost = np.zeros(len(boxes))
-    if not len(centres):
-        return cost
-    cx, cy, limit = centres[None, :, 0], centres[None, :, 1], (radii + GAP_PX)[None, :]
-    near_x = (boxes[:, None, 0] - cx < limit) & (cx - boxes[:, None, 2] < limit)
-    near_y = (boxes[:, None, 1] - cy < limit) & (cy - boxes[:, None, 3] < limit)
-    rows = np.flatnonzero(np.any(near_x & near_y, axis=1))
-    if not len(rows):
-        return cost
-    near = boxes[rows]
-    nearest = np.minimum(np.maximum(centres[None], near[:, None, :2]), near[:, None, 2:])
-    gap = nearest - centres[None]
-    reach = radii[None, :] + GAP_PX - np.hypot(gap[..., 0], gap[..., 1])
-    cost[rows] = np.sum(weights[None, :] * np.maximum(reach, 0.0) ** 2, axis=1)
+    cx, cy = centres[:, 0], centres[:, 1]
+    dx = np.maximum(np.maximum(boxes[:, 0:1] - cx, cx - boxes[:, 2:3]), 0.0)
+    dy = np.maximum(np.maximum(boxes[:, 1:2] - cy, cy - boxes[:, 3:4]), 0.0)
+    limit = radii + GAP_PX
+    squared = dx * dx + dy * dy
+    rows, cols = np.nonzero(squared < limit * limit)
+    reach = limit[cols] - np.sqrt(squared[rows, cols])
+    np.add.at(cost, rows, weights[cols] * reach * reach)
     return cost
 
 
@@ -184,24 +187,29 @@ _ANCHOR_DIRECTIONS = np.array([[fx + 0.5, fy + 0.5] for fx, fy in ANCHORS.values
 _ANCHOR_DIRECTIONS /= np.linalg.norm(_ANCHOR_DIRECTIONS, axis=1)[:, None]
 
 
-def _ranked(direction: np.ndarray, current: str) -> list[str]:
-    """Anchors, the one whose box lies most along ``direction`` (screen) first; the current
-    anchor wins ties, so that a label does not flicker between equals."""
-    score = (-(_ANCHOR_DIRECTIONS @ direction)).tolist()
-    if current in _ANCHOR_INDEX:
-        score[_ANCHOR_INDEX[current]] -= 1e-3
-    # A stable sort of a few floats: Python's is much cheaper than numpy's on 8 elements.
-    return [_ANCHOR_NAMES[i] for i in sorted(range(len(score)), key=score.__getitem__)]
+def _ranked(direction: np.ndarray, current: Sequence[str]) -> np.ndarray:
+    """Per label, the anchors (N, 8; indices into _ANCHOR_NAMES), the one whose box lies most
+    along its ``direction`` (N, 2; screen) first; the ``current`` anchor wins ties, so that a
+    label does not flicker between equals."""
+    score = -(direction @ _ANCHOR_DIRECTIONS.T)
+    rows = [i for i, anchor in enumerate(current) if anchor in _ANCHOR_INDEX]
+    score[rows, [_ANCHOR_INDEX[current[i]] for i in rows]] -= 1e-3
+    return np.argsort(score, axis=1, kind="stable")
 
 
-def _outward(*candidates: np.ndarray) -> np.ndarray:
-    """The first screen direction (unit) longer than 2 px; up-right if there is none (an arrow
-    seen end-on)."""
-    for vector in candidates:
-        length = math.hypot(float(vector[0]), float(vector[1]))
-        if length > 2.0:
-            return vector / length
-    return np.array([math.sqrt(0.5), -math.sqrt(0.5)])
+#: A label's outward direction when its arrow is seen end-on: up-right (screen, y down).
+_UP_RIGHT = np.array([math.sqrt(0.5), -math.sqrt(0.5)])
+
+
+def _outward(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Per row (N, 2): the first of the two screen directions longer than 2 px, as a unit
+    vector; up-right where neither is (an arrow seen end-on)."""
+    out = np.tile(_UP_RIGHT, (len(first), 1))
+    for vector in (second, first):  # the first wins: written last
+        length = np.hypot(vector[:, 0], vector[:, 1])
+        long = length > 2.0
+        out[long] = vector[long] / length[long, None]
+    return out
 
 
 #: Points along an arrow that the boxes keep clear of.
@@ -217,13 +225,32 @@ PUSH_RINGS = 3
 
 @dataclasses.dataclass(frozen=True)
 class _Candidates:
-    """A label's places to try, best first: anchors, screen shifts (K, 2), boxes (K, 4)."""
+    """Every label's places to try, best first, K per label (N labels): the anchors (N, K;
+    indices into _ANCHOR_NAMES), the screen shifts of the label's point (N, K, 2), the boxes
+    (N, K, 4), and ``barred`` (N, K): +inf for the pushes of a label that may not move."""
 
-    slot: Slot
-    depth: float
-    anchors: list[str]
+    anchors: np.ndarray
     shifts: np.ndarray
     boxes: np.ndarray
+    barred: np.ndarray
+
+    @classmethod
+    def of(cls, slots: Sequence[Slot], screen: np.ndarray) -> _Candidates:
+        """The candidates of ``slots``, their point, tip and root on screen (N, 3, 2). Each
+        label is first pushed (:func:`_pushes`), then tries its anchors round its point,
+        those along its outward direction first (away from its arrow's root)."""
+        point, tip, root = screen[:, 0], screen[:, 1], screen[:, 2]
+        direction = _outward(tip - root, point - tip)
+        ranked = _ranked(direction, [slot.anchor for slot in slots])
+        pushes, push_anchors = _pushes(slots, point, tip, direction)
+        anchors = np.concatenate([push_anchors, ranked], axis=1)
+        shifts = np.concatenate([pushes, np.zeros((*ranked.shape, 2))], axis=1)
+        size = np.array([box_size(slot.text, slot.scale) for slot in slots])[:, None]
+        corner = point[:, None] + shifts + _FRACTIONS[anchors] * size
+        boxes = np.concatenate([corner, corner + size], axis=2)
+        barred = np.zeros(anchors.shape)
+        barred[[not slot.movable for slot in slots], : pushes.shape[1]] = np.inf
+        return cls(anchors, shifts, boxes, barred)
 
 
 def lay_out(
@@ -238,57 +265,109 @@ def lay_out(
 
     A candidate's cost is its overlap with the labels placed before it (LABEL_WEIGHT) plus its
     reach into the markers and arrows; the first candidate of cost 0 wins, else the cheapest.
-    The second part is the same whatever the order, so it is computed for all labels at once
-    and only the first is computed per label (a layout is a few numpy calls per label)."""
-    placed: dict[str, Placement] = {}
+    Every label's candidates are made, and their reach costed, in one pass of array
+    operations (:class:`_Candidates`); only the overlap with the labels placed before is a
+    step per label (:func:`_choose`)."""
+    return finish(lay_out_in_steps(slots, camera, markers, arrows))
+
+
+Steps = Generator[None, None, T]
+
+
+def lay_out_in_steps(
+    slots: Sequence[Slot],
+    camera: Camera,
+    markers: Sequence[tuple[np.ndarray, float]] = (),
+    arrows: Sequence[tuple[np.ndarray, np.ndarray, float]] = (),
+) -> Steps[dict[str, Placement]]:
+    """:func:`lay_out` in three steps, a ``yield`` between two: the candidates, their reach
+    into the markers and arrows, the choice. A caller that resumes it once per frame spreads
+    a layout over frames (:func:`finish` runs it at once)."""
     if not slots:
-        return placed
-    _, right, up = camera.axes()
+        return {}
     points = np.array([[slot.point, slot.tip, slot.root] for slot in slots], float)
     screen, depths = camera.project(points.reshape(-1, 3))
-    screen, depths = screen.reshape(-1, 3, 2), depths.reshape(-1, 3)
-    candidates = [
-        _candidates(slot, point, tip, root, float(depth))
-        for slot, (point, tip, root), depth in zip(slots, screen, depths[:, 0], strict=True)
-        if depth > 0
-    ]
-    if not candidates:
-        return placed
-    reach = _disc_costs(
-        np.concatenate([c.boxes for c in candidates]), *_discs(camera, markers, arrows)
-    )
-    placed_boxes: list[np.ndarray] = []
-    start = 0
-    for c in candidates:
-        cost = reach[start : start + len(c.boxes)]
-        start += len(c.boxes)
-        if placed_boxes:
-            cost = _overlap_costs(c.boxes, np.array(placed_boxes)) + cost
-        free = np.flatnonzero(cost == 0.0)
-        k = int(free[0]) if len(free) else int(np.argmin(cost))
-        shift = c.shifts[k] * camera.world_per_px(c.depth)
-        offset = shift[0] * right - shift[1] * up
-        box = c.boxes[k]
-        placed[c.slot.key] = Placement(
-            c.anchors[k],
-            offset,
-            (float(box[0]), float(box[1]), float(box[2]), float(box[3])),
-            float(cost[k]),
-        )
-        placed_boxes.append(box)
-    return placed
+    front = np.flatnonzero(depths[::3] > 0)
+    if not len(front):
+        return {}
+    shown = [slots[i] for i in front.tolist()]
+    c = _Candidates.of(shown, screen.reshape(-1, 3, 2)[front])
+    yield
+    cost = _disc_costs(c.boxes.reshape(-1, 4), *_discs(camera, markers, arrows))
+    cost = cost.reshape(c.boxes.shape[:2]) + c.barred
+    yield
+    chosen, costs = _choose(c.boxes, cost)
+    return _placements(shown, c, chosen, costs, camera, depths[::3][front])
 
 
-def _candidates(
-    slot: Slot, point: np.ndarray, tip: np.ndarray, root: np.ndarray, depth: float
-) -> _Candidates:
-    """The places to try for ``slot``, its point, tip and root on screen (see :func:`_options`)."""
-    direction = _outward(tip - root, point - tip)
-    anchors, shifts = _options(slot, point, tip, direction)
-    width, height = box_size(slot.text, slot.scale)
-    corner = point + shifts + _FRACTIONS[[_ANCHOR_INDEX[a] for a in anchors]] * (width, height)
-    boxes = np.concatenate([corner, corner + (width, height)], axis=1)
-    return _Candidates(slot, depth, anchors, shifts, boxes)
+def finish(steps: Steps[T]) -> T:
+    """Run ``steps`` to their end; their result."""
+    while True:
+        try:
+            next(steps)
+        except StopIteration as stop:
+            return stop.value
+
+
+def _choose(boxes: np.ndarray, reach: np.ndarray) -> tuple[list[int], list[float]]:
+    """Label by label, in order: the first candidate whose cost is 0, else the cheapest, a
+    candidate's cost being its ``reach`` (N, K) plus its overlap with the boxes (N, K, 4)
+    chosen before. Returns each label's chosen candidate and its cost.
+
+    A candidate of no reach is checked against the chosen boxes in plain floats, in order:
+    the usual label, free at its first or second try, costs no array operation. Only a label
+    with no free candidate costs them all (:func:`_overlap_costs`), to take the cheapest."""
+    box_rows, reach_rows = boxes.tolist(), reach.tolist()
+    chosen: list[int] = []
+    costs: list[float] = []
+    placed: list[list[float]] = []
+    for i, (row_boxes, row_reach) in enumerate(zip(box_rows, reach_rows, strict=True)):
+        free = (k for k, r in enumerate(row_reach) if r == 0.0 and _clear(row_boxes[k], placed))
+        k = next(free, -1)
+        cost = 0.0
+        if k < 0:
+            row = reach[i] + _overlap_costs(boxes[i], np.array(placed)) if placed else reach[i]
+            k = int(np.argmin(row))
+            cost = float(row[k])
+        chosen.append(k)
+        costs.append(cost)
+        placed.append(row_boxes[k])
+    return chosen, costs
+
+
+def _clear(box: list[float], placed: list[list[float]]) -> bool:
+    """Whether ``box`` overlaps none of the ``placed`` boxes, each grown by GAP_PX (as
+    :func:`_overlap_costs` would find it: a zero overlap; NaN is not clear)."""
+    x0, y0, x1, y1 = box
+    for p0, q0, p1, q1 in placed:
+        w = min(x1, p1) - max(x0, p0) + GAP_PX
+        h = min(y1, q1) - max(y0, q0) + GAP_PX
+        if not (w <= 0.0 or h <= 0.0 or w * h == 0.0):
+            return False
+    return True
+
+
+def _placements(
+    slots: Sequence[Slot],
+    c: _Candidates,
+    chosen: list[int],
+    costs: list[float],
+    camera: Camera,
+    depths: np.ndarray,
+) -> dict[str, Placement]:
+    """Each slot's chosen candidate as a :class:`Placement`: its screen shift turned into a
+    world offset in the screen plane at the label's depth."""
+    rows = np.arange(len(slots))
+    _, right, up = camera.axes()
+    world_per_px = 2.0 * depths * math.tan(0.5 * camera.fov) / camera.height
+    shift = c.shifts[rows, chosen] * world_per_px[:, None]
+    offsets = shift[:, :1] * right - shift[:, 1:] * up
+    boxes = c.boxes[rows, chosen].tolist()
+    anchors = c.anchors[rows, chosen].tolist()
+    return {
+        slot.key: Placement(_ANCHOR_NAMES[a], offset, tuple(box), cost)
+        for slot, a, offset, box, cost in zip(slots, anchors, offsets, boxes, costs, strict=True)
+    }
 
 
 def _discs(
@@ -298,19 +377,23 @@ def _discs(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Screen centres (D, 2), radii and weights of the discs the boxes keep clear of: the
     markers, and ARROW_SAMPLES points along each arrow (those in front of the camera)."""
-    points = [np.asarray(p, float) for p, _ in markers]
-    radii = [float(r) for _, r in markers]
-    weights = [MARKER_WEIGHT] * len(markers)
-    f = np.linspace(0.0, 1.0, ARROW_SAMPLES)[:, None]
-    for start, end, radius in arrows:
-        points.extend((1.0 - f) * np.asarray(start, float) + f * np.asarray(end, float))
-        radii += [float(radius)] * ARROW_SAMPLES
-        weights += [1.0] * ARROW_SAMPLES
-    if not points:
-        return np.zeros((0, 2)), np.zeros(0), np.zeros(0)
-    screen, depth = camera.project(np.array(points))
+    points = np.zeros((len(markers) + ARROW_SAMPLES * len(arrows), 3))
+    radii = np.empty(len(points))
+    weights = np.ones(len(points))
+    for i, (point, radius) in enumerate(markers):
+        points[i], radii[i], weights[i] = point, radius, MARKER_WEIGHT
+    if arrows:
+        ends = np.array([(start, end) for start, end, _ in arrows], float)
+        samples = (1.0 - _ALONG) * ends[:, None, 0] + _ALONG * ends[:, None, 1]
+        points[len(markers) :] = samples.reshape(-1, 3)
+        radii[len(markers) :] = np.repeat([radius for _, _, radius in arrows], ARROW_SAMPLES)
+    screen, depth = camera.project(points)
     front = depth > 0
-    return screen[front], np.array(radii)[front], np.array(weights)[front]
+    return screen[front], radii[front], weights[front]
+
+
+#: Where along an arrow its samples lie (fractions of its length, (ARROW_SAMPLES, 1)).
+_ALONG = np.linspace(0.0, 1.0, ARROW_SAMPLES)[:, None]
 
 
 #: The eight screen directions a movable label may be pushed in (y down).
@@ -327,27 +410,25 @@ def _anchor_towards(direction: np.ndarray) -> str:
     return f"{vertical}-{horizontal}"
 
 
-_DIRECTION_ANCHORS = [_anchor_towards(d) for d in _DIRECTIONS]
+#: The anchor of a push in each of those directions (indices into _ANCHOR_NAMES).
+_DIRECTION_ANCHORS = np.array([_ANCHOR_INDEX[_anchor_towards(d)] for d in _DIRECTIONS])
 _RINGS = np.arange(1, PUSH_RINGS + 1, dtype=np.float64)
 
 
-def _options(
-    slot: Slot, point: np.ndarray, tip: np.ndarray, direction: np.ndarray
-) -> tuple[list[str], np.ndarray]:
-    """The anchors and screen shifts of the point (K, 2) to try, best first. A fixed label
-    tries its anchors round its point, those along ``direction`` first; a movable one is first
-    pushed, at least ``clearance`` beyond its tip, in each of eight directions, the outward one
-    first (and up to PUSH_RINGS times as far)."""
-    ranked = _ranked(direction, slot.anchor)
-    if not slot.movable:
-        return ranked, np.zeros((len(ranked), 2))
-    reach = max(math.hypot(*(point - tip)), slot.clearance, 1.0)
-    score = (-(_DIRECTIONS @ direction)).tolist()
-    order = sorted(range(len(score)), key=score.__getitem__)  # stable, as np.argsort's
-    pushes = _RINGS[:, None, None] * reach * _DIRECTIONS[order][None, :, :]
-    pushes = pushes.reshape(-1, 2) + (tip - point)
-    anchors = [_DIRECTION_ANCHORS[i] for i in order] * PUSH_RINGS
-    return anchors + ranked, np.vstack([pushes, np.zeros((len(ranked), 2))])
+def _pushes(
+    slots: Sequence[Slot], point: np.ndarray, tip: np.ndarray, direction: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The shifts (N, PUSH_RINGS * 8, 2) of each label's point (N, 2) that push it at least
+    its clearance beyond its ``tip``, in each of eight directions, the one nearest its
+    outward ``direction`` first, and up to PUSH_RINGS times as far; and their anchors (N,
+    PUSH_RINGS * 8), each box lying on the far side of its push."""
+    gap = point - tip
+    clearance = np.array([slot.clearance for slot in slots])
+    reach = np.maximum(np.maximum(np.hypot(gap[:, 0], gap[:, 1]), clearance), 1.0)
+    order = np.argsort(-(direction @ _DIRECTIONS.T), axis=1, kind="stable")
+    pushes = _RINGS[None, :, None, None] * reach[:, None, None, None] * _DIRECTIONS[order][:, None]
+    pushes = pushes.reshape(len(slots), -1, 2) - gap[:, None]
+    return pushes, np.tile(_DIRECTION_ANCHORS[order], (1, PUSH_RINGS))
 
 
 def overlapping(boxes: Sequence[tuple[float, float, float, float]]) -> list[tuple[int, int]]:
@@ -359,86 +440,3 @@ def overlapping(boxes: Sequence[tuple[float, float, float, float]]) -> list[tupl
             if min(a[2], b[2]) > max(a[0], b[0]) and min(a[3], b[3]) > max(a[1], b[1]):
                 pairs.append((i, j))
     return pairs
-
-
-#: A movable label's position is resent only when it moved by more than this [display units].
-POSITION_TOLERANCE = 2e-3
-
-
-@dataclasses.dataclass(frozen=True)
-class Pose:
-    """What the labels' points depend on at a layout: the body's attitude (body -> space), the
-    contact point (world) and the camera."""
-
-    rotation: Rotation
-    contact: np.ndarray
-    camera: Camera
-
-
-class LabelNode:
-    """A label node of the scene, its own font scale, and the anchor and position the layout
-    last sent it (so that only changes are sent)."""
-
-    def __init__(self, handle: viser.LabelHandle, key: str, text: str, scale: float) -> None:
-        self.handle, self.key, self.text, self.scale = handle, key, text, float(scale)
-        self.look_scale = 1.0
-        self.anchor: str = handle.anchor
-        self.position = np.asarray(handle.position, dtype=np.float64)
-
-    def restyle(self, look_scale: float) -> None:
-        if look_scale != self.look_scale:
-            self.look_scale = look_scale
-            self.handle.font_screen_scale = self.scale * look_scale
-
-    def slot(
-        self,
-        point: np.ndarray,
-        tip: np.ndarray,
-        root: np.ndarray,
-        *,
-        movable: bool = False,
-        clearance: float = 0.0,
-    ) -> Slot:
-        """The layout's view of this label, its points in world coordinates."""
-        return Slot(
-            self.key,
-            self.text,
-            self.scale * self.look_scale,
-            np.asarray(point, float),
-            np.asarray(tip, float),
-            np.asarray(root, float),
-            movable,
-            clearance,
-            self.anchor,
-        )
-
-    def place(
-        self,
-        placement: Placement | None,
-        base: np.ndarray | None = None,
-        rotation: Rotation | None = None,
-    ) -> None:
-        """Send the placement's anchor and, given the label's ``base`` position in its frame,
-        that position plus the placement's offset (turned into the frame by ``rotation``, the
-        frame's attitude at the layout, for a label on the body), if they changed."""
-        if placement is None:
-            return
-        if placement.anchor != self.anchor:
-            self.anchor = placement.anchor
-            self.handle.anchor = placement.anchor  # type: ignore[assignment]
-        if base is not None:
-            offset = placement.offset
-            if rotation is not None:  # a world offset, into the body's coordinates
-                offset = rotation.apply(offset, inverse=True)
-            position = np.asarray(base, float) + offset
-            if np.max(np.abs(position - self.position)) > POSITION_TOLERANCE:
-                self.position = position
-                updates.set_position(self.handle, position)
-
-
-def screen_right_in_plane(pose: Pose) -> np.ndarray:
-    """The direction in the plane (x, y) that points right on the screen (the herpolhode's
-    label goes on that side of its ring: below it on screen runs ω's arrow)."""
-    _, right, _ = pose.camera.axes()
-    norm = float(np.linalg.norm(right[:2]))
-    return right[:2] / norm if norm > 1e-6 else np.array([1.0, 0.0])

@@ -16,7 +16,6 @@ from collections.abc import Callable
 
 import numpy as np
 import viser
-from scipy.spatial.transform import Rotation
 
 from poinsot.app.elements import Element
 from poinsot.app.scene import meshes, palette, updates
@@ -32,7 +31,8 @@ from poinsot.app.scene.geometry import (
     Geometry,
     triple,
 )
-from poinsot.app.scene.labels import LabelNode, Placement, Pose, Slot, screen_right_in_plane
+from poinsot.app.scene.label_nodes import LabelNode, Pose, screen_right_in_plane
+from poinsot.app.scene.labels import Placement, Slot
 from poinsot.app.scene.palette import Look
 from poinsot.app.scene.trail import Trail
 
@@ -142,7 +142,7 @@ class PrincipalAxes(Drawing):
             f"{root}/origin", radius=ORIGIN_RADIUS, color=palette.ORIGIN, cast_shadow=False
         )
         self.ends = np.zeros((3, 3))
-        self._rotation: Rotation | None = None  # the body's attitude at the last layout
+        self._attitude: np.ndarray | None = None  # the body's attitude at the last layout
         super().__init__([*self.lines, *self.labels, self.origin])
 
     def fit(self, geometry: Geometry) -> None:
@@ -161,8 +161,8 @@ class PrincipalAxes(Drawing):
         self.origin.color = look.origin
 
     def slots(self, pose: Pose) -> list[Slot]:
-        self._rotation = pose.rotation
-        tips = pose.rotation.apply(self.ends)
+        self._attitude = pose.attitude
+        tips = self.ends @ pose.attitude.T
         return [
             node.slot(
                 tip * (1.0 + BEYOND), tip, np.zeros(3), movable=True, clearance=BODY_CLEARANCE
@@ -172,7 +172,7 @@ class PrincipalAxes(Drawing):
 
     def place(self, placements: dict[str, Placement]) -> None:
         for node, end in zip(self.nodes, self.ends, strict=True):
-            node.place(placements.get(node.key), end * (1.0 + BEYOND), self._rotation)
+            node.place(placements.get(node.key), end * (1.0 + BEYOND), self._attitude)
 
 
 class InvariablePlane(Drawing):
@@ -389,7 +389,7 @@ class Trace(Drawing):
         self.point = np.zeros(3)  # the named point: on the polhode (body), on the ring (space)
         self.ring = (0.0, 0.0)  # herpolhode: the radius of its ring and the plane's height
         self._base = np.zeros(3)  # herpolhode: the label's point before the layout's push
-        self._rotation: Rotation | None = None  # polhode: the body's attitude at the layout
+        self._attitude: np.ndarray | None = None  # polhode: the body's attitude at the layout
 
     def fit(self, geometry: Geometry) -> None:
         if self.element is Element.POLHODE:  # a point of the curve, on the body
@@ -414,8 +414,8 @@ class Trace(Drawing):
 
     def slots(self, pose: Pose) -> list[Slot]:
         if self.element is Element.POLHODE:
-            self._rotation = pose.rotation
-            tip = pose.rotation.apply(self.point)
+            self._attitude = pose.attitude
+            tip = pose.attitude @ self.point
             radius = float(np.linalg.norm(tip))
             point = tip * (1.0 + BEYOND / radius) if radius > 0 else tip
             return [self.node.slot(point, tip, np.zeros(3), movable=True, clearance=BODY_CLEARANCE)]
@@ -429,7 +429,7 @@ class Trace(Drawing):
         if self.element is Element.POLHODE:
             radius = float(np.linalg.norm(self.point))
             base = self.point * (POLHODE_INFLATE + BEYOND / radius) if radius > 0 else self.point
-            self.node.place(placement, base, self._rotation)
+            self.node.place(placement, base, self._attitude)
         else:
             self.node.place(placement, self._base)
 
