@@ -10,7 +10,8 @@ view, and the labels' layout for the browser's camera.
   the left column folded (its strip opens it again) for a wide picture.
 - Labels: a few times a second the scene's labels are laid out for the camera the browser
   reports (:meth:`~poinsot.app.scene.construction.PoinsotScene.label_steps`), one step of the
-  layout per frame, on frames that send no traces: no frame carries a whole layout.
+  layout every other frame, on frames that send no traces: no frame carries a whole layout,
+  and the plot (which waits for a frame that carries neither) finds one between two steps.
 
 Frame thread only, except :meth:`Display.request`, which records a wish for the frame thread.
 """
@@ -42,8 +43,8 @@ PROJECTOR_TEXT_PERCENT = 150
 #: view: the boxes follow it), at most every LABEL_MIN_FRAMES frames; under a still camera,
 #: when only the time runs, LABEL_STILL_HZ and every LABEL_STILL_FRAMES frames at most (the boxes
 #: ride on their frames in between: only their anchors wait for the next layout); never for
-#: the same camera and time. A layout costs 1-2 ms, taken in five steps over as many frames
-#: (one at a time: the next layout begins once the last has ended), so a client whose frame
+#: the same camera and time. A layout costs 1-2 ms, taken in five steps, one every other frame
+#: (one layout at a time: the next begins once the last has ended), so a client whose frame
 #: rate is lowered (a busy server, a slow browser) gets fewer layouts too.
 LABEL_HZ = 6.0
 LABEL_MIN_FRAMES = 5
@@ -162,11 +163,12 @@ class Display:
                 view.fit(scene.geometry, self._attitude0(frame))
             view.advance(frame)
         self._frames_since_layout += 1
-        self.laid_out_now = False
+        stepped, self.laid_out_now = self.laid_out_now, False
         if self.session.scene.sent_traces:
             return  # this frame is heavier than most already: the labels wait for the next
         if self._steps is not None:
-            self._step()
+            if not stepped:  # every other frame: the plot finds one free between two steps
+                self._step()
             return
         if now < self._last_layout + 1.0 / LABEL_HZ or self._frames_since_layout < LABEL_MIN_FRAMES:
             return

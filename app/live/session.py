@@ -42,10 +42,12 @@ log = logging.getLogger(__name__)
 
 #: The animation rate cap per client [frames per second].
 MAX_FPS = 60.0
-#: Plot and time-readout refresh rates [Hz]: the plot resends its whole window.
+#: Plot and time-readout refresh rates [Hz]: the plot resends its whole window, at most every
+#: PLOT_MIN_FRAMES frames (12 Hz at 60 fps: a window that waits a frame for one not busy
+#: already still keeps up with the samples; fewer on a client whose frame rate is lowered).
 PLOT_HZ = 10.0
 TIME_HZ = 5.0
-PLOT_MIN_FRAMES = 6
+PLOT_MIN_FRAMES = 5
 #: "Step" advances this many wall seconds' worth of simulation time.
 STEP_SECONDS = 0.1
 #: While another session rebuilds, a due frame is held until the rebuild ends, for at most
@@ -274,29 +276,28 @@ class Session:
         return True
 
     _frames_since_plot = PLOT_MIN_FRAMES  # frames drawn since the plot was last sent
+    _plot_unsent = False  # a sample was recorded since
 
     def _refresh(self, now: float) -> None:
-        """After a frame: a plot sample at PLOT_HZ, the whole window sent at most every
-        PLOT_MIN_FRAMES frames, on a frame that is not busy already; the time readout (and
-        retired widgets) at TIME_HZ."""
+        """After a frame: a plot sample at PLOT_HZ; the whole window sent at most every
+        PLOT_MIN_FRAMES frames, on the first frame not busy already after a sample; the time
+        readout (and retired widgets) at TIME_HZ."""
         motion = self.panel.motion
         self._frames_since_plot += 1
         if now - self._last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
             self._last_plot = now
             motion.record_plot(self.frame.t, self.frame.omega)
-            if self._frames_since_plot >= PLOT_MIN_FRAMES and not self._busy_frame():
-                self._frames_since_plot = 0
-                motion.send_plot()
+            self._plot_unsent = True
+        busy = self.scene.sent_traces or self.lecture.display.laid_out_now  # a layout step
+        if self._plot_unsent and self._frames_since_plot >= PLOT_MIN_FRAMES and not busy:
+            self._frames_since_plot, self._plot_unsent = 0, False
+            motion.send_plot()
         if now - self._last_time >= 1.0 / TIME_HZ:
             self._last_time = now
             motion.show_time(self.frame.t if self.frame is not None else 0.0, self.clock.paused)
             self.retirement.collect(now)
         if self.showcase is not None and self.frame is not None:
             self.showcase.refresh(now, self.frame.t)  # its readouts and plots, at their rates
-
-    def _busy_frame(self) -> bool:
-        """This frame sent the traces or took a step of the labels' layout (the plot waits)."""
-        return self.scene.sent_traces or self.lecture.display.laid_out_now
 
     def _drain(self) -> None:
         if not len(self.actions):  # the usual frame
