@@ -57,7 +57,6 @@ _TEXT = (str, bytes)
 _COMPLEX = (complex, np.complexfloating)
 #: dtype kinds that hold real numbers.
 _REAL_KINDS = "iuf"
-_SEQUENCES = (list, tuple)
 _KIND_NAMES = {
     "b": "True/False values",
     "c": "complex numbers",
@@ -135,7 +134,7 @@ def real_array(value: object, name: str, expected: str = "real numbers") -> NDAr
     """
     if type(value) is np.ndarray and value.dtype == np.float64:
         return value
-    if type(value) in _SEQUENCES and all(type(x) is float for x in value):
+    if isinstance(value, list | tuple) and all(type(x) is float for x in value):
         return np.array(value, dtype=np.float64)  # plain floats, the usual input: none refused
     bad = _not_real(value)
     if bad is not None:

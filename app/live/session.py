@@ -43,8 +43,7 @@ log = logging.getLogger(__name__)
 #: The animation rate cap per client [frames per second].
 MAX_FPS = 60.0
 #: Plot and time-readout refresh rates [Hz]: the plot resends its whole window, at most every
-#: PLOT_MIN_FRAMES frames (12 Hz at 60 fps: a window that waits a frame for one not busy
-#: already still keeps up with the samples; fewer on a client whose frame rate is lowered).
+#: PLOT_MIN_FRAMES frames (12 Hz at 60 fps: a window that waits a frame still keeps up).
 PLOT_HZ = 10.0
 TIME_HZ = 5.0
 PLOT_MIN_FRAMES = 5

@@ -94,8 +94,8 @@ def test_the_D_slider_sweeps_the_family(make_app, make_probe):
     for D, family in ((2.3, "around the major axis"), (2.0, "separatrix")):
         probe.set_value(uuid, D)
         assert wait_until(lambda d=D: session.showcase.showcase.model.D == d, 10)
-        rows = wait_readouts(probe, spec.readouts)
         assert probe.wait_for(lambda p, f=family: wait_readouts(p, spec.readouts)["family"][0] == f)
+        rows = wait_readouts(probe, spec.readouts)  # the table that names the new family
         body = session.showcase.showcase.model.body
         assert body.D == pytest.approx(D, abs=1e-15)
         _, nodes = sent_at(session, probe, 1.0)
