@@ -147,6 +147,20 @@ def wait_until(predicate: Callable[[], bool], timeout: float = 10.0, poll: float
     return predicate()
 
 
+def record_messages(server) -> list:
+    """Every message ``server`` queues from now on (appended as it is queued)."""
+    sent: list = []
+    transport = server._websock_server
+    original = transport.queue_message
+
+    def queue_message(message) -> None:
+        sent.append(message)
+        original(message)
+
+    transport.queue_message = queue_message
+    return sent
+
+
 # -- browsers ------------------------------------------------------------------------------
 @pytest.fixture(scope="session")
 def chromium():

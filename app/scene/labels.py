@@ -32,6 +32,7 @@ from collections.abc import Generator, Sequence
 from typing import TypeVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 T = TypeVar("T")
 
@@ -102,9 +103,9 @@ class Camera:
         y = 0.5 * self.height - focal * (d @ up) / safe
         return np.stack([x, y], axis=1), depth
 
-    def world_per_px(self, depth: float) -> float:
-        """World length of one CSS pixel at ``depth`` (in the screen plane)."""
-        return 2.0 * depth * math.tan(0.5 * self.fov) / self.height
+    def world_per_px(self, depth: ArrayLike) -> np.ndarray:
+        """World length of one CSS pixel at ``depth`` (any shape; in the screen plane)."""
+        return 2.0 * np.asarray(depth, float) * math.tan(0.5 * self.fov) / self.height
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -359,8 +360,7 @@ def _placements(
     world offset in the screen plane at the label's depth."""
     rows = np.arange(len(slots))
     _, right, up = camera.axes()
-    world_per_px = 2.0 * depths * math.tan(0.5 * camera.fov) / camera.height
-    shift = c.shifts[rows, chosen] * world_per_px[:, None]
+    shift = c.shifts[rows, chosen] * camera.world_per_px(depths)[:, None]
     offsets = shift[:, :1] * right - shift[:, 1:] * up
     boxes = c.boxes[rows, chosen].tolist()
     anchors = c.anchors[rows, chosen].tolist()

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 import viser
-from conftest import session_of, wait_until
+from conftest import record_messages, session_of, wait_until
 
 from poinsot.app.live.session import PLOT_MIN_FRAMES
 from poinsot.app.parameters import Parameters
@@ -79,21 +79,12 @@ def test_the_reach_into_discs_is_the_sum_over_each_pair():
 def scene_and_sent():
     """A default scene on a server of its own, its body turning, and the messages it sends."""
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
-    sent: list = []
-    transport = server._websock_server
-    original = transport.queue_message
-
-    def queue_message(message) -> None:
-        sent.append(message)
-        original(message)
-
     try:
         scene = PoinsotScene(server.scene, DEFAULT_PRESET.elements, 48, atomic=server.atomic)
         body = Parameters.from_preset(DEFAULT_PRESET).build()
         scene.load(body, DEFAULT_PRESET.solid, frame_time=DEFAULT_PRESET.speed / 60.0)
         scene.advance(1.7)
-        transport.queue_message = queue_message  # type: ignore[method-assign]
-        yield scene, sent
+        yield scene, record_messages(server)
     finally:
         server.stop()
 

@@ -7,7 +7,7 @@ import collections
 import socket
 
 import viser
-from conftest import session_of, wait_until
+from conftest import record_messages, session_of, wait_until
 
 from poinsot.app.live.pacing import MAX_IN_FLIGHT, MAX_UNACKED, MIN_FPS, Pacer
 from poinsot.app.parameters import Parameters
@@ -88,20 +88,6 @@ def test_a_slow_client_gets_the_frames_it_takes():
     assert pacer.fps < 60.0
 
 
-def _record_messages(server: viser.ViserServer) -> list:
-    """Every message the server's scene queues (appended as it is queued)."""
-    sent: list = []
-    transport = server._websock_server
-    original = transport.queue_message
-
-    def queue_message(message) -> None:
-        sent.append(message)
-        original(message)
-
-    transport.queue_message = queue_message  # type: ignore[method-assign]
-    return sent
-
-
 def _target(message) -> tuple[str, str]:
     return type(message).__name__, str(getattr(message, "name", ""))
 
@@ -120,7 +106,7 @@ def test_a_frame_of_the_default_preset_sends_three_messages_and_traces_every_fou
         for _ in range(400):  # past the trails' first fill: 48 points each
             t += dt
             scene.advance(t)
-        sent = _record_messages(server)
+        sent = record_messages(server)
         per_frame = []
         for _ in range(10 * TRAIL_EVERY):
             t += dt
