@@ -11,10 +11,10 @@ scalar twins in plain floats, with the same operations and so the same bits.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial.transform import Rotation
 
 from poinsot.physics.closed_forms import ClosedForm, Columns, ScalarQuaternion
 from poinsot.physics.relabelling import AxisMap
@@ -39,21 +39,26 @@ class Evaluator:
         frame: the relabelling caller -> the form's internal body axes.
         w_exp: ``ω_ref = 2^w_exp`` [rad per time unit], the unit of the form's ω and rates.
         omega_s: (3,) the scaled ω0 ``ω0/ω_ref`` in the caller's axes.
-        attitude0: ``R(0)``, body -> space.
+        q_user: ``R(0)`` (body -> space) as a scalar-last quaternion, 4 floats.
 
     Attributes:
         out_of_range: why ω(t) cannot be returned in the caller's units, or None.
     """
 
     def __init__(
-        self, form: ClosedForm, frame: AxisMap, w_exp: int, omega_s: Array, attitude0: Rotation
+        self,
+        form: ClosedForm,
+        frame: AxisMap,
+        w_exp: int,
+        omega_s: Sequence[float],
+        q_user: Sequence[float],
     ) -> None:
         self.form, self.frame = form, frame
         self.w_exp = w_exp
         self.w_ref = math.ldexp(1.0, w_exp)
         self.out_of_range: str | None = None
         self._set_ranges()
-        self._anchor_at_zero(omega_s, attitude0)
+        self._anchor_at_zero(omega_s, q_user)
 
     def _set_ranges(self) -> None:
         """The ranges of the evaluation (scaled units): the phases rate·τ must stay finite, and
@@ -69,21 +74,20 @@ class Evaluator:
                 "time unit (then ω0 is a smaller number)"
             )
 
-    def _anchor_at_zero(self, omega_s: Array, attitude0: Rotation) -> None:
-        """Make ``omega(0)`` return ω0 and ``attitude(0)`` return ``attitude0``.
+    def _anchor_at_zero(self, omega_s: Sequence[float], q_user: Sequence[float]) -> None:
+        """Make ``omega(0)`` return ω0 and ``attitude(0)`` return ``R(0)``.
 
         The closed form reproduces ω0 only to O(eps · amplitude) (through u0 = F(φ0|m) and back
         through sn, cn, dn); adding the constant ω0 - f(0) makes omega(0) exact and changes no
         other value by more than that rounding. ``R_user(t) = S · R_int(t) · C`` with C the
-        relabelling and S fixed so that ``R_user(0) = attitude0``.
+        relabelling and S fixed so that ``R_user(0)`` is ``q_user``.
         """
         cols0, q0 = self.form.quat_scalar(0.0)
         user0 = self.frame.to_user_tuple(cols0)
-        self._anchor_t = tuple(float(omega_s[k]) - user0[k] for k in range(3))
+        self._anchor_t = tuple(omega_s[k] - user0[k] for k in range(3))
         self._anchor = np.array(self._anchor_t)
         self._anchored = any(self._anchor_t)  # exactly 0 for the uniform forms
         fq = self.frame.quat_tuple
-        q_user = tuple(attitude0.as_quat().tolist())
         self._q_space_t = hamilton(hamilton(q_user, conjugate(fq)), conjugate(q0))
 
     def omega(self, tau: Array) -> Array:

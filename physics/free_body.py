@@ -41,6 +41,7 @@ from poinsot.physics.regime import Regime
 from poinsot.physics.relabelling import sorting_map
 from poinsot.physics.rotations import rotate, rotate_vector
 from poinsot.physics.validation import (
+    IDENTITY_ATTITUDE,
     MAX_POINTS,
     check_attitude,
     check_count,
@@ -65,6 +66,7 @@ Array = NDArray[np.float64]
 _SLOWER = "use a shorter time unit (then ω0 and the rates are smaller numbers, the times larger)"
 _FASTER = "use a longer time unit (then ω0 and the rates are larger numbers, the times smaller)"
 _LARGER = "express the moments or ω0 in larger units"
+_IDENTITY_QUAT = (0.0, 0.0, 0.0, 1.0)
 
 
 class FreeRigidBody:
@@ -174,42 +176,50 @@ class FreeRigidBody:
         """Scale, classify, anchor; inputs checked. ``on_separatrix``: see :meth:`from_energy`."""
         self.inertia, self.omega0, self.attitude0 = inertia, omega0, attitude0
         check_moment_span(inertia)
+        moments, w_user = inertia.tolist(), omega0.tolist()
         # Exact power-of-two scaling: moments and ω near 1 whatever the caller's units.
-        self._I_exp = math.frexp(max(inertia.tolist()))[1] - 1
+        self._I_exp = math.frexp(max(moments))[1] - 1
         self._I_ref = math.ldexp(1.0, self._I_exp)
-        w_max = max(abs(x) for x in omega0.tolist())
+        w_max = max(map(abs, w_user))
         self._w_exp = math.frexp(w_max)[1] - 1 if w_max > 0.0 else 0
         self._w_ref = math.ldexp(1.0, self._w_exp)
-        inertia_s = inertia / self._I_ref
-        omega_s = omega0 / self._w_ref  # a component 1e308 times below the largest is lost
-        sort = sorting_map(inertia)
+        inertia_s = tuple(x / self._I_ref for x in moments)
+        omega_s = tuple(x / self._w_ref for x in w_user)  # 1e308 below the largest is lost
+        sort = sorting_map(moments)
         state = SortedState(
             sort=sort,
-            J=sort.to_internal(inertia_s) * sort.sign,  # moments are not signed
-            w=sort.to_internal(omega_s),
-            w_exact=sort.to_internal(omega0),  # unscaled: exact zeros, signs and integers
+            J=sort.to_internal_tuple(inertia_s, signed=False),
+            w=sort.to_internal_tuple(omega_s),
+            w_exact=sort.to_internal_tuple(w_user),  # unscaled: exact zeros, signs, integers
             inertia=inertia_s,
             omega=omega_s,
             omega_user=omega0,
             w_exp=self._w_exp,
         )
-        on_separatrix = on_separatrix and bool(np.all(state.w_exact[[0, 2]] != 0.0))
+        on_separatrix = on_separatrix and state.w_exact[0] != 0.0 and state.w_exact[2] != 0.0
         motion = classify(state, on_separatrix)
         self.regime, self._form = motion.regime, motion.form
         self.parameter = motion.form.parameter
         self.complementary_parameter = motion.form.complementary_parameter
-        self._eval = Evaluator(motion.form, motion.frame, self._w_exp, omega_s, attitude0)
-        self._set_invariants(state)
+        # The identity (attitude0 None), the usual start, needs no scipy call.
+        identity = attitude0 is IDENTITY_ATTITUDE
+        q_user = _IDENTITY_QUAT if identity else attitude0.as_quat().tolist()
+        self._eval = Evaluator(motion.form, motion.frame, self._w_exp, omega_s, q_user)
+        self._set_invariants(state, identity)
 
-    def _set_invariants(self, s: SortedState) -> None:
+    def _set_invariants(self, s: SortedState, identity: bool) -> None:
         """D, the invariable plane, 2T and L in the scaled units, read back by exact powers of
         two: they over/underflow only where the physical value itself is out of double range,
         and an overflowing one raises a ValueError when it is read (see :func:`_in_units`)."""
-        m = s.J * s.w
-        G = math.hypot(*m.tolist())  # m·m would underflow for a moment ~1e-300
-        two_T = float(s.w @ m)
-        self._L_scaled = self.attitude0.apply(s.inertia * s.omega)
-        self._two_T_scaled = float(s.omega @ (s.inertia * s.omega))
+        (J1, J2, J3), (w1, w2, w3) = s.J, s.w
+        m = (J1 * w1, J2 * w2, J3 * w3)
+        G = math.hypot(*m)  # m·m would underflow for a moment ~1e-300
+        # The dot products as numpy takes them (its summation order, kept bit for bit).
+        two_T = float(np.array(s.w) @ np.array(m))
+        m_user = np.array([i * x for i, x in zip(s.inertia, s.omega, strict=True)])
+        self._L_scaled = m_user if identity else self.attitude0.apply(m_user)
+        L = self._L_scaled.tolist()
+        self._two_T_scaled = float(np.array(s.omega) @ m_user)
         self._inertia_scaled = s.inertia
         if self.regime is Regime.REST:
             self.D = 0.0
@@ -218,16 +228,16 @@ class FreeRigidBody:
             return
         # D = G²/2T lies in [min I, max I]; on the separatrix it is I2 exactly (Δ2 = 0).
         if self.regime is Regime.SEPARATRIX:
-            scaled_D = float(s.J[1])
+            scaled_D = J2
         else:
             # In [min J, max J] exactly, not just to rounding: one ulp above the largest
             # moment 1.8e308 would read back as inf.
             ratio = G * (G / two_T) if two_T > 0 else 0.0
-            scaled_D = min(max(ratio, float(s.J.min())), float(s.J.max()))
+            scaled_D = min(max(ratio, J1), J3)  # J sorted ascending
         self.D = scaled_D * self._I_ref
         self._plane_distance_scaled = two_T / G  # 2T/G <= |ω|: may pass 1.8e308 with |ω|
-        G_space = math.hypot(*self._L_scaled.tolist())  # no underflow of G² for moments ~1e-300
-        self.plane_normal = self._L_scaled / G_space
+        G_space = math.hypot(*L)  # no underflow of G² for moments ~1e-300
+        self.plane_normal = np.array([x / G_space for x in L])
 
     @overload
     def omega(self, t: float) -> Vector: ...
@@ -343,7 +353,7 @@ class FreeRigidBody:
         [rad per time unit]."""
         # From the scaled state (2T/I_i = w_ref² · 2T_s/I_s,i): no underflow at ω ~ 1e-200.
         return _vector_in_units(
-            np.sqrt(self._two_T_scaled / self._inertia_scaled),
+            np.sqrt(self._two_T_scaled / np.array(self._inertia_scaled)),
             self._w_exp,
             "the largest semi-axis of the energy ellipsoid",
         )

@@ -9,6 +9,7 @@ Euler's equations change sign [LL76 §36, Eq. 36.5], so one axis is reversed to 
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,6 +49,16 @@ class AxisMap:
         """(..., 3) user components -> internal components."""
         return self.sign * x[..., self.index]
 
+    def to_internal_tuple(
+        self, x: Sequence[float], signed: bool = True
+    ) -> tuple[float, float, float]:
+        """:meth:`to_internal` for one vector of plain floats (the same operations);
+        ``signed=False`` only permutes (moments, which a reversed axis leaves as they are)."""
+        (i0, s0), (i1, s1), (i2, s2) = self.pairs
+        if not signed:
+            return (x[i0], x[i1], x[i2])
+        return (s0 * x[i0], s1 * x[i1], s2 * x[i2])
+
     def to_user_columns(self, cols: tuple[NDArray[np.float64], ...]) -> NDArray[np.float64]:
         """Stack internal components ``cols[k]`` (each (N,)) into user-order (N, 3)."""
         if self.identity:
@@ -84,9 +95,9 @@ def axis_map(index: tuple[int, ...], sign: tuple[float, ...]) -> AxisMap:
     return AxisMap(index, sign)
 
 
-def sorting_map(inertia: NDArray[np.float64]) -> AxisMap:
+def sorting_map(inertia: Sequence[float] | NDArray[np.float64]) -> AxisMap:
     """Proper relabelling that sorts the moments ascending (an odd permutation flips axis 1)."""
-    values = inertia.tolist()
+    values = inertia.tolist() if isinstance(inertia, np.ndarray) else list(inertia)
     order = tuple(sorted(range(3), key=values.__getitem__))  # stable, as argsort(kind="stable")
     inversions = sum(order[i] > order[j] for i in range(3) for j in range(i + 1, 3))
     parity = -1.0 if inversions % 2 else 1.0  # an odd permutation gets axis 1 reversed

@@ -261,10 +261,15 @@ def check_moment_span(inertia: NDArray[np.float64]) -> None:
         )
 
 
+#: The identity attitude, one shared instance (a single Rotation cannot be changed in place).
+IDENTITY_ATTITUDE = Rotation.identity()
+
+
 def check_attitude(value: object, name: str = "attitude0") -> Rotation:
-    """One scipy Rotation (body -> space) with a finite quaternion; ``None`` is the identity."""
+    """One scipy Rotation (body -> space) with a finite quaternion; ``None`` is the identity
+    (:data:`IDENTITY_ATTITUDE`)."""
     if value is None:
-        return Rotation.identity()
+        return IDENTITY_ATTITUDE
     if not isinstance(value, Rotation) or not value.single:
         raise ValueError(f"{name} must be one scipy Rotation (body -> space) or None")
     if not all(map(math.isfinite, value.as_quat().tolist())):

@@ -54,11 +54,10 @@ class Separatrix:
     The internal space frame has ``e_z ∥ L`` (Z-X-Z angles, as the triaxial form).
     """
 
-    def __init__(self, J: Array, exact: ExactState) -> None:
-        J1, J2, J3 = (float(x) for x in J)
+    def __init__(self, J: Triple, exact: ExactState) -> None:
+        J1, J2, J3 = J
         n1, n2, n3 = exact.Jn
         self.J = J
-        self.J_tuple = (J1, J2, J3)
         self.A = exact.amplitudes()
         # λ² = (J3-J2)Δ1/(J1 J2 J3), rounded once from the exact data (as the triaxial form).
         self.lam = sqrt_ratio(*exact.lam_squared())
@@ -113,7 +112,7 @@ class Separatrix:
         phi = self.precession.reduce_scalar(tau)[0] + self.amp * (
             float(np.arctan(self.a * th)) - self.atan0
         )
-        J1, J2, J3 = self.J_tuple
+        J1, J2, J3 = self.J
         psi = float(np.arctan2((self.s1 * self.k_psi) * sech, th))
         return w, zxz_from_momentum_scalar(J1 * w[0], J2 * w[1], J3 * w[2], self.G, phi, psi)
 

@@ -132,7 +132,7 @@ def _slow_rate(
 
 
 def _initial_phase(
-    w: Array,
+    w: Triple,
     A: Triple,
     exact: ExactState,
     par: elliptic.JacobiParameter,
@@ -147,7 +147,7 @@ def _initial_phase(
     ratio is still O(1).
     """
     if min(A[0], A[1]) > _NORMAL_AMPLITUDE:
-        sn0, cn0 = float(w[1]) / A[1], float(w[0]) / A[0]
+        sn0, cn0 = w[1] / A[1], w[0] / A[0]
     else:
         sn0 = exact.sign(1) * sqrt_ratio(*exact.unit_ratio_sq(1))
         cn0 = exact.sign(0) * sqrt_ratio(*exact.unit_ratio_sq(0))
@@ -207,10 +207,9 @@ class Triaxial:
     :mod:`~poinsot.physics.closed_forms.euler_angles`.
     """
 
-    def __init__(self, J: Array, w: Array, exact: ExactState) -> None:
-        J1, J2, J3 = (float(x) for x in J)
+    def __init__(self, J: Triple, w: Triple, exact: ExactState) -> None:
+        J1, J2, J3 = J
         self.J = J
-        self.J_tuple = (J1, J2, J3)
         # Exact square roots of exact ratios: a spin a hair off an axis (Δ ~ 1e-600) still
         # gets its amplitude ~1e-300.
         self.A = exact.amplitudes()
@@ -237,7 +236,7 @@ class Triaxial:
 
     def _init_precession(self, exact: ExactState, c: _Constants) -> None:
         """The constants of φ [LL76 §37, Eq. 37.16] and of the slow angle χ = φ + sψ."""
-        J1, _, J3 = self.J_tuple
+        J1, _, J3 = self.J
         n1, n2, n3 = exact.Jn
         K = self.par.K
         self.G = exact.G_float()
@@ -331,7 +330,7 @@ class Triaxial:
         r, sign, sn, cn, dn = self._reduced_scalar(tau)
         A1, A2, A3 = self.A
         w = (A1 * sign * cn, A2 * sign * sn, (self.s * A3) * dn)
-        J1, J2, J3 = self.J_tuple
+        J1, J2, J3 = self.J
         P = elliptic.periodic_third_kind_scalar(self.pp, self.par, r, sn, cn, dn)
         psi_r = float(np.arctan2(self.k_psi * cn, sn))
         chi = (
