@@ -164,13 +164,13 @@ def run(clients: int, seconds: float = 5.0, redraws: int = 30) -> Result:
             s.stats.frame_seconds.clear()
             s.stats.frame_cpu_seconds.clear()
         frames0 = {id(s): s.stats.frames for s in sessions}
-        skipped0 = sum(s.stats.skipped for s in sessions)
+        skipped0 = sum(s.pacer.stats.skipped for s in sessions)
         cpu0, wall0 = time.process_time(), time.perf_counter()
         parent.send("go")
         kind, traffic = parent.recv()
         cpu1, wall1 = time.process_time(), time.perf_counter()
         frames = {id(s): s.stats.frames - frames0[id(s)] for s in sessions}
-        skipped = sum(s.stats.skipped for s in sessions) - skipped0
+        skipped = sum(s.pacer.stats.skipped for s in sessions) - skipped0
         total_frames = sum(frames.values())
         frame_walls = [x for s in sessions for x in s.stats.frame_seconds]
         frame_cpus = [x for s in sessions for x in s.stats.frame_cpu_seconds]

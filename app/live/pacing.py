@@ -209,9 +209,8 @@ class SessionStats:
     rebuild_seconds: collections.deque = dataclasses.field(
         default_factory=lambda: collections.deque(maxlen=500)
     )
+    #: Frames drawn (those the browser was not ready for are the pacer's ``stats.skipped``).
     frames: int = 0
-    #: Frames not drawn because the browser had not taken the ones before (pacing).
-    skipped: int = 0
     rebuilds: int = 0
     errors: int = 0
     last_error: str = ""

@@ -265,7 +265,6 @@ class Session:
         """Draw a frame, unless the browser has not yet taken the one before (:class:`Pacer`:
         skipped, the rate lowered). A frame's messages go out at once, in one atomic window."""
         if not self.pacer.may_draw():
-            self.stats.skipped += 1
             return False
         with self.client.atomic():
             self._advance()

@@ -29,7 +29,7 @@ def _stalled(app: PoinsotApp, make_probe, skips: int = 20) -> tuple[Probe, Sessi
     slow._ws.socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
     assert wait_until(lambda: fast_session.stats.frames > 10, 30)
     slow.stall()
-    assert wait_until(lambda: slow_session.stats.skipped >= skips, 120)
+    assert wait_until(lambda: slow_session.pacer.stats.skipped >= skips, 120)
     return slow, slow_session, fast, fast_session
 
 

@@ -146,10 +146,10 @@ def test_a_stalled_client_gets_fewer_frames_and_a_bounded_queue(poinsot_app, mak
     slow._ws.socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)  # fills sooner
     assert wait_until(lambda: fast_session.stats.frames > 10, 30)
     slow.stall()
-    assert wait_until(lambda: slow_session.stats.skipped > 20, 120)  # the socket filled
+    assert wait_until(lambda: slow_session.pacer.stats.skipped > 20, 120)  # the socket filled
     outbox = slow_session.pacer.outbox
     skipped, f_slow, f_fast = (
-        slow_session.stats.skipped,
+        slow_session.pacer.stats.skipped,
         slow_session.stats.frames,
         fast_session.stats.frames,
     )
@@ -163,6 +163,6 @@ def test_a_stalled_client_gets_fewer_frames_and_a_bounded_queue(poinsot_app, mak
 
     assert wait_until(measured, 120, poll=0.005)
     assert slow_session.stats.frames - f_slow < 20  # fewer than a sixth of the other's
-    assert slow_session.stats.skipped > skipped  # its loop goes on, skipping
+    assert slow_session.pacer.stats.skipped > skipped  # its loop goes on, skipping
     assert slow_session.pacer.fps < slow_session.max_fps
     assert most_pending <= 16 * (MAX_IN_FLIGHT + 1)  # a few frames' messages, never more
