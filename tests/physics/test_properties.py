@@ -166,6 +166,24 @@ def test_initial_state(case) -> None:
 
 @SETTINGS
 @given(bodies(), TAUS)
+def test_no_attitude_is_the_identity_bit_for_bit(case, taus) -> None:
+    """``attitude0=None`` takes a shortcut (no scipy call for the identity); a Rotation that
+    is the identity, made by the caller, takes the general path: the same bits everywhere."""
+    inertia, omega0, _ = case
+    short = FreeRigidBody(inertia=inertia, omega0=omega0)
+    general = FreeRigidBody(inertia=inertia, omega0=omega0, attitude0=Rotation.identity())
+    t = _times(short, taus) if np.any(omega0 != 0) else np.array(taus)
+    for name in ("omega", "contact_point"):
+        assert np.array_equal(getattr(short, name)(t), getattr(general, name)(t)), name
+        assert np.array_equal(getattr(short, name)(t[-1]), getattr(general, name)(t[-1])), name
+    assert np.array_equal(short.attitude(t).as_quat(), general.attitude(t).as_quat())
+    for name in ("angular_momentum", "plane_normal", "semi_axes"):
+        assert np.array_equal(getattr(short, name), getattr(general, name)), name
+    assert (short.D, short.energy) == (general.D, general.energy)
+
+
+@SETTINGS
+@given(bodies(), TAUS)
 def test_kinematics_finite_differences(case, taus) -> None:
     """dR/dt = R [omega]x (body-frame angular velocity), by a 4th-order central difference."""
     inertia, omega0, rot0 = case
