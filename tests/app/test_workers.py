@@ -88,6 +88,12 @@ def _read_lines(stream, into: list[str]) -> None:
 def start_classroom(*args: str, workers: int = 2) -> Classroom:
     """``poinsot serve --workers N --port 0 ARGS`` in a child; wait until it announces its
     workers (it prints the landing's URL first)."""
+    # A test run started in the background by a script has SIGINT ignored, and a child would
+    # inherit that: Python then never turns SIGINT into KeyboardInterrupt, and the classroom
+    # would sit out stop_classroom's SIGINT for its whole minute. A handled SIGINT is reset to
+    # the default in the child.
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     process = subprocess.Popen(
         [sys.executable, "-m", "poinsot.app", "serve", "--workers", str(workers), "--port", "0"]
         + list(args),
