@@ -84,6 +84,10 @@ class LectureControls:
         self.client = session.client
         self.render_timeout = float(render_timeout)
         self.camera = "default"
+        # A view chosen in the browser (viser's thread) and the frame thread's ride-along step
+        # each check the view and send the camera under this lock, so that a ride-along camera
+        # computed before a new view was chosen is never sent after it.
+        self._camera_lock = threading.Lock()
         self._render_lock = threading.Lock()
         self.last_download: str = ""  # name of the last file handed to the browser
         with self.client.gui.add_folder("Lecture: views and export", order=order):
@@ -204,13 +208,14 @@ class LectureControls:
         """Move this browser's camera to a view; "ride-along" rides along from now on."""
         if name not in CAMERA_NAMES:
             raise ValueError(f"no camera view {name!r}")
-        self.camera = name
-        if name == RIDE_ALONG:
-            frame = self.session.frame
-            if frame is not None:
-                self._apply(ride_along(BODY_VIEW, frame.wxyz))
-            return
-        self._apply(space_view(name))
+        with self._camera_lock:
+            self.camera = name
+            if name == RIDE_ALONG:
+                frame = self.session.frame
+                if frame is not None:
+                    self._apply(ride_along(BODY_VIEW, frame.wxyz))
+                return
+            self._apply(space_view(name))
 
     def _apply(self, view: View) -> None:
         with self.client.atomic():
@@ -219,8 +224,9 @@ class LectureControls:
     def on_frame(self, frame: Frame) -> None:
         """Per frame (the session's frame thread): carry the ride-along camera, and the
         display's work (a style asked for, the body-frame view, the labels' layout)."""
-        if self.camera == RIDE_ALONG:
-            self._apply(ride_along(BODY_VIEW, frame.wxyz))
+        with self._camera_lock:
+            if self.camera == RIDE_ALONG:
+                self._apply(ride_along(BODY_VIEW, frame.wxyz))
         self.display.on_frame(frame, time.monotonic())
 
     # -- theme ---------------------------------------------------------------------------

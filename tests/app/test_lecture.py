@@ -134,3 +134,45 @@ def test_hotkeys_and_views_are_registered(live):
         "V": "Two views",
     }
     assert probe.has_widget("Camera") and probe.has_widget("Dark theme")
+
+
+def test_a_view_chosen_during_a_ride_along_frame_is_the_last_camera_sent(live, monkeypatch):
+    """Key 3 pressed (viser's thread) while the frame thread is between its ride-along check
+    and sending that camera: the chosen view must still be the last camera the browser gets
+    (it was not: the ride-along camera landed after it and the browser stayed on the ride)."""
+    from poinsot.app.live import lecture as lecture_module
+    from poinsot.app.scene.cameras import space_view
+
+    _, _, session = live
+    controls = lecture_of(session)
+    sent: list = []
+    apply = controls._apply
+    monkeypatch.setattr(controls, "_apply", lambda view: (sent.append(view), apply(view)))
+    inside, release = threading.Event(), threading.Event()
+    ride_along = lecture_module.ride_along
+    stepping: threading.Thread | None = None  # this test's frame step, once started
+
+    def slow_ride_along(view, q):
+        if threading.current_thread() is stepping:  # this test's frame step only
+            inside.set()
+            release.wait(10)
+        return ride_along(view, q)
+
+    monkeypatch.setattr(lecture_module, "ride_along", slow_ride_along)
+    controls.set_camera("ride-along")
+    frame = session.frame
+    chooser = threading.Thread(target=controls.set_camera, args=("side",))
+
+    def frame_step() -> None:
+        controls.on_frame(frame)
+
+    stepping = threading.Thread(target=frame_step)
+    stepping.start()
+    assert inside.wait(10)  # the frame step has checked the view and computes its camera
+    chooser.start()
+    chooser.join(0.5)  # bounded: with the lock it waits for the frame step
+    release.set()
+    stepping.join(10)
+    chooser.join(10)
+    assert controls.camera == "side"
+    assert np.allclose(sent[-1].position, space_view("side").position), sent[-1]
