@@ -3,7 +3,8 @@
 ``poinsot`` serves the live app; ``report``, ``screenshot``, ``export-html``, ``benchmark`` and
 ``fit`` (the exact free motion fitted to a gyroscope recording) are the offline commands.
 
-Every option of every command is declared here (:func:`build_parser`). Each subcommand sets
+Every option of every command is declared here (:func:`build_parser`), with the converters of
+:mod:`poinsot.app.cli_types`. Each subcommand sets
 ``func``, its implementation, which takes its options as plain typed keyword arguments named
 as its parameters (the parser's ``type=`` converters turn the text into values) and returns
 the exit code.
@@ -14,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import inspect
-import math
 import os
 import pathlib
 import sys
@@ -33,11 +33,19 @@ from poinsot.app.arguments import (
     positive_int,
     run_guarded,
 )
+from poinsot.app.cli_types import (
+    fixed_view_type,
+    preset_type,
+    scene_only_type,
+    scene_type,
+    seconds_type,
+    size_type,
+    view_type,
+)
 from poinsot.app.exports.html import HTML_FPS, HTML_MAX_SECONDS
-from poinsot.app.exports.screenshot import parse_size, resolve_scene
 from poinsot.app.presets import PRESETS, Preset, preset_by_key
-from poinsot.app.scene.cameras import CAMERA_NAMES, RIDE_ALONG, canonical
-from poinsot.app.scenes import scene_by_name, scene_names
+from poinsot.app.scene.cameras import CAMERA_NAMES, RIDE_ALONG
+from poinsot.app.scenes import scene_names
 from poinsot.app.scenes.spec import SceneSpec
 
 DESCRIPTION = "Poinsot: torque-free rigid-body motion, live in the browser and offline."
@@ -55,63 +63,6 @@ class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
 
 class CommandParser(OneLineParser):
     """A command's parser: a bad option is one line on stderr (exit status 2)."""
-
-
-# -- converters (text -> value; a readable error for argparse) ------------------------------
-def _preset(key: str) -> Preset:
-    try:
-        return preset_by_key(key)
-    except KeyError as exc:
-        raise argparse.ArgumentTypeError(exc.args[0]) from exc
-
-
-def _scene(name: str) -> Preset | SceneSpec:
-    try:
-        return resolve_scene(name)
-    except KeyError as exc:
-        raise argparse.ArgumentTypeError(exc.args[0]) from exc
-
-
-def _scene_only(name: str) -> SceneSpec:
-    try:
-        return scene_by_name(name)
-    except KeyError as exc:
-        raise argparse.ArgumentTypeError(exc.args[0]) from exc
-
-
-def _seconds(text: str) -> float:
-    """A time in seconds: a finite number."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds")
-    return value
-
-
-def _view(text: str) -> str:
-    """A camera view's name (:data:`~poinsot.app.scene.cameras.CAMERA_NAMES`, the words of the
-    browser's buttons; the older "top" and "body" are still understood)."""
-    try:
-        return canonical(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from exc
-
-
-def _fixed_view(text: str) -> str:
-    """A camera view that stands still (an HTML page's initial camera)."""
-    view = _view(text)
-    if view == RIDE_ALONG:
-        raise argparse.ArgumentTypeError("a page starts from a fixed view, not ride-along")
-    return view
-
-
-def _size(text: str) -> tuple[int, int]:
-    try:
-        return parse_size(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from exc
 
 
 # -- the commands ---------------------------------------------------------------------------
@@ -275,7 +226,7 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
     which.add_argument(
         "--scene",
         dest="start_scene",
-        type=_scene_only,
+        type=scene_only_type,
         default=None,
         metavar="{" + ",".join(scene_names()) + "}",
         help="or the scene each new browser starts with",
@@ -299,14 +250,14 @@ def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
     which.add_argument(
         "--preset",
         dest="scene",
-        type=_preset,
+        type=preset_type,
         default=PRESETS[0].key,
         metavar=keys,
         help="preset to draw",
     )
     which.add_argument(
         "--scene",
-        type=_scene,
+        type=scene_type,
         metavar="NAME",
         help="a scene by name ("
         + ", ".join(scene_names())
@@ -320,10 +271,12 @@ def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="simulation time of the picture (default: one period of omega)",
     )
-    parser.add_argument("--size", type=_size, default="1920x1080", help="WIDTHxHEIGHT in pixels")
+    parser.add_argument(
+        "--size", type=size_type, default="1920x1080", help="WIDTHxHEIGHT in pixels"
+    )
     parser.add_argument(
         "--view",
-        type=_view,
+        type=view_type,
         default="default",
         metavar="{" + ",".join(CAMERA_NAMES) + "}",
         help="camera, as the browser's buttons name it: the scene's default view, along L "
@@ -349,12 +302,12 @@ def _add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
     keys = "{" + ",".join(p.key for p in PRESETS) + "}"
     which = parser.add_mutually_exclusive_group()
     which.add_argument(
-        "--preset", type=_preset, default=PRESETS[0].key, metavar=keys, help="preset to record"
+        "--preset", type=preset_type, default=PRESETS[0].key, metavar=keys, help="preset to record"
     )
     which.add_argument(
         "--scene",
         dest="preset",
-        type=_scene,
+        type=scene_type,
         metavar="NAME",
         help="or a scene to record: " + ", ".join(scene_names()),
     )
@@ -369,7 +322,7 @@ def _add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--view",
-        type=_fixed_view,
+        type=fixed_view_type,
         default="default",
         metavar="{" + ",".join(v for v in CAMERA_NAMES if v != RIDE_ALONG) + "}",
         help="initial camera, as the browser's buttons name it (the viewer can still orbit)",
@@ -400,10 +353,10 @@ def _add_fit_arguments(parser: argparse.ArgumentParser) -> None:
         help="a phyphox export (folder or .zip) or a CSV of t, ωx, ωy, ωz",
     )
     parser.add_argument(
-        "--start", type=_seconds, metavar="S", help="fit only from this time [s] (one stretch)"
+        "--start", type=seconds_type, metavar="S", help="fit only from this time [s] (one stretch)"
     )
     parser.add_argument(
-        "--end", type=_seconds, metavar="E", help="fit only up to this time [s] (one stretch)"
+        "--end", type=seconds_type, metavar="E", help="fit only up to this time [s] (one stretch)"
     )
     parser.add_argument(
         "--json", dest="json_out", type=output_file, metavar="OUT", help="write the fits as JSON"

@@ -1,0 +1,70 @@
+"""The command line's converters: text to a preset, a scene, a time, a view or a size, with a
+readable one-line error for argparse. Every command's parser (:mod:`poinsot.app.cli` and the
+commands that declare their options in their own module) takes its types from here."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from poinsot.app.exports.screenshot import parse_size, resolve_scene
+from poinsot.app.presets import Preset, preset_by_key
+from poinsot.app.scene.cameras import RIDE_ALONG, canonical
+from poinsot.app.scenes import scene_by_name
+from poinsot.app.scenes.spec import SceneSpec
+
+
+def preset_type(key: str) -> Preset:
+    try:
+        return preset_by_key(key)
+    except KeyError as exc:
+        raise argparse.ArgumentTypeError(exc.args[0]) from exc
+
+
+def scene_type(name: str) -> Preset | SceneSpec:
+    try:
+        return resolve_scene(name)
+    except KeyError as exc:
+        raise argparse.ArgumentTypeError(exc.args[0]) from exc
+
+
+def scene_only_type(name: str) -> SceneSpec:
+    try:
+        return scene_by_name(name)
+    except KeyError as exc:
+        raise argparse.ArgumentTypeError(exc.args[0]) from exc
+
+
+def seconds_type(text: str) -> float:
+    """A time in seconds: a finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds")
+    return value
+
+
+def view_type(text: str) -> str:
+    """A camera view's name (:data:`~poinsot.app.scene.cameras.CAMERA_NAMES`, the words of the
+    browser's buttons; the older "top" and "body" are still understood)."""
+    try:
+        return canonical(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from exc
+
+
+def fixed_view_type(text: str) -> str:
+    """A camera view that stands still (an HTML page's initial camera)."""
+    view = view_type(text)
+    if view == RIDE_ALONG:
+        raise argparse.ArgumentTypeError("a page starts from a fixed view, not ride-along")
+    return view
+
+
+def size_type(text: str) -> tuple[int, int]:
+    try:
+        return parse_size(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from exc
