@@ -7,7 +7,10 @@ which the tests and the work-precision report loop over, one module each:
   Euler's equations plus the quaternion kinematics of the attitude;
 - :mod:`~.splitting`: ``splitting``, the symplectic Strang splitting 1-2-3-2-1 [DLM97];
 - :mod:`~.midpoint`: ``midpoint``, the implicit midpoint rule on (m, R) with the Cayley
-  attitude update [HNW93 §II.10], [HLW06 §IX].
+  attitude update [HNW93 §II.10], [HLW06 §IX];
+- :mod:`~.games`: the rotation steps of game engines (:data:`GAME_STEPS`: no gyroscopic term,
+  its explicit and implicit forms, Jolt's, a fixed-step RK4), registered beside the others
+  but kept out of :data:`INTEGRATORS`, the work-precision study's list.
 
 :class:`Propagation` (:mod:`~.propagation`) advances the same methods piece by piece, carrying
 their whole state (scipy's stepper for the adaptive pairs, the grid state for the fixed-step
@@ -17,6 +20,15 @@ restarting it. Conventions: :mod:`~.interface`.
 
 from poinsot.physics.integrators.interface import Integrator, Trajectory
 from poinsot.physics.integrators.propagation import Propagation, State
-from poinsot.physics.integrators.registry import INTEGRATORS, integrate
+from poinsot.physics.integrators.registry import GAME_STEPS, INTEGRATORS, METHODS, integrate
 
-__all__ = ["INTEGRATORS", "Integrator", "Propagation", "State", "Trajectory", "integrate"]
+__all__ = [
+    "GAME_STEPS",
+    "INTEGRATORS",
+    "METHODS",
+    "Integrator",
+    "Propagation",
+    "State",
+    "Trajectory",
+    "integrate",
+]

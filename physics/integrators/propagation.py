@@ -7,17 +7,24 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
-from scipy.integrate import DOP853, RK45, OdeSolver
+from scipy.integrate import OdeSolver
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics.integrators.registry import MAX_STEPS, Scaled, validated
-from poinsot.physics.integrators.runge_kutta import euler_quaternion_rhs, scipy_atol
+from poinsot.physics.integrators.runge_kutta import (
+    DEFAULT_MAX_STEPS,
+    SCIPY_STEPPERS,
+    euler_quaternion_rhs,
+    scipy_atol,
+    too_many_steps,
+)
 from poinsot.physics.validation import check_count, check_number
 
 __all__ = ["Propagation", "State"]
 
-#: scipy's stepper classes behind the adaptive entries of the registry.
-_SCIPY_STEPPERS: dict[str, type[OdeSolver]] = {"RK45": RK45, "DOP853": DOP853}
+#: scipy's stepper classes behind the adaptive entries of the registry (shared with
+#: :func:`~.runge_kutta.solve`).
+_SCIPY_STEPPERS = SCIPY_STEPPERS
 #: A requested time within this many steps' rounding of a grid time counts as that grid time
 #: (the same slack as :func:`~poinsot.physics.integrators.interface.steps_per_interval`).
 _GRID_SLACK = 1e-9
@@ -124,7 +131,9 @@ class Propagation:
 
     def advance(self, t: float, max_cost: int | None = None) -> State:
         """The solution at time ``t``, or at the furthest time reached when ``max_cost``
-        (RHS evaluations or steps in this call) runs out first. ``t`` may not lie before the
+        (RHS evaluations or steps in this call) runs out first; without ``max_cost`` an
+        adaptive pair raises a ValueError past ``DEFAULT_MAX_STEPS`` steps in one call (a stiff
+        motion: what to do instead is in the message). ``t`` may not lie before the
         start of the last step taken (ValueError): the past is not kept."""
         t = check_number(t, "t")
         if max_cost is not None:
@@ -143,8 +152,13 @@ class Propagation:
         self._units.check_cost(self.integrator, tau - float(stepper.t), 0.0, 0)
         nfev0 = stepper.nfev
         stepped = False
+        steps = 0
         with np.errstate(all="ignore"):  # a run that leaves the range is refused below
             while stepper.t < tau and (max_cost is None or stepper.nfev - nfev0 < max_cost):
+                if max_cost is None and steps >= DEFAULT_MAX_STEPS:
+                    reached = self._caller_time(float(stepper.t))
+                    raise ValueError(too_many_steps(self.method, steps, reached, t))
+                steps += 1
                 message = stepper.step()
                 if stepper.status == "failed":
                     raise ValueError(f"{self.method} failed ({message}): use a smaller tolerance")

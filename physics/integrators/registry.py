@@ -17,13 +17,21 @@ from typing import NamedTuple
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from poinsot.physics.integrators.games import (
+    run_gyro_explicit,
+    run_gyro_implicit,
+    run_jolt,
+    run_no_gyro,
+    run_rk4,
+)
 from poinsot.physics.integrators.interface import Integrator, Trajectory
 from poinsot.physics.integrators.midpoint import run_midpoint
-from poinsot.physics.integrators.runge_kutta import run_scipy
+from poinsot.physics.integrators.runge_kutta import DEFAULT_MAX_STEPS, run_scipy, solve
 from poinsot.physics.integrators.splitting import run_splitting
 from poinsot.physics.validation import (
     InputTypeError,
     check_attitude,
+    check_count,
     check_inertia,
     check_moment_span,
     check_positive,
@@ -31,7 +39,7 @@ from poinsot.physics.validation import (
     check_vector,
 )
 
-__all__ = ["INTEGRATORS", "Scaled", "integrate", "validated"]
+__all__ = ["GAME_STEPS", "INTEGRATORS", "METHODS", "Scaled", "integrate", "validated"]
 
 #: The most steps a fixed-step run may take (the report's longest run takes ~10⁷).
 MAX_STEPS = 50_000_000
@@ -80,6 +88,60 @@ INTEGRATORS: dict[str, Integrator] = {
     ),
 }
 
+#: The steps of game physics engines (:mod:`.games`), at a game's frame step (1/60 s): what
+#: most simulations people watch actually run. Not in :data:`INTEGRATORS` (the work-precision
+#: study), which holds the methods a numerical analyst would compare.
+GAME_STEPS: dict[str, Integrator] = {
+    "no-gyro": Integrator(
+        name="no-gyro",
+        title="Game step without the gyroscopic term (GodotPhysics, brax, PhysX)",
+        kind="fixed",
+        order=0,
+        default_setting=1.0 / 60.0,
+        conserves_norm=False,
+        run=run_no_gyro,
+    ),
+    "gyro-explicit": Integrator(
+        name="gyro-explicit",
+        title="Semi-implicit Euler with the explicit gyroscopic torque (Bullet explicit)",
+        kind="fixed",
+        order=1,
+        default_setting=1.0 / 60.0,
+        conserves_norm=False,
+        run=run_gyro_explicit,
+    ),
+    "gyro-implicit": Integrator(
+        name="gyro-implicit",
+        title="Implicit gyroscopic step, one Newton step (Bullet implicit body, Catto 2015)",
+        kind="fixed",
+        order=1,
+        default_setting=1.0 / 60.0,
+        conserves_norm=False,
+        run=run_gyro_implicit,
+    ),
+    "jolt": Integrator(
+        name="jolt",
+        title="Jolt's gyroscopic step, |L| kept (semi-implicit Euler)",
+        kind="fixed",
+        order=1,
+        default_setting=1.0 / 60.0,
+        conserves_norm=False,
+        run=run_jolt,
+    ),
+    "rk4": Integrator(
+        name="rk4",
+        title="Fixed-step classical RK4, quaternion normalised (MuJoCo RK4)",
+        kind="fixed",
+        order=4,
+        default_setting=1.0 / 60.0,
+        conserves_norm=False,
+        run=run_rk4,
+    ),
+}
+
+#: Every method :func:`integrate` and :class:`~.propagation.Propagation` accept.
+METHODS: dict[str, Integrator] = {**INTEGRATORS, **GAME_STEPS}
+
 
 def integrate(
     method: str,
@@ -88,13 +150,15 @@ def integrate(
     attitude0: Rotation | None,
     t_eval: np.typing.ArrayLike,
     setting: float | None = None,
+    max_steps: int | None = None,
 ) -> Trajectory:
     """Integrate the free rigid body numerically from t = 0 and sample it at ``t_eval``.
 
     Parameters
     ----------
     method
-        A key of :data:`INTEGRATORS`: ``"RK45"``, ``"DOP853"``, ``"splitting"``, ``"midpoint"``.
+        A key of :data:`METHODS`: ``"RK45"``, ``"DOP853"``, ``"splitting"``, ``"midpoint"``
+        (:data:`INTEGRATORS`) or a game engine's step (:data:`GAME_STEPS`).
     inertia
         (3,) positive finite principal moments, any order (the caller's body axes).
     omega0
@@ -109,6 +173,11 @@ def integrate(
         Adaptive methods: the relative tolerance ``rtol``; the absolute tolerance is
         ``rtol * max|omega0|`` on omega and ``rtol`` on the unit quaternion.
         None: the method's ``default_setting``.
+    max_steps
+        The most steps the run may take (fixed step: counted in advance; adaptive: counted as
+        they are taken). Past it a ValueError says what to do instead (a looser tolerance or
+        larger step, the exact solution, a stiff method). None: :data:`MAX_STEPS` for the
+        fixed-step methods, ``DEFAULT_MAX_STEPS`` (1e5) for the adaptive pairs.
 
     Returns
     -------
@@ -124,11 +193,22 @@ def integrate(
         raise ValueError("t_eval must be a non-empty 1-D array of finite times")
     if t_eval[0] < 0.0 or np.any(t_eval[1:] < t_eval[:-1]):
         raise ValueError("t_eval must be non-negative and non-decreasing")
+    budget = _budget(integrator, max_steps)
     units = Scaled.of(integrator, inertia, omega0)
     tau, h = units.time(t_eval), units.setting(integrator, value)
-    units.check_cost(integrator, float(tau[-1]) if tau.size else 0.0, h, tau.size)
-    run = integrator.run(units.inertia, units.omega0, attitude0, tau, h)
+    units.check_cost(integrator, float(tau[-1]) if tau.size else 0.0, h, tau.size, budget)
+    if integrator.kind == "adaptive":
+        args = (units.inertia, units.omega0, attitude0, tau, h)
+        run = solve(integrator.name, *args, budget)
+    else:
+        run = integrator.run(units.inertia, units.omega0, attitude0, tau, h)
     return Trajectory(units.omega(run.omega), run.attitude, run.cost)
+
+
+def _budget(integrator: Integrator, max_steps: int | None) -> int:
+    if max_steps is None:
+        return MAX_STEPS if integrator.kind == "fixed" else DEFAULT_MAX_STEPS
+    return check_count(max_steps, "max_steps", 1, 1 << 62)
 
 
 def validated(
@@ -140,10 +220,10 @@ def validated(
 ) -> tuple[Integrator, np.ndarray, np.ndarray, Rotation, float]:
     """The checks shared by :func:`integrate` and :class:`Propagation` (readable ValueErrors)."""
     if not isinstance(method, str):
-        raise InputTypeError(f"method must be a name, one of {sorted(INTEGRATORS)}; got {method!r}")
-    if method not in INTEGRATORS:
-        raise ValueError(f"unknown method {method!r}; choose one of {sorted(INTEGRATORS)}")
-    integrator = INTEGRATORS[method]
+        raise InputTypeError(f"method must be a name, one of {sorted(METHODS)}; got {method!r}")
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; choose one of {sorted(METHODS)}")
+    integrator = METHODS[method]
     inertia = check_inertia(inertia)
     check_moment_span(inertia)
     omega0 = check_vector(omega0, "omega0")
@@ -204,15 +284,17 @@ class Scaled(NamedTuple):
             )
         return out
 
-    def check_cost(self, integrator: Integrator, span: float, h: float, outputs: int) -> None:
-        """Refuse a run that would never end: more than :data:`MAX_STEPS` fixed steps (one at
-        least per output time), or more than :data:`MAX_RADIANS` for an adaptive method."""
+    def check_cost(
+        self, integrator: Integrator, span: float, h: float, outputs: int, budget: int = MAX_STEPS
+    ) -> None:
+        """Refuse a run that would never end: more than ``budget`` fixed steps (one at least
+        per output time), or more than :data:`MAX_RADIANS` for an adaptive method."""
         if integrator.kind == "fixed":
             steps = span / h + outputs if h > 0.0 else math.inf
-            if not steps <= MAX_STEPS:
+            if not steps <= budget:
                 raise ValueError(
                     f"{integrator.name} would take {steps:.3g} steps (one at least per output "
-                    f"time), more than {MAX_STEPS:,}: {_ADVICE}"
+                    f"time), more than max_steps = {budget:,}: {_ADVICE}"
                 )
             return
         i = self.inertia
@@ -226,6 +308,9 @@ class Scaled(NamedTuple):
             )
 
 
-_ADVICE = "use a larger step or fewer, earlier output times"
+_ADVICE = (
+    "use a larger step or fewer, earlier output times, raise max_steps, or use the exact "
+    "solution (FreeRigidBody)"
+)
 #: Where the adaptive pairs keep the caller's time unit.
 _SAFE_OMEGA = (1e-100, 1e100)
