@@ -15,6 +15,8 @@ Outputs in the output directory:
   (one row per run; errors are maxima over the output grid; the ``exact`` rows carry the
   closed form's errors against the mpmath reference, at its check points);
 * ``error_vs_time.csv``: the same errors against simulated time, for every run;
+* ``game_steps.csv``: the game engines' steps at 1/60 s and 1/240 s on the T-handle (does it
+  flip, the first flip's error, the drifts per minute; :mod:`~poinsot.app.report.games`);
 * ``report.md``: tables, a verdict per case, the observed orders, each case's conditioning
   (:mod:`~poinsot.app.report.conditioning`), the saturated errors near the separatrix read as
   flips (:mod:`~poinsot.app.report.findings`), the exact solution's stability findings, its
@@ -37,6 +39,8 @@ from pathlib import Path
 from poinsot.app.report.cases import StudyConfig
 from poinsot.app.report.exact import load_reference
 from poinsot.app.report.figures import write_figures
+from poinsot.app.report.games import game_rows
+from poinsot.app.report.games import write_csv as write_games_csv
 from poinsot.app.report.markdown import ReportInputs, write_markdown
 from poinsot.app.report.progress import Progress
 from poinsot.app.report.speedup import Speedup, speedup_study
@@ -67,10 +71,14 @@ def write_report(out: Path, *, quick: bool, progress: bool = True) -> ReportSumm
     results = [study_case(case, config, reference_cls, bar) for case in config.cases]
     speedup = speedup_study(config, reference_cls, bar)
     bar.close()
+    games = tuple(game_rows())
     write_csvs(out, results)
+    write_games_csv(out, list(games))
     figures, figure_note = write_figures(out, results)
     elapsed = time.perf_counter() - start
-    inputs = ReportInputs(config, results, speedup, reference_note, figures, figure_note, elapsed)
+    inputs = ReportInputs(
+        config, results, speedup, reference_note, figures, figure_note, elapsed, games
+    )
     write_markdown(out, inputs)
     return ReportSummary(out, results, speedup, elapsed)
 

@@ -24,6 +24,7 @@ from poinsot.app.report.findings import (
     saturation_section,
 )
 from poinsot.app.report.formatting import exp, sig, vector
+from poinsot.app.report.games import GameRow, games_section
 from poinsot.app.report.speedup import SPEEDUP_REPEATS, Speedup
 from poinsot.app.report.study import CaseResult
 from poinsot.app.report.timing import repeats_text
@@ -46,6 +47,8 @@ class ReportInputs:
     figure_note: str
     elapsed: float
     """Wall time of the whole run [s]."""
+    games: tuple[GameRow, ...] = ()
+    """The game-engine table's rows (:mod:`~poinsot.app.report.games`)."""
 
 
 def write_markdown(out: Path, inputs: ReportInputs) -> None:
@@ -57,6 +60,7 @@ def write_markdown(out: Path, inputs: ReportInputs) -> None:
         *_cases_table(inputs.results),
         *_speedup(inputs.speedup),
         *_verdicts(inputs.results),
+        *(games_section(list(inputs.games)) if inputs.games else []),
         *orders_section(inputs.results),
         *conditioning_section(inputs.results),
         *saturation_section(inputs.results),
