@@ -33,6 +33,7 @@ from poinsot.app.arguments import (
     positive_int,
     run_guarded,
 )
+from poinsot.app.check_engine import add_check_engine_arguments
 from poinsot.app.cli_types import (
     fixed_view_type,
     preset_type,
@@ -402,6 +403,10 @@ _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] =
     "fit": (
         "fit the exact free motion to the tosses of a gyroscope recording (phyphox or CSV)",
         _add_fit_arguments,
+    ),
+    "check-engine": (
+        "does a physics engine's log (t, wx, wy, wz[, qw, qx, qy, qz]) move as a free body?",
+        add_check_engine_arguments,
     ),
 }
 
