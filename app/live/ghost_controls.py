@@ -32,20 +32,34 @@ from poinsot.app.scene.ghost import (
     DEFAULT_METHOD,
     DEFAULT_TOLERANCE,
     DIVISIONS,
+    GAME_STEP_RATES,
     TOLERANCES,
     Ghost,
     GhostConfig,
     division_label,
+    game_step_label,
     tolerance_label,
 )
-from poinsot.physics.integrators import INTEGRATORS
+from poinsot.physics.integrators import GAME_STEPS, INTEGRATORS
 
 #: Order of the controls folder in the main panel (after "Show", before the lecture folder).
 FOLDER_ORDER = 45.0
 
+GAME_LABELS: dict[str, str] = {
+    "no-gyro": "no gyroscopic term (Godot, brax)",
+    "gyro-explicit": "explicit gyroscopic (Bullet)",
+    "gyro-implicit": "implicit gyroscopic (Bullet)",
+    "jolt": "Jolt (|L| kept)",
+    "rk4": "RK4, fixed step",
+}
+
 METHOD_LABELS: dict[str, str] = {
-    name: f"{name} ({'adaptive' if i.kind == 'adaptive' else 'fixed step'}, order {i.order})"
-    for name, i in INTEGRATORS.items()
+    **{
+        name: f"{name} ({'adaptive' if i.kind == 'adaptive' else 'fixed step'}, order {i.order})"
+        for name, i in INTEGRATORS.items()
+    },
+    # The game engines' steps, by what they do and where they run (GAME_STEPS' titles).
+    **{name: f"game: {GAME_LABELS[name]}" for name in GAME_STEPS},
 }
 
 
@@ -84,15 +98,17 @@ class GhostControls:
                 tuple(METHOD_LABELS.values()),
                 initial_value=METHOD_LABELS[DEFAULT_METHOD],
                 order=1.0,
-                hint="A numerical integrator (poinsot.physics.integrators); changing it "
-                "restarts the ghost from the exact state.",
+                hint="A numerical integrator (poinsot.physics.integrators), or a game "
+                "engine's step at a game's frame step ('game: ...': no-gyro never flips); "
+                "changing it restarts the ghost from the exact state.",
             )
             self.setting = gui.add_dropdown(
                 "Tolerance",
                 tuple(tolerance_label(t) for t in TOLERANCES),
                 initial_value=tolerance_label(DEFAULT_TOLERANCE),
                 order=2.0,
-                hint="Relative tolerance (adaptive) or step h = T/n, T the period of ω.",
+                hint="Relative tolerance (adaptive), step h = T/n (T the period of ω) or, "
+                "for a game step, h = 1/60 s and the like.",
             )
             self.message = gui.add_markdown("", order=3.0)
         # Browser changes only, each value checked against its widget first (:func:`on_user`).
@@ -118,6 +134,8 @@ class GhostControls:
         value = str(sent.value)
         if value.startswith("T/"):
             self.configure(divisions=int(value[2:]))
+        elif value.endswith(" s"):
+            self.configure(game_rate=int(value[2:-2]))
         else:
             self.configure(tolerance=float(value))
 
@@ -182,6 +200,9 @@ class GhostControls:
         if wanted.adaptive:
             options = tuple(tolerance_label(t) for t in TOLERANCES)
             label, value = "Tolerance", tolerance_label(wanted.tolerance)
+        elif wanted.game:
+            options = tuple(game_step_label(r) for r in GAME_STEP_RATES)
+            label, value = "Game step", game_step_label(wanted.game_rate)
         else:
             options = tuple(division_label(n) for n in DIVISIONS)
             label, value = "Step h", division_label(wanted.divisions)

@@ -10,6 +10,7 @@ driven frame by frame without waiting for the wall clock; the work cap; no NaN e
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -34,7 +35,7 @@ from poinsot.app.scene.ghost import (
     time_scale,
 )
 from poinsot.app.scene.sampling import evaluate
-from poinsot.physics.integrators import State
+from poinsot.physics.integrators import METHODS, State
 from poinsot.physics.rotations import geodesic_angle, rotate_vector
 
 GHOST_NODES = {
@@ -210,6 +211,25 @@ def test_changing_method_or_setting_restarts_from_the_exact_state(poinsot_app, p
     assert session.stats.errors == 0, session.stats.last_error
 
 
+def test_the_menu_offers_every_registered_method_and_game_steps_take_frame_steps(
+    poinsot_app, probe
+):
+    assert set(METHOD_LABELS) == set(METHODS)
+    session = session_of(poinsot_app)
+    ghost = switch_on(probe, session)
+    uuid, _ = probe.widget("Method")
+    probe.set_value(uuid, METHOD_LABELS["no-gyro"])
+    assert wait_until(lambda: ghost.config.method == "no-gyro", 5)
+    assert probe.wait_for(lambda p: p.has_widget("Game step"), 5)
+    _, step = probe.widget("Game step")
+    assert step.value == "1/60 s" and "1/240 s" in step.props["options"]
+    probe.set_value(probe.widget("Game step")[0], "1/240 s")
+    assert wait_until(lambda: ghost.config.game_rate == 240, 5)
+    assert wait_until(lambda: ghost.propagation.setting == 1.0 / 240.0, 5)
+    assert probe.wait_for(lambda p: "**no-gyro**, h = 1/240 s" in ghost_readout(p), 5)
+    assert session.stats.errors == 0, session.stats.last_error
+
+
 def test_reset_and_a_new_body_restart_it_at_zero(poinsot_app, probe):
     session = session_of(poinsot_app)
     ghost = switch_on(probe, session)
@@ -265,8 +285,10 @@ def exact_frames(body, times: np.ndarray, scale: float) -> list[Frame]:
     ]
 
 
-def drive(server, config: GhostConfig, times: np.ndarray) -> tuple[Ghost, list[GhostErrors]]:
-    body = Parameters.from_preset(DEFAULT_PRESET).build()
+def drive(
+    server, config: GhostConfig, times: np.ndarray, preset=DEFAULT_PRESET
+) -> tuple[Ghost, list[GhostErrors]]:
+    body = Parameters.from_preset(preset).build()
     geometry = Geometry.from_body(body, None)
     frames = exact_frames(body, times, geometry.scale)
     folder = server.gui.add_folder("ghost under test")
@@ -300,6 +322,27 @@ def test_rk45_drifts_and_the_splitting_energy_error_stays_bounded(server):
     assert late.max() < SPLITTING_BOUNDED_FACTOR * early.max(), (early.max(), late.max())
     assert early.max() > 1e-5  # not trivially zero: h = T/20 is coarse
     assert window(split, 0, 240, "momentum").max() < SPLITTING_NORM_DRIFT
+
+
+def test_the_game_step_without_gyroscopic_term_fails_to_flip_beside_the_exact_body(server):
+    """The T-handle preset starts at ω = (1.66, 0, 1.11): the exact body swings to its middle
+    axis within 3 s (ω2 = +1.71) and flips at t = 7.28 s (ω2 -> -1.70). The ghost stepped as
+    GodotPhysics does, at 1/60 s, keeps ω0 in the body for ever (ω2 = 0): it never reaches
+    the middle axis, let alone flips. RK4 at the same step keeps up."""
+    times = np.arange(0.0, 12.0, 1.0 / 60.0)
+    t_handle = preset_by_key("t_handle")
+    config = GhostConfig(enabled=True, method="no-gyro", game_rate=60)
+    ghost, errors = drive(server, config, times, t_handle)
+    assert ghost.propagation.setting == 1.0 / 60.0
+    assert "h = 1/60 s" in ghost.readout_markdown()
+    np.testing.assert_array_equal(ghost.state.omega, ghost.body.omega0)
+    assert ghost.body.omega0[1] == 0.0
+    assert errors[0].omega < 0.02  # one frame in, still beside the exact body
+    assert window(errors, 3.0, 12.0, "omega").min() > 1.0  # |ω_ghost - ω| > |ω|
+    # ω is kept exactly, so the energy and |L| are too: the failure is not a drift.
+    assert window(errors, 0.0, 12.0, "energy").max() < 1e-12
+    _, rk4 = drive(server, dataclasses.replace(config, method="rk4"), times, t_handle)
+    assert window(rk4, 0.0, 12.0, "omega").max() < 1e-5
 
 
 def test_the_plot_covers_the_whole_run_within_its_bound(server):
