@@ -21,7 +21,7 @@ from poinsot.physics.fuzz.checks import Invariants, finite, require, rotation
 from poinsot.physics.fuzz.free_body import energy_parameter, short
 from poinsot.physics.fuzz.harness import Call
 from poinsot.physics.fuzz.values import Source, pick
-from poinsot.physics.integrators import INTEGRATORS, Propagation, integrate
+from poinsot.physics.integrators import METHODS, Propagation, integrate
 
 __all__ = ["TARGETS"]
 
@@ -127,7 +127,7 @@ def _time_scale(inertia: Any, w0: Any) -> float:
 
 
 def _integrator_args(src: Source) -> tuple[Any, ...]:
-    method = pick(src, [*INTEGRATORS, "euler", None, 3])
+    method = pick(src, [*METHODS, "euler", None, 3])
     inertia = values.moments(src) if src.index(3) == 0 else (1.0, 2.0, src.real(2.5, 3.5))
     w0 = values.omega(src) if src.index(3) == 0 else (src.real(-2, 2), src.real(-2, 2), 1.0)
     attitude0 = values.attitude(src)

@@ -8,20 +8,21 @@ They differ only in the velocity step of a free body, the gyroscopic term ``-ω 
 Euler's equations [LL76 §36, Eq. 36.5]:
 
 - ``no-gyro``: none. ω in space is kept, so the body turns about one fixed axis for ever and
-  ω in the body is constant: no flip, ever. GodotPhysics3D [GOD-BODY], brax [BRAX], PhysX and
-  Bullet unless a gyroscopic flag is set [BT-RB].
+  ω in the body is constant: no flip, ever. GodotPhysics3D [GOD21], brax [BRAX22], PhysX and
+  Bullet unless a gyroscopic flag is set [BT15].
 - ``gyro-explicit``: the torque ``-ω_n × I ω_n`` applied explicitly (Bullet's
-  ``BT_ENABLE_GYROSCOPIC_FORCE_EXPLICIT`` [BT-RB]; avian before its fix [AVIAN]). Each step
+  ``BT_ENABLE_GYROSCOPIC_FORCE_EXPLICIT`` [BT15]; avian before its fix [AVIAN24]). Each step
   adds ``h² |ω × I ω|²`` to ``|L|²``: energy and |L| grow, and a large step blows up.
 - ``gyro-implicit``: backward Euler on ``I ω' = -ω × I ω`` in the body frame, solved by one
   Newton step from ω_n (``btRigidBody::computeGyroscopicImpulseImplicit_Body``, Bullet's
-  ``BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY`` [BT-RB]; [CAT15]). Backward Euler takes
-  ``|L|`` down at every step: the flip is damped.
+  ``BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY`` [BT15]; [CAT15]). Backward Euler proper takes
+  ``|L|`` and the energy down at every step (``|m_n|² = |m_{n+1}|² + |m_n - m_{n+1}|²``); its
+  one Newton step does too at game steps (the tests measure it): a fast flip is damped out.
 - ``jolt``: the explicit step of the body angular momentum, rescaled to its old length
-  (``MotionProperties::ApplyGyroscopicForceInternal`` [JOLT]; avian since [AVIAN]): |L| kept
+  (``MotionProperties::ApplyGyroscopicForceInternal`` [JOLT24]; avian since [AVIAN24]): |L| kept
   to rounding, the energy not.
 - ``rk4``: the classical fourth-order Runge-Kutta step [HNW93 §II.1] on Euler's equations and
-  ``q' = q (ω, 0) / 2``, the quaternion normalised after each step (MuJoCo's ``RK4`` [MUJOCO]).
+  ``q' = q (ω, 0) / 2``, the quaternion normalised after each step (MuJoCo's ``RK4`` [MJ22]).
 
 The sequential part is a scalar recurrence on three floats (plain Python floats, as in
 :mod:`.splitting`); the attitudes are assembled afterwards by :func:`.attitudes.attitudes_at`.
