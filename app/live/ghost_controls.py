@@ -25,6 +25,7 @@ from typing import Any, Protocol
 
 import viser
 
+from poinsot.app.live.engine_upload import EngineLogUpload
 from poinsot.app.live.widgets import Retirement, Sent, on_user, set_value
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
@@ -111,6 +112,9 @@ class GhostControls:
                 "for a game step, h = 1/60 s and the like.",
             )
             self.message = gui.add_markdown("", order=3.0)
+            # A game engine's own log, judged against the exact motion (check-engine);
+            # below the ghost's readout (10) and plot (11).
+            self.engine_log = EngineLogUpload(self.client, order=20.0)
         # Browser changes only, each value checked against its widget first (:func:`on_user`).
         on_user(self.enabled, self._on_enabled, self._record_error)
         on_user(self.method, self._on_method, self._record_error)
@@ -154,6 +158,7 @@ class GhostControls:
         """Per frame, after the exact scene: apply the wanted configuration, advance the ghost.
         Never raises: a failure switches the ghost off and says why in the panel."""
         try:
+            self.engine_log.on_frame()
             with self._lock:
                 wanted, error = self._wanted, self._callback_error
                 self._callback_error = ""

@@ -8,9 +8,13 @@ import math
 
 import numpy as np
 import pytest
+from conftest import session_of, wait_until
+from test_server import markdown_texts
+from uploading import upload
 
 from poinsot.app.cli import main
 from poinsot.app.engine_logs import write_engine_log
+from poinsot.app.live.engine_upload import BUTTON, MOMENTS
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.integrators import integrate
 
@@ -113,3 +117,30 @@ def test_bad_inertia_option_is_exit_2(tmp_path, capsys):
     path = exact_log(tmp_path / "log.csv")
     assert main(["check-engine", str(path), "--inertia", "1,2"]) == 2
     assert "three positive moments" in capsys.readouterr().err
+
+
+# -- the same check in the browser: an upload in the ghost's folder --------------------------
+def test_an_uploaded_log_gets_its_verdict_in_the_panel(tmp_path, poinsot_app, probe):
+    session = session_of(poinsot_app)
+    checker = session.ghost.engine_log
+    assert probe.wait_for(lambda p: p.has_widget(BUTTON) and p.has_widget(MOMENTS), 10)
+
+    def answer_with(text: str) -> str:
+        assert probe.wait_for(lambda p: any(text in m for m in markdown_texts(p)), 20), text
+        return next(m for m in markdown_texts(probe) if text in m)
+
+    upload(probe, BUTTON, "exact.csv", exact_log(tmp_path / "exact.csv").read_bytes())
+    assert wait_until(lambda: checker.finished >= 1, 30)
+    shown = answer_with("exact.csv: moves as a free rigid body should")
+    assert "Looks most like: exact" in shown and "Flips when the exact motion does" in shown
+
+    nogyro = game_log(tmp_path / "nogyro.csv", "no-gyro", 1 / 60).read_bytes()
+    upload(probe, BUTTON, "nogyro.csv", nogyro)
+    assert wait_until(lambda: checker.finished >= 2, 30)
+    shown = answer_with("nogyro.csv: does NOT move as a free rigid body should")
+    assert "Looks most like: no-gyro" in shown and "measured 0" in shown
+
+    upload(probe, BUTTON, "broken.csv", b"t,wx,wy\n0,1,2\n")
+    assert wait_until(lambda: checker.finished >= 3, 30)
+    assert "no column wz" in answer_with("⚠ broken.csv")
+    assert session.stats.errors == 0, session.stats.last_error
