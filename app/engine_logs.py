@@ -188,7 +188,10 @@ class Judgement:
 
 def judge(log: EngineLog, inertia: tuple[float, float, float]) -> Judgement:
     """Check the log and say in words and numbers what it shows."""
-    c = check_log(log.t, log.omega, np.array(inertia), log.quaternion)
+    try:
+        c = check_log(log.t, log.omega, np.array(inertia), log.quaternion)
+    except ValueError as exc:  # moments or a first sample that make no free body
+        raise LogError(f"no free body from these moments and the first sample: {exc}") from None
     minutes = max(1.0, c.duration / 60.0)
     kept = abs(c.energy_drift) <= DRIFT_LIMIT and abs(c.momentum_drift) <= DRIFT_LIMIT
     space_kept = c.space_drift is None or c.space_drift <= SPACE_LIMIT * minutes

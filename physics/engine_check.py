@@ -164,6 +164,7 @@ def check_log(
     t = np.asarray(t, dtype=float)
     omega = np.asarray(omega, dtype=float)
     inertia = np.asarray(inertia, dtype=float)
+    body = FreeRigidBody(inertia, omega[0])  # validates the moments and the first sample
     m = omega * inertia
     energy = 0.5 * np.sum(m * omega, axis=1)
     size = np.linalg.norm(m, axis=1)
@@ -172,7 +173,6 @@ def check_log(
         ls = Rotation.from_quat(quaternion).apply(m)
         space = float(np.max(np.linalg.norm(ls - ls[0], axis=1)) / size[0])
     step = float(np.median(np.diff(t)))
-    body = FreeRigidBody(inertia, omega[0])
     tau = t - t[0]
     predicted = exact_flip_times(body, tau) + t[0]
     measured = flip_times(inertia, omega, t)

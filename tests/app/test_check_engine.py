@@ -117,6 +117,10 @@ def test_bad_inertia_option_is_exit_2(tmp_path, capsys):
     path = exact_log(tmp_path / "log.csv")
     assert main(["check-engine", str(path), "--inertia", "1,2"]) == 2
     assert "three positive moments" in capsys.readouterr().err
+    # Moments 1e20 apart: no body the physics can build, still one line and exit 2.
+    assert main(["check-engine", str(path), "--inertia", "1e-200,1,1e200"]) == 2
+    err = capsys.readouterr().err
+    assert "no free body" in err and err.count("\n") == 1
 
 
 # -- the same check in the browser: an upload in the ghost's folder --------------------------
