@@ -115,6 +115,9 @@ def test_report_markdown_has_verdicts_and_findings(quick_report):
     assert "## Speed-up of the exact solution over DOP853 at t = 1e4" in text
     assert "**Speed-up:" in text
     assert "mpmath" in text
+    games = text.split("## Game-engine steps: does the body flip?", 1)[1].split("\n## ", 1)[0]
+    assert "| T-handle preset, 2 rad/s | no-gyro | 1/60 s | never |" in games
+    assert (quick_report / "game_steps.csv").read_text().count("\n") == 1 + 22
     for name in ("work_precision.png", "work_precision_attitude.png", "error_vs_time.png"):
         assert f"]({name})" in text
 
