@@ -152,12 +152,13 @@ def _log(
 
 def parse_inertia(text: str, what: str = "--inertia") -> tuple[float, float, float]:
     """``"I1,I2,I3"`` -> three positive finite moments; :class:`LogError` otherwise."""
-    try:
-        values = [float(v) for v in text.replace(";", ",").split(",")]
+    try:  # three numbers need no more than 200 characters
+        values = [float(v) for v in text.replace(";", ",").split(",")] if len(text) <= 200 else []
     except ValueError:
         values = []
     if len(values) != 3 or not all(math.isfinite(v) and v > 0.0 for v in values):
-        raise LogError(f"{what} must be three positive moments I1,I2,I3; got {text.strip()!r}")
+        got = text.strip()[:40] + ("…" if len(text.strip()) > 40 else "")
+        raise LogError(f"{what} must be three positive moments I1,I2,I3; got {got!r}")
     return values[0], values[1], values[2]
 
 
