@@ -177,7 +177,7 @@ def integrate(
         The most steps the run may take (fixed step: counted in advance; adaptive: counted as
         they are taken). Past it a ValueError says what to do instead (a looser tolerance or
         larger step, the exact solution, a stiff method). None: :data:`MAX_STEPS` for the
-        fixed-step methods, ``DEFAULT_MAX_STEPS`` (2e4, a second or two) for the adaptive pairs.
+        fixed-step methods, ``DEFAULT_MAX_STEPS`` (1e4, about a second) for the adaptive pairs.
 
     Returns
     -------

@@ -26,11 +26,11 @@ __all__ = [
 
 #: scipy's stepper classes behind the adaptive entries of the registry.
 SCIPY_STEPPERS: dict[str, type[OdeSolver]] = {"RK45": RK45, "DOP853": DOP853}
-#: Steps an adaptive run may take unless the caller says otherwise (:func:`solve`): a second or
-#: two of work (DOP853 takes 0.1-0.16 ms a step here, RK45 ~0.06 ms). A longer run is a choice
-#: the caller makes with ``max_steps``: the report's most accurate DOP853 run (rtol 1e-13 to
-#: t = 1e4 on the generic box, ~5e4 steps) passes its own budget.
-DEFAULT_MAX_STEPS = 20_000
+#: Steps an adaptive run may take unless the caller says otherwise (:func:`solve`): about a
+#: second of work on an idle machine (DOP853 takes 0.1-0.3 ms a step, RK45 ~0.06 ms). A longer
+#: run is a choice the caller makes with ``max_steps``: the report's most accurate DOP853 run
+#: (rtol 1e-13 to t = 1e4 on the generic box, ~5e4 steps) passes its own budget.
+DEFAULT_MAX_STEPS = 10_000
 
 
 def euler_quaternion_rhs(inertia: np.ndarray) -> Callable[[float, np.ndarray], np.ndarray]:

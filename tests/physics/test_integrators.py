@@ -294,7 +294,7 @@ def _first_and_last_tenth(method: str, setting: float) -> tuple[float, float]:
     inertia, omega0, attitude0 = body_case("generic")
     period = FreeRigidBody(inertia, omega0).period
     t = np.linspace(0.0, 500 * period, 2001)
-    # RK45 at rtol 1e-8 over 500 periods takes ~5e4 steps, past the default budget (2e4).
+    # RK45 at rtol 1e-8 over 500 periods takes ~5e4 steps, past the default budget (1e4).
     traj = integrate(method, inertia, omega0, attitude0, t, setting, max_steps=200_000)
     err = relative_energy_error(inertia, omega0, traj.omega)
     tenth = len(t) // 10
