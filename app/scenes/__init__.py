@@ -32,6 +32,7 @@ from poinsot.app.scenes.long_cylinder import SPEC as LONG_CYLINDER
 from poinsot.app.scenes.polhode_family import SPEC as POLHODE_FAMILY
 from poinsot.app.scenes.spec import SceneSpec
 from poinsot.app.scenes.symmetric_top import SPEC as SYMMETRIC_TOP
+from poinsot.app.scenes.tennis_racket import SPEC as TENNIS_RACKET
 
 SCENES: tuple[SceneSpec, ...] = (
     POLHODE_FAMILY,
@@ -41,6 +42,7 @@ SCENES: tuple[SceneSpec, ...] = (
     LONG_CYLINDER,
     EXPLORER_1,
     GEOMETRIC_PHASE,
+    TENNIS_RACKET,
 )
 
 
