@@ -19,8 +19,8 @@ and :mod:`~.errors` (the quaternion algebra and the error measures), :mod:`~.int
 input check: a ValueError, or an InputTypeError for what is no real number),
 :mod:`~.relabelling`, :mod:`~.solids`, :mod:`~.geometric_phase` (Montgomery's split of the turn
 per period, the solid angle of the cone of L in closed form), :mod:`~.racket` (the tennis racket
-effect: the head's twist over one turn of the handle), :mod:`~.fuzz` (odd input of every kind against the whole
-API: ``python -m poinsot.physics.fuzz --cases 100000``).
+effect: the head's twist over one turn of the handle), :mod:`~.fuzz` (odd input of every kind
+against the whole API: ``python -m poinsot.physics.fuzz --cases 100000``).
 """
 
 from poinsot.physics.free_body import FreeRigidBody

@@ -41,7 +41,7 @@ PHASE_CAP: RGB = (110, 235, 120)
 PHASE_CAP_OPACITY = 0.55
 #: The racket's twist: the handle's and the head normal's traces in space.
 HANDLE_PATH: RGB = (255, 210, 60)
-NORMAL_PATH: RGB = (120, 255, 160)
+NORMAL_PATH: RGB = (140, 235, 165)
 #: Solid bodies drawn from their own meshes.
 SOLID: RGB = palette.SOLID
 

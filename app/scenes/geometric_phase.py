@@ -248,7 +248,7 @@ SPEC = SceneSpec(
     controls=(
         Choice(
             "D",
-            "D = |L|²/2T",
+            "D = |L|²/2T, toward I₂",
             D_OPTIONS,
             "2.1",
             hint="Which polhode: D < I₂ = 2 circles the minor axis (Ω < 0), D > I₂ the major "

@@ -2,11 +2,12 @@
 makes one turn about L [VMS17; VMS20; ACC91].
 
 What it shows: the bundled racquet mesh (its handle along e₁, its head's normal along e₃) tossed
-at the angle ε from its middle axis e₂, with its axes, ω and L. Around the first flip the
-scene marks the window over which the handle makes one full turn about L, and draws in space the
-path of the handle's tip (a circle, nearly) and of the head's normal (from one side to the
-other: the faces swap). Controls: the moments (the mesh's at uniform density, Brody's measured
-racquet, and three other ratios down to an ideal racket with I₁ → 0) and the start's offset ε.
+at the angle ε from its middle axis e₂, inside its energy ellipsoid, with its axes, ω and L.
+Around the first flip the scene marks the window over which the handle makes one full turn about
+L, and draws in space the path of the handle's tip (a circle, nearly) and of the head's normal
+(from one side to the other: the faces swap). Controls: the moments (the mesh's at uniform
+density, Brody's measured racquet, and three other ratios down to an ideal racket with I₁ → 0)
+and the start's offset ε.
 
 Readouts: how far the mesh's moments are from Brody's; ε measured from ω₀; the handle's turn
 over the window (one turn, from the attitude); the head's twist Δψ read off the attitude against
@@ -195,8 +196,8 @@ class RacketDrawing(RidingMesh):
 
     def __init__(self, canvas: Canvas) -> None:
         super().__init__(canvas, RACQUET, racquet().mesh)
-        self.handle = self.parts.lines("paths", HANDLE_PATH_NODE, colors.HANDLE_PATH, 3.0)
-        self.normal = self.parts.lines("paths", NORMAL_PATH_NODE, colors.NORMAL_PATH, 3.0)
+        self.handle = self.parts.lines("paths", HANDLE_PATH_NODE, colors.HANDLE_PATH, 4.0)
+        self.normal = self.parts.lines("paths", NORMAL_PATH_NODE, colors.NORMAL_PATH, 4.0)
 
     def fit(self, model: Model, geometry: Geometry | None) -> None:
         super().fit(model, geometry)
@@ -206,7 +207,7 @@ class RacketDrawing(RidingMesh):
             np.max(np.abs(self.vertices[:, 0]))
         )
         self.handle.points = segments(1.08 * reach * model.handle_path, closed=False)
-        self.normal.points = segments(0.8 * reach * model.normal_path, closed=False)
+        self.normal.points = segments(1.0 * reach * model.normal_path, closed=False)
 
 
 SPEC = SceneSpec(
@@ -220,7 +221,9 @@ SPEC = SceneSpec(
     body="the bundled racquet mesh (assets/bodies/tennis_racquet.stl), moments by trimesh at "
     "uniform density, or Brody's measured moments 0.00121, 0.01638, 0.01748 kg m² [ACC91]",
     motion="FreeRigidBody(I, flip_initial_omega(ε, 2, β = π/2)); measure_twist, separatrix_twist",
-    elements=frozenset({Element.AXES, Element.OMEGA, Element.L}),
+    elements=frozenset(
+        {Element.ELLIPSOID, Element.AXES, Element.OMEGA, Element.L, Element.POLHODE}
+    ),
     parts=(
         RACQUET,
         Part(
@@ -261,7 +264,7 @@ SPEC = SceneSpec(
     plots=(),
     build=build,
     draw=lambda canvas: RacketDrawing(canvas),
-    view=View(position=(2.4, -3.2, 1.6), look_at=(0.0, 0.0, 0.0)),
+    view=View(position=(1.0, -1.45, 0.7), look_at=(0.0, 0.0, 0.1)),
     speed=1.0,
     trail_points=1600,
     picture_time=4.9,  # just after the default toss's window (t = 1.64 … 4.86)
