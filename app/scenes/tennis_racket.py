@@ -264,7 +264,7 @@ SPEC = SceneSpec(
     plots=(),
     build=build,
     draw=lambda canvas: RacketDrawing(canvas),
-    view=View(position=(1.0, -1.45, 0.7), look_at=(0.0, 0.0, 0.1)),
+    view=View(position=(1.2, -1.75, 0.85), look_at=(0.0, 0.0, 0.12)),
     speed=1.0,
     trail_points=1600,
     picture_time=4.9,  # just after the default toss's window (t = 1.64 … 4.86)
