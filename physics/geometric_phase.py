@@ -50,7 +50,7 @@ from scipy import integrate, special
 
 from poinsot.physics.free_body import FreeRigidBody
 from poinsot.physics.regime import Regime
-from poinsot.physics.validation import check_inertia
+from poinsot.physics.validation import check_inertia, check_moment_span
 
 __all__ = [
     "MontgomeryPhase",
@@ -65,12 +65,30 @@ __all__ = [
 
 Array = NDArray[np.float64]
 
+#: Beyond this p = G²/b² the bracket R_F − (p/3) R_J, of size ~1/√p, loses log10 √p digits to
+#: cancellation (5 at 1e10); only moments 1e10 apart on the minor side reach it.
+_LOPSIDED = 1e10
+
 
 def _sorted_moments(inertia: ArrayLike) -> tuple[float, float, float]:
-    I1, I2, I3 = sorted(check_inertia(inertia).tolist())
+    checked = check_inertia(inertia)
+    check_moment_span(checked)
+    I1, I2, I3 = sorted(checked.tolist())
     if not I1 < I2 < I3:
         raise ValueError("the geometric phase of a free body needs three distinct moments")
     return I1, I2, I3
+
+
+def _energy_parameters(D: ArrayLike) -> Array:
+    """D as a float array, or a ValueError for anything that is not real numbers."""
+    try:
+        d = np.asarray(D)
+    except (TypeError, ValueError):
+        d = np.asarray(None)
+    if d.dtype.kind not in "iuf":
+        raise ValueError(f"D must be a real number or an array of them, got {D!r:.80}")
+    with np.errstate(over="ignore"):  # a long double beyond the double range: inf, refused
+        return d.astype(float)
 
 
 def solid_angle(inertia: ArrayLike, D: ArrayLike) -> Array:
@@ -78,29 +96,47 @@ def solid_angle(inertia: ArrayLike, D: ArrayLike) -> Array:
 
     Args:
         inertia: (3,) distinct positive moments, any order [any unit].
-        D: (N,) or scalar ``|L|²/2T`` in ``(I1, I3)``, not ``I2`` [same unit].
+        D: (N,) or scalar ``|L|²/2T`` in ``[I1, I3]``, not ``I2`` [same unit].
 
     Returns:
         (N,) Ω [sr] (a scalar D gives shape ()): in (0, 2π) around the major axis, in (−2π, 0)
         around the minor one, 0 at either pole.
 
     Raises:
-        ValueError: moments not distinct, or a D outside ``[I1, I3]`` or equal to ``I2``.
+        ValueError: moments not distinct (or more than 300 decades apart), a D that is not real,
+            outside ``[I1, I3]`` or equal to ``I2``, moments so lopsided that the closed form
+            would lose more than 5 digits (:data:`_LOPSIDED`), or so close to each other that Ω
+            leaves the double range.
     """
     I1, I2, I3 = _sorted_moments(inertia)
-    d = np.asarray(D, dtype=float)
+    d = _energy_parameters(D)
     if not np.all(np.isfinite(d)) or np.any((d < I1) | (d > I3) | (d == I2)):
         raise ValueError(f"D must lie in [{I1}, {I3}] and differ from I2 = {I2}")
+    # In units of I3 (the solid angle depends on the ratios only): no overflow.
+    j1, j2, x = I1 / I3, I2 / I3, d / I3
     major = d > I2
-    Ip = np.where(major, I3, I1)
-    Ia = np.where(major, I1, I3)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        mc = (Ip - Ia) * (d - I2) / ((Ip - I2) * (d - Ia))
-        p = 1.0 + Ia * (Ip - d) / (Ip * (d - Ia))
-        scale = (Ip - d) * np.sqrt(Ia * I2 / (Ip * d * (Ip - I2) * (d - Ia)))
+    jp = np.where(major, 1.0, j1)
+    ja = np.where(major, j1, 1.0)
+    with np.errstate(all="ignore"):
+        mc = ((jp - ja) / (jp - j2)) * ((x - j2) / (x - ja))
+        p = 1.0 + (ja / jp) * ((jp - x) / (x - ja))
+        # (Ip − I2)(D − Ia) > 0 on either side: the product of the magnitudes.
+        root = np.sqrt(np.abs(x - ja)) * np.sqrt(np.abs(jp - j2) / j2) * np.sqrt(x)
+        scale = (jp - x) / root * np.sqrt(ja / jp)
         bracket = special.elliprf(0.0, mc, 1.0) - (p / 3.0) * special.elliprj(0.0, mc, 1.0, p)
-    # At a pole (D = Ip) the cone is a line: Ω = 0 (the formula's 0·finite).
-    return np.where(d == Ip, 0.0, 4.0 * scale * bracket)
+        # At a pole (D = Ip) the cone is a line: Ω = 0 (the formula's 0·finite).
+        omega = np.where(d == np.where(major, I3, I1), 0.0, 4.0 * scale * bracket)
+    if np.any(p > _LOPSIDED):
+        raise ValueError(
+            "the moments are so lopsided (I1/I2 or 1 - I2/I3 below about 1e-10) that the closed "
+            "form of the solid angle would lose more than 5 digits"
+        )
+    if not np.all(np.isfinite(omega)):
+        raise ValueError(
+            "the moments lie so close together that the solid angle leaves the double range; "
+            "spread them further apart"
+        )
+    return omega
 
 
 def separatrix_solid_angles(inertia: ArrayLike) -> tuple[float, float]:

@@ -48,7 +48,7 @@ from scipy import optimize
 
 from poinsot.physics.flip import measure_flips
 from poinsot.physics.free_body import FreeRigidBody
-from poinsot.physics.validation import check_inertia
+from poinsot.physics.validation import check_inertia, check_moment_span
 
 __all__ = [
     "LIMIT_ACCURACY",
@@ -88,39 +88,61 @@ class TwistTheory:
     defect_high: Array
 
 
+def _moment_rows(inertia: ArrayLike) -> tuple[Array, tuple[int, ...]]:
+    """The checked moments as rows (N, 3) sorted and divided by the largest (the twist depends on
+    the ratios only), and the shape of the stack given ((): one body)."""
+    try:
+        stacked = np.ndim(inertia) == 2
+    except (TypeError, ValueError):  # ragged or odd input: checked as one body below
+        stacked = False
+    given = list(inertia) if stacked else [inertia]  # type: ignore[arg-type]
+    rows = []
+    for row in given:
+        checked = check_inertia(row)
+        check_moment_span(checked)
+        moments = np.sort(checked)
+        if moments[0] == moments[1] or moments[1] == moments[2]:
+            raise ValueError("the racket's twist needs three distinct moments")
+        rows.append(moments / moments[2])
+    return np.array(rows), ((len(rows),) if stacked else ())
+
+
+def _atanc(z: Array) -> Array:
+    """atan(z)/z, 1 at z = 0 (z >= 0)."""
+    small = z < 1e-8
+    safe = np.where(small, 1.0, z)
+    return np.where(small, 1.0 - z * z / 3.0, np.arctan(safe) / safe)
+
+
 def separatrix_twist(inertia: ArrayLike) -> TwistTheory:
     """:class:`TwistTheory` of the moments ``inertia``: (3,) or a stack (N, 3) of distinct positive
-    moments, any order within a row [any unit]."""
-    rows = np.atleast_2d(np.asarray(inertia, dtype=float))
-    for row in rows:
-        check_inertia(row)
-    I1, I2, I3 = np.sort(rows, axis=1).T
-    if np.any((I1 == I2) | (I2 == I3)):
-        raise ValueError("the racket's twist needs three distinct moments")
-    r = np.sqrt((I3 - I2) * (I2 - I1) / (I1 * I3))
-    c3 = np.sqrt(I3 * (I2 - I1) / (I2 * (I3 - I1)))
-    a = (I3 - I2) / (I3 - I1)
-    b = (I1 / I2) * a
+    moments, any order within a row [any unit]; a ValueError for moments that are not three
+    distinct positive numbers (or span more than 300 decades)."""
+    rows, shape = _moment_rows(inertia)
+    i1, i2, _ = rows.T
+    r = np.sqrt((1.0 - i2) * ((i2 - i1) / i1))
+    c3 = np.sqrt((i2 - i1) / (i2 * (1.0 - i1)))
+    a = (1.0 - i2) / (1.0 - i1)
+    b = (i1 / i2) * a
     q = np.sqrt(b / (1.0 - b))
-    coef = (a - b) / np.sqrt(b * (1.0 - b))
+    slope = (a - b) / (1.0 - b)
 
-    def excess(x: Array) -> Array:
-        return coef * np.arctan(q * x)
+    def excess(x: Array) -> Array:  # A(x) = ((a - b)/sqrt(b(1 - b))) atan(q x)
+        return slope * x * _atanc(q * x)
 
     C = excess(np.ones_like(r))
-    tau = math.pi * r + C  # f is convex and increasing: Newton from above stays above the root
-    for _ in range(_NEWTON_STEPS):
-        sech2 = 1.0 / np.cosh(tau) ** 2
-        f = tau - excess(np.tanh(tau)) - math.pi * r
-        slope = 1.0 - (a - b) * sech2 / (1.0 - b * sech2)
-        step = f / slope
-        tau = tau - step
-        if np.all(np.abs(step) <= 1e-15 * tau):
-            break
-    defect = 2.0 * np.arctan(c3 / np.sinh(tau))
-    shape = np.shape(inertia)[:-1]
-    low = 2.0 * np.arctan(c3 / np.sinh(math.pi * r + C))
-    high = 2.0 * np.arctan(c3 / np.sinh(math.pi * r))
+    with np.errstate(over="ignore"):  # sinh, cosh of a huge τ: inf, and 1/inf = 0 is right
+        tau = math.pi * r + C  # f is convex and increasing: Newton from above stays above
+        for _ in range(_NEWTON_STEPS):
+            sech2 = 1.0 / np.cosh(tau) ** 2
+            f = tau - excess(np.tanh(tau)) - math.pi * r
+            step = f / (1.0 - (a - b) * sech2 / (1.0 - b * sech2))
+            tau = tau - step
+            if np.all(np.abs(step) <= 1e-15 * tau):
+                break
+        defect = 2.0 * np.arctan(c3 / np.sinh(tau))
+        low = 2.0 * np.arctan(c3 / np.sinh(math.pi * r + C))
+        high = 2.0 * np.arctan(c3 / np.sinh(math.pi * r))
     return TwistTheory(
         ratio=np.reshape(r, shape),
         tau=np.reshape(tau, shape),
