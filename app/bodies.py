@@ -34,6 +34,43 @@ BUNDLED: dict[str, tuple[str, str]] = {
 }
 
 
+@dataclasses.dataclass(frozen=True)
+class MeasuredBody:
+    """A body known by its measured principal moments rather than by a mesh of its own; it is
+    drawn with the bundled mesh of its kind (``mesh_key``).
+
+    Attributes:
+        key, label: its name. inertia: (3,) principal moments, ascending [kg m²].
+        mesh_key: the :data:`BUNDLED` mesh drawn for it. source: where the moments come from
+        (a key of docs/REFERENCES.md).
+    """
+
+    key: str
+    label: str
+    inertia: tuple[float, float, float]
+    mesh_key: str
+    source: str
+
+    @property
+    def ratios(self) -> tuple[float, float, float]:
+        """The moments normalised so that the largest is 1."""
+        top = self.inertia[2]
+        return (self.inertia[0] / top, self.inertia[1] / top, 1.0)
+
+
+#: Bodies known by their measured moments: Brody's Wilson T-2000 tennis racquet (1985), as
+#: quoted by [ACC91, footnote 4], beside the bundled racquet mesh.
+MEASURED: dict[str, MeasuredBody] = {
+    "brody": MeasuredBody(
+        "brody",
+        "Tennis racquet (Brody's Wilson T-2000, measured)",
+        (0.00121, 0.01638, 0.01748),
+        "racquet",
+        "[ACC91] footnote 4, Brody (1985)",
+    ),
+}
+
+
 class MeshError(ValueError):
     """A mesh that cannot be a rigid body; the message says what to change."""
 

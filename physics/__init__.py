@@ -17,12 +17,16 @@ caller's axes, units and attitude), :mod:`~.elliptic` (Jacobi functions and inte
 and :mod:`~.errors` (the quaternion algebra and the error measures), :mod:`~.integrators`
 (numerical methods to compare against), :mod:`~.initial_state`, :mod:`~.validation` (every
 input check: a ValueError, or an InputTypeError for what is no real number),
-:mod:`~.relabelling`, :mod:`~.solids`, :mod:`~.fuzz` (odd input of every kind against the whole
-API: ``python -m poinsot.physics.fuzz --cases 100000``).
+:mod:`~.relabelling`, :mod:`~.solids`, :mod:`~.geometric_phase` (Montgomery's split of the turn
+per period, the solid angle of the cone of L in closed form), :mod:`~.racket` (the tennis racket
+effect: the head's twist over one turn of the handle), :mod:`~.fuzz` (odd input of every kind
+against the whole API: ``python -m poinsot.physics.fuzz --cases 100000``).
 """
 
 from poinsot.physics.free_body import FreeRigidBody
+from poinsot.physics.geometric_phase import montgomery_phase, solid_angle
 from poinsot.physics.initial_state import attitude_with_L_along_z, omega_from_energy
+from poinsot.physics.racket import measure_twist, separatrix_twist
 from poinsot.physics.regime import Regime
 from poinsot.physics.solids import box_dimensions, check_real_body
 
@@ -32,5 +36,9 @@ __all__ = [
     "attitude_with_L_along_z",
     "box_dimensions",
     "check_real_body",
+    "measure_twist",
+    "montgomery_phase",
     "omega_from_energy",
+    "separatrix_twist",
+    "solid_angle",
 ]

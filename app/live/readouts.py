@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 from poinsot.physics import FreeRigidBody, Regime
+from poinsot.physics.geometric_phase import montgomery_phase
 
 REGIME_TEXT: dict[Regime, str] = {
     Regime.MAJOR_AXIS: "polhode around the major axis",
@@ -42,10 +43,26 @@ def rows(body: FreeRigidBody) -> list[tuple[str, str]]:
         *k2,
         ("period of ω", _num(body.period)),
         ("precession / period", precession_text),
+        *_montgomery(body),
         ("D = |L|²/2T", _num(body.D, 6)),
         ("h = 2T/|L|", _num(body.plane_distance)),
         ("energy T", _num(body.energy)),
         ("|L|", _num(math.hypot(*body.angular_momentum))),
+    ]
+
+
+def _montgomery(body: FreeRigidBody) -> list[tuple[str, str]]:
+    """The precession per period split [Mon91]: its dynamic part 2TP/|L| and its geometric part
+    −Ω (the solid angle L sweeps in the body), on a triaxial body's polhode; nothing else."""
+    if body.regime not in (Regime.MAJOR_AXIS, Regime.MINOR_AXIS):
+        return []
+    try:
+        phase = montgomery_phase(body)
+    except ValueError:  # a period beyond the double range: the row above says so
+        return []
+    return [
+        ("… dynamic 2TP/|L|", f"{_num(phase.dynamic)} rad"),
+        ("… geometric −Ω", f"{_num(phase.geometric)} rad"),
     ]
 
 

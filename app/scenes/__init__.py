@@ -15,18 +15,24 @@ One module per scene, each with a docstring saying what it shows and its sources
 - ``long-cylinder`` (:mod:`.long_cylinder`): a spin that looks stable for a long time
   [FM06 Remark 7.5];
 - ``explorer-1`` (:mod:`.explorer_1`): energy dissipation at fixed |L| turns a minor-axis spin
-  into a flat spin [BG58].
+  into a flat spin [BG58];
+- ``geometric-phase`` (:mod:`.geometric_phase`): Montgomery's split of the turn per period into
+  2TP/|L| and the solid angle of the cone of L [Mon91];
+- ``tennis-racket`` (:mod:`.tennis_racket`): the racquet's head twists by almost π while its
+  handle makes one turn [VMS17; VMS20; ACC91].
 """
 
 from __future__ import annotations
 
 from poinsot.app.scenes.dzhanibekov import SPEC as DZHANIBEKOV
 from poinsot.app.scenes.explorer_1 import SPEC as EXPLORER_1
+from poinsot.app.scenes.geometric_phase import SPEC as GEOMETRIC_PHASE
 from poinsot.app.scenes.gyroscope_torque import SPEC as GYROSCOPE_TORQUE
 from poinsot.app.scenes.long_cylinder import SPEC as LONG_CYLINDER
 from poinsot.app.scenes.polhode_family import SPEC as POLHODE_FAMILY
 from poinsot.app.scenes.spec import SceneSpec
 from poinsot.app.scenes.symmetric_top import SPEC as SYMMETRIC_TOP
+from poinsot.app.scenes.tennis_racket import SPEC as TENNIS_RACKET
 
 SCENES: tuple[SceneSpec, ...] = (
     POLHODE_FAMILY,
@@ -35,6 +41,8 @@ SCENES: tuple[SceneSpec, ...] = (
     GYROSCOPE_TORQUE,
     LONG_CYLINDER,
     EXPLORER_1,
+    GEOMETRIC_PHASE,
+    TENNIS_RACKET,
 )
 
 

@@ -35,6 +35,13 @@ DRIFT: RGB = (120, 255, 120)
 AXIS_PATH: RGB = (255, 210, 60)
 OMEGA: RGB = palette.OMEGA
 L: RGB = palette.ANGULAR_MOMENTUM
+#: The geometric phase: the cone L sweeps in the body and the cap it cuts from a sphere.
+PHASE_CONE: RGB = (120, 200, 255)
+PHASE_CAP: RGB = (110, 235, 120)
+PHASE_CAP_OPACITY = 0.55
+#: The racket's twist: the handle's and the head normal's traces in space.
+HANDLE_PATH: RGB = (255, 210, 60)
+NORMAL_PATH: RGB = (140, 235, 165)
 #: Solid bodies drawn from their own meshes.
 SOLID: RGB = palette.SOLID
 

@@ -44,7 +44,7 @@ class Tabulated:
 
 
 def _value(value: Value) -> str:
-    return f"{value:g}" if isinstance(value, float) else value
+    return f"{value:.12g}" if isinstance(value, float) else value
 
 
 def tabulate(spec: SceneSpec) -> list[Tabulated]:

@@ -1,5 +1,5 @@
 """Fuzz targets of the textbook modules: the polhode family, the flip, the symmetric top, the
-gyroscope and the dissipating body."""
+gyroscope, the dissipating body, the geometric phase's solid angle and the racket's twist."""
 
 from __future__ import annotations
 
@@ -9,7 +9,16 @@ from typing import Any
 
 import numpy as np
 
-from poinsot.physics import FreeRigidBody, dissipation, family, flip, gyroscope, symmetric
+from poinsot.physics import (
+    FreeRigidBody,
+    dissipation,
+    family,
+    flip,
+    geometric_phase,
+    gyroscope,
+    racket,
+    symmetric,
+)
 from poinsot.physics.fuzz import values
 from poinsot.physics.fuzz.checks import finite, number, require, rotation
 from poinsot.physics.fuzz.free_body import body_maker, energy_parameter, short
@@ -330,6 +339,37 @@ def _energy_sink(src: Source) -> Call:
     return Call(f"dissipation.EnergySink{short(*args)}.{part}({short(t)[1:-1]})", run, check)
 
 
+def _solid_angle(src: Source) -> Call:
+    inertia = sorted_moments(src)
+    D = energy_parameter(src, inertia) if src.index(3) else [energy_parameter(src, inertia)] * 3
+
+    def check(omega: Any) -> None:
+        out = finite(omega, None, "solid angle")
+        require(bool(np.all(np.abs(out) <= 2.0 * math.pi)), "|Ω| beyond 2π")
+
+    return Call(
+        f"geometric_phase.solid_angle{short(inertia, D)}",
+        lambda: geometric_phase.solid_angle(inertia, D),
+        check,
+    )
+
+
+def _separatrix_twist(src: Source) -> Call:
+    inertia = sorted_moments(src)
+
+    def check(th: Any) -> None:
+        for field in ("ratio", "tau", "twist", "defect", "defect_low", "defect_high"):
+            finite(getattr(th, field), None, field)
+        require(bool(np.all(th.defect_low <= th.defect)), "defect below its lower bound")
+        require(bool(np.all(th.defect <= th.defect_high)), "defect above its upper bound")
+
+    return Call(
+        f"racket.separatrix_twist{short(inertia)}",
+        lambda: racket.separatrix_twist(inertia),
+        check,
+    )
+
+
 TARGETS: dict[str, Callable[[Source], Call]] = {
     **{
         f"family.{name}": _family_call(name, getattr(family, name), check)
@@ -350,4 +390,6 @@ TARGETS: dict[str, Callable[[Source], Call]] = {
     "symmetric.symmetric_top": _symmetric_top,
     "gyroscope.Gyroscope": _gyroscope,
     "dissipation.EnergySink": _energy_sink,
+    "geometric_phase.solid_angle": _solid_angle,
+    "racket.separatrix_twist": _separatrix_twist,
 }

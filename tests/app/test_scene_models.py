@@ -43,6 +43,8 @@ NAMES = (
     "gyroscope-torque",
     "long-cylinder",
     "explorer-1",
+    "geometric-phase",
+    "tennis-racket",
 )
 
 
@@ -59,7 +61,7 @@ def rows_of(spec: SceneSpec, settings=None, t: float = 0.0) -> dict[str, Readout
     return {r.quantity: r for r in rows}
 
 
-def test_the_catalogue_names_the_six_scenes():
+def test_the_catalogue_names_the_eight_scenes():
     assert scene_names() == NAMES
     for spec in SCENES:
         assert scene_by_name(spec.name) is spec
@@ -103,7 +105,9 @@ def test_every_readout_is_filled_and_theory_meets_measurement(spec):
     assert "nan" not in text.lower() and "inf" not in text.lower()
     for row in rows.values():
         if row.gap is not None:  # theory vs measured
-            tolerance = 1e-2 if spec.name == "explorer-1" else 1e-6
+            # Two theories are approximations: Explorer 1's averaged model, and the racket's
+            # separatrix formula for a toss at ε = 1e-2 (accurate to O(1 − k²) ~ 1e-4 there).
+            tolerance = 1e-2 if spec.name in ("explorer-1", "tennis-racket") else 1e-6
             assert gap(row) < tolerance, (spec.name, row)
 
 
