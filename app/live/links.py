@@ -267,8 +267,8 @@ def apply(session: LinkSession, link: Opening) -> None:
         clock = session.clock
         if link.paused:
             clock.paused = True
-        if link.t is not None:
-            clock.reset(link.t)
+        if link.t is not None or link.paused:  # paused at once: at the link's time, or 0
+            clock.reset(link.t or 0.0)
             session.panel.motion.clear_plot()  # its first sample is t = 0's
         session.panel.show_playback(clock.speed, clock.paused, session.scene.trail_points)
         if link.problem:
