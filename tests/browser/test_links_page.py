@@ -15,7 +15,6 @@ from poinsot.app.live.landing import Balancer, LandingServer
 from poinsot.app.live.server import PoinsotApp
 from poinsot.app.presets import DEFAULT_PRESET, preset_by_key
 from poinsot.app.scene.cameras import space_view
-from poinsot.app.scenes import scene_by_name
 from tests.conftest import BrowserPage, session_of, wait_until
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
@@ -145,10 +144,9 @@ def test_a_bad_link_opens_the_default_scene_and_names_the_parameter(make_app, op
     for n, (query, named) in enumerate(BAD.items(), start=1):
         page = open_page(f"{app.url}/?{query}")
         session = session_of(app, n)
-        assert wait_until(
-            lambda: page.page.get_by_text("This link could not be opened").count() == 1, 20
-        )
-        status = page.page.get_by_text("This link could not be opened").inner_text()
+        message = page.page.get_by_text("This link could not be opened")
+        assert wait_until(lambda m=message: m.count() == 1, 20), query
+        status = message.inner_text()
         assert named in status, (query, status)
         assert session.preset is DEFAULT_PRESET and session.showcase is None
         assert page.dropdown_value("Preset") == DEFAULT_PRESET.label
