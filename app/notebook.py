@@ -143,10 +143,13 @@ def show(
     arguments."""
     if not (isinstance(height, int) and 100 <= height <= 4000):
         raise ValueError("height must be a whole number of pixels in [100, 4000]")
-    serializer, legend = clip(
-        preset, scene=scene, body=body, seconds=seconds, light=light, **options
-    )
     from IPython.display import HTML, display
+    from IPython.utils.capture import capture_output
+
+    with capture_output():  # viser's server banners (rich) are not for the notebook
+        serializer, legend = clip(
+            preset, scene=scene, body=body, seconds=seconds, light=light, **options
+        )
 
     display(HTML(legend))
     serializer.show(height=height, dark_mode=not light)

@@ -43,6 +43,14 @@ class AppBackend:
         return len(self.app.sessions())
 
 
+def new_session(app: PoinsotApp, known: set[int]):
+    """The session of the browser that arrived after those in ``known`` (added to it)."""
+    assert wait_until(lambda: bool(set(app.sessions()) - known), 20), "no new session"
+    client_id = max(set(app.sessions()) - known)
+    known.add(client_id)
+    return app.sessions()[client_id]
+
+
 def time_readout(page: BrowserPage) -> tuple[float, str]:
     text = page.page.locator("p").filter(has_text=re.compile(r"t = +-?\d")).first.inner_text()
     match = re.search(r"t = +(-?[\d.]+)\s+(\w+)", text)
@@ -116,17 +124,20 @@ def test_links_through_the_landing_open_on_either_worker(make_app, open_page):
     apps = [make_app(), make_app()]
     landing = LandingServer("127.0.0.1", 0, Balancer([AppBackend(a) for a in apps]))
     landing.start()
+    used = []
     try:
-        for query, check in LINKS.items():
+        for query, check in LINKS.items():  # the pages stay: the next goes to the other worker
             page = open_page(f"http://127.0.0.1:{landing.port}/?{query}")
-            port = urllib.parse.urlsplit(page.page.url).port
-            app = next(a for a in apps if a.port == port)
-            assert urllib.parse.urlsplit(page.page.url).query == query  # the redirect kept it
-            check(page, session_of(app, len(app.sessions())))
-            page.page.context.close()  # one rendering page at a time (software WebGL)
+            url = urllib.parse.urlsplit(page.page.url)
+            assert url.query == query  # the redirect kept the link's state
+            app = next(a for a in apps if a.port == url.port)
+            used.append(app)
+            check(page, session_of(app, used.count(app)))
+            assert page.errors == []
     finally:
         landing.shutdown()
         landing.server_close()
+    assert set(map(id, used)) == set(map(id, apps))
 
 
 BAD = {
@@ -141,9 +152,10 @@ BAD = {
 
 def test_a_bad_link_opens_the_default_scene_and_names_the_parameter(make_app, open_page):
     app = make_app()
-    for n, (query, named) in enumerate(BAD.items(), start=1):
+    known: set[int] = set()
+    for query, named in BAD.items():
         page = open_page(f"{app.url}/?{query}")
-        session = session_of(app, n)
+        session = new_session(app, known)
         message = page.page.get_by_text("This link could not be opened")
         assert wait_until(lambda m=message: m.count() == 1, 20), query
         status = message.inner_text()
