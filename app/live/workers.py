@@ -247,10 +247,12 @@ def serve_classroom(
     *,
     announce: bool = True,
     origins: tuple[str, ...] = (),
+    link: str = "",
 ) -> int:
     """Run ``count`` workers behind a landing on ``host:port`` until Ctrl-C (exit status 0),
     or until every worker has ended (1). A port that cannot be served raises
-    :class:`PortError` before anything runs."""
+    :class:`PortError` before anything runs. ``link``: a link's query printed with the board
+    (:func:`~poinsot.app.live.network.board`)."""
     from poinsot.app.live.landing import Balancer, LandingServer
     from poinsot.app.live.network import board
 
@@ -263,7 +265,7 @@ def serve_classroom(
         raise
     landing.start()
     if announce:
-        print(board(host, landing.port), flush=True)
+        print(board(host, landing.port, link), flush=True)
         ports = ", ".join(str(w.port) for w in workers)
         print(f"{count} workers on ports {ports}; each new browser goes to the least busy")
     try:
