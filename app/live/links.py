@@ -214,12 +214,22 @@ def _general(
     return Opening(preset, scene, t, view, speed, paused in _TRUE, page=page)
 
 
-def opening(address: str | None, preset: Preset, scene: SceneSpec | None) -> Opening:
+def opening(
+    address: str | None,
+    preset: Preset,
+    scene: SceneSpec | None,
+    landing: tuple[int, int] = (0, 0),
+) -> Opening:
     """What the page at ``address`` opens: its link's state, or (no query, no address) the
     server's ``preset`` or ``scene``; a bad link opens those too, with a message naming its
-    parameter."""
+    parameter. ``landing``: (this server's port, its landing's): a page served straight from
+    here copies links that name the landing, which spreads the browsers that open them."""
     page, _, query = (address or "").partition("?")
     query = query.partition("#")[0]
+    parts = urllib.parse.urlsplit(page)
+    if all(landing) and parts.port == landing[0] and parts.hostname:
+        host = f"[{parts.hostname}]" if ":" in parts.hostname else parts.hostname
+        page = parts._replace(netloc=f"{host}:{landing[1]}").geturl()
     default = Opening(preset, scene, page=page)
     if not _pairs_or_empty(query):
         return default

@@ -48,14 +48,17 @@ class PoinsotApp:
         verbose: bool = False,
         allow_origins: Iterable[str] = (),
         backlog: BacklogLimit | None = None,
+        landing_port: int = 0,
     ) -> None:
         """Each new browser starts with ``preset``, or with ``scene`` if one is given. A
         browser's websocket is refused unless it comes from a page this server served, or from
         one of ``allow_origins`` (``scheme://host[:port]``); see :mod:`.guard`. A browser that
         leaves more than ``backlog`` untaken for longer than its grace is disconnected
-        (:mod:`.backlog`; its defaults if None)."""
+        (:mod:`.backlog`; its defaults if None). ``landing_port``: a landing in front of this
+        server (:mod:`.landing`), named by the links copied from the pages served here."""
         self.preset = preset
         self.scene = scene
+        self.landing_port = landing_port
         self.max_fps = max_fps
         self._lock = threading.Lock()
         self._sessions: dict[int, Session] = {}
@@ -138,7 +141,7 @@ class PoinsotApp:
                 self._departed.discard(client.client_id)
                 self.discarded += 1
                 return
-        link = links.opening(address, self.preset, self.scene)
+        link = links.opening(address, self.preset, self.scene, (self.port, self.landing_port))
         session = Session(
             client, link.preset, max_fps=self.max_fps, budget=self.budget, scene=link.scene
         )

@@ -85,6 +85,15 @@ def test_no_link_opens_the_server_s_default_without_a_message():
         assert (opened.preset, opened.scene, opened.problem) == (DEFAULT_PRESET, scene, "")
 
 
+def test_a_worker_s_page_copies_links_that_name_the_landing():
+    address = "http://10.0.0.7:8081/?preset=oblate"
+    assert opening(address, DEFAULT_PRESET, None, (8081, 8080)).page == "http://10.0.0.7:8080/"
+    assert opening(address, DEFAULT_PRESET, None, (8081, 0)).page == "http://10.0.0.7:8081/"
+    # through a proxy the page is not on this server's port: its address is kept
+    proxied = "https://lab.example/?preset=oblate"
+    assert opening(proxied, DEFAULT_PRESET, None, (8081, 8080)).page == "https://lab.example/"
+
+
 def test_serve_link_prints_the_link_and_its_qr_code(monkeypatch):
     monkeypatch.setattr(network, "_interface_addresses", lambda: [("wlan0", "10.0.0.7")])
     monkeypatch.setattr(network, "_route_address", lambda: "10.0.0.7")

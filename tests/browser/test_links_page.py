@@ -125,6 +125,8 @@ def test_links_through_the_landing_open_on_either_worker(make_app, make_probe, o
     apps = [make_app(), make_app()]
     landing = LandingServer("127.0.0.1", 0, Balancer([AppBackend(a) for a in apps]))
     landing.start()
+    for app in apps:  # as poinsot serve --workers tells its workers
+        app.landing_port = landing.port
     known: dict[int, set[int]] = {id(a): set() for a in apps}
     used = []
     try:
@@ -134,7 +136,11 @@ def test_links_through_the_landing_open_on_either_worker(make_app, make_probe, o
             assert url.query == query  # the redirect kept the link's state
             app = next(a for a in apps if a.port == url.port)
             used.append(app)
-            check(page, new_session(app, known[id(app)]))
+            session = new_session(app, known[id(app)])
+            check(page, session)
+            if len(used) == 1:  # a copied link names the landing, not the worker
+                link = copy_link(page, session)
+                assert link.startswith(f"http://127.0.0.1:{landing.port}/?")
             assert page.errors == []
             page.page.context.close()  # one rendering page at a time (software WebGL is slow)
             make_probe(app)  # holds that worker's load: the next browser goes to the other
