@@ -36,6 +36,7 @@ from poinsot.app.arguments import (
 from poinsot.app.check_engine import add_check_engine_arguments
 from poinsot.app.cli_types import (
     fixed_view_type,
+    link_type,
     preset_type,
     scene_only_type,
     scene_type,
@@ -74,6 +75,7 @@ def serve(
     start_scene: SceneSpec | None,
     workers: int,
     allow_origin: list[str],
+    link: str | None = None,
 ) -> int:
     """Serve until interrupted (Ctrl-C); each browser starts with ``start_scene`` if given,
     else with ``preset``. With ``workers`` > 1 the sessions run in that many processes behind
@@ -87,7 +89,10 @@ def serve(
             from poinsot.app.live.workers import serve_classroom
 
             scene = start_scene.name if start_scene else None
-            return serve_classroom(host, port, workers, preset, scene, origins=tuple(allow_origin))
+            origins = tuple(allow_origin)
+            return serve_classroom(
+                host, port, workers, preset, scene, origins=origins, link=link or ""
+            )
     except PortError as exc:
         print(f"poinsot serve: {exc}", file=sys.stderr)
         return 2
@@ -100,7 +105,7 @@ def serve(
         app.stop()
         print(f"poinsot serve: {port_problem(host, port)}", file=sys.stderr)
         return 2
-    print(board(host, app.port), flush=True)
+    print(board(host, app.port, link or ""), flush=True)
     try:
         while True:
             time.sleep(3600)
@@ -216,6 +221,14 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         default=[],
         metavar="ORIGIN",
         help="also accept browsers from this page's origin (http://host:port); repeatable",
+    )
+    parser.add_argument(
+        "--link",
+        type=link_type,
+        default=None,
+        metavar="QUERY",
+        help="also print the link to this state and its QR code, as 'preset=t_handle&t=12"
+        "&view=side' (the README's table lists the parameters)",
     )
     which = parser.add_mutually_exclusive_group()
     which.add_argument(

@@ -8,6 +8,7 @@ import argparse
 import math
 
 from poinsot.app.exports.screenshot import parse_size, resolve_scene
+from poinsot.app.live.links import LinkError, parse
 from poinsot.app.presets import Preset, preset_by_key
 from poinsot.app.scene.cameras import RIDE_ALONG, canonical
 from poinsot.app.scenes import scene_by_name
@@ -68,3 +69,16 @@ def size_type(text: str) -> tuple[int, int]:
         return parse_size(text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from exc
+
+
+def link_type(text: str) -> str:
+    """A link to a state (:mod:`poinsot.app.live.links`): its query, or a whole URL; the
+    query is returned, checked."""
+    query = text.partition("?")[2] if "?" in text else text
+    try:
+        parse(query)
+    except LinkError as exc:
+        raise argparse.ArgumentTypeError(f"this link cannot be opened: {exc}") from None
+    if not query.strip():
+        raise argparse.ArgumentTypeError("a link needs a state, as 'preset=t_handle&t=12'")
+    return query.strip()

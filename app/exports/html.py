@@ -13,6 +13,8 @@ import re
 import time
 from typing import Any
 
+from viser.infra import StateSerializer
+
 from poinsot.app.elements import Element, Solid
 from poinsot.app.exports.stage import Stage
 from poinsot.app.parameters import Parameters
@@ -66,15 +68,25 @@ def _record(
     title: str,
 ) -> str:
     """Record ``seconds`` of a stage, frame by frame, as a page that plays from a file."""
+    html = record(stage, seconds, fps, speed, view).as_html(dark_mode=dark_mode)
+    safe_title = re.sub(r"[<>&\"]", "", title)
+    return html.replace("<title>Viser</title>", f"<title>{safe_title}</title>", 1)
+
+
+def record(
+    stage: Stage | SceneStage, seconds: float, fps: float, speed: float, view: View
+) -> StateSerializer:
+    """``seconds`` of a stage recorded frame by frame (``speed`` simulation time units per
+    second) by viser's scene serializer: its ``as_html()`` is a page, its ``show()`` the viewer
+    inline in a notebook."""
+    _check_clip(seconds, fps)
     stage.set_initial_camera(view)
     serializer = stage.server.get_scene_serializer()  # snapshot: the scene at t = 0
     frames = round(seconds * fps)
     for i in range(1, frames + 1):
         serializer.insert_sleep(1.0 / fps)
         stage.advance(i / fps * speed)
-    html = serializer.as_html(dark_mode=dark_mode)
-    safe_title = re.sub(r"[<>&\"]", "", title)
-    return html.replace("<title>Viser</title>", f"<title>{safe_title}</title>", 1)
+    return serializer
 
 
 def scene_html(

@@ -32,6 +32,7 @@ from poinsot.app.exports.run_csv import run_csv, run_span
 from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
 from poinsot.app.live.clock import SimClock
 from poinsot.app.live.display import LARGE_TEXT_PERCENT, Display
+from poinsot.app.live.links import link_of
 from poinsot.app.live.motion_window import MotionWindow
 from poinsot.app.live.widgets import Sent, on_user, set_value
 from poinsot.app.presets import Preset
@@ -39,6 +40,7 @@ from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.cameras import BODY_VIEW, CAMERA_NAMES, RIDE_ALONG, ride_along, space_view
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.view import View
+from poinsot.app.viser_private import copy_to_clipboard
 from poinsot.physics import FreeRigidBody
 
 #: Seconds a screenshot waits for the browser's render. A GPU browser answers a 4K render in
@@ -66,6 +68,7 @@ class LectureSession(Protocol):
     def panel(self) -> HasMotion: ...
 
     def toggle_pause(self) -> None: ...
+    def post(self, action: Callable[[], None], key: object = None) -> None: ...
 
 
 class HasMotion(Protocol):
@@ -90,6 +93,9 @@ class LectureControls:
         self._camera_lock = threading.Lock()
         self._render_lock = threading.Lock()
         self.last_download: str = ""  # name of the last file handed to the browser
+        #: The page's address as its browser sees it (set by :func:`.links.apply`), and the
+        #: last link given by "Copy link".
+        self.page = self.last_link = ""
         with self.client.gui.add_folder("Lecture: views and export", order=order):
             self._add_widgets(self.client.gui)
         self.display = Display(session, session.panel.motion, self.style)
@@ -99,6 +105,10 @@ class LectureControls:
             (self.screenshot, lambda _: self._discard(self.take_screenshot())),
             (self.csv, lambda _: self._discard(self.download_csv())),
             (self.glb, lambda _: self._discard(self.download_glb())),
+            (
+                self.link,
+                lambda _: self.session.post(lambda: self._discard(self.copy_link()), "link"),
+            ),
             (self.dark, lambda sent: self.set_theme(dark=bool(sent.value))),
             (self.large, lambda sent: self.set_theme(large=bool(sent.value))),
             (self.projector, lambda sent: self.display.request(projector=bool(sent.value))),
@@ -133,6 +143,12 @@ class LectureControls:
             "Mesh: ellipsoid, plane, curves (GLB)",
             icon=viser.Icon.CUBE,
             hint="For Blender or any glTF viewer.",
+        )
+        self.link = gui.add_button(
+            "Copy link",
+            icon=viser.Icon.LINK,
+            hint="A link that opens exactly this: the scene or body, the time, the view, the "
+            "speed, paused or playing.",
         )
         self.dark = gui.add_checkbox("Dark theme", True)
         self.large = gui.add_checkbox("Large text", False, hint="Scales every text of the panel.")
@@ -194,6 +210,15 @@ class LectureControls:
     # -- messages ------------------------------------------------------------------------
     def show(self, text: str, error: bool = False) -> None:
         self.message.content = f"**⚠ {text}**" if error else text
+
+    def copy_link(self) -> str:
+        """(The session's frame thread) the link of what is on screen, shown under the tools
+        and put on the browser's clipboard."""
+        link = link_of(self.session)  # type: ignore[arg-type]
+        self.last_link = link
+        copy_to_clipboard(self.client, link)
+        self.show(f"Link to this state (copied to the clipboard):\n\n`{link}`")
+        return link
 
     # -- camera --------------------------------------------------------------------------
     def _on_view(self, sent: Sent) -> None:

@@ -118,17 +118,25 @@ def qr_text(text: str) -> str:
     )
 
 
-def board(host: str, port: int) -> str:
+def board(host: str, port: int, link: str = "") -> str:
     """What to print for the lecturer: the URL to open here, and with ``host`` 0.0.0.0 the
-    URL(s) to write on the board with a QR code of the first."""
-    if host not in ANY_HOST:
-        return f"Poinsot is running at http://{host}:{port}  (Ctrl-C to stop)"
-    lines = [f"Poinsot is running at http://localhost:{port}  (Ctrl-C to stop)"]
-    addresses = lan_addresses()
-    if not addresses:
-        lines.append("No network address found: students cannot reach this machine yet.")
-        return "\n".join(lines)
-    lines.append("Students open (write it on the board):")
-    lines += [f"    http://{address}:{port}    ({name})" for name, address in addresses]
-    lines.append(qr_text(f"http://{addresses[0][1]}:{port}"))
+    URL(s) to write on the board with a QR code of the first. With a ``link`` (a query, as
+    ``preset=t_handle&t=12``), also the link to that state on the first address, and its QR
+    code."""
+    lines = [f"Poinsot is running at http://{host}:{port}  (Ctrl-C to stop)"]
+    shown = host
+    if host in ANY_HOST:
+        lines = [f"Poinsot is running at http://localhost:{port}  (Ctrl-C to stop)"]
+        addresses = lan_addresses()
+        if not addresses:
+            lines.append("No network address found: students cannot reach this machine yet.")
+            shown = "localhost"
+        else:
+            lines.append("Students open (write it on the board):")
+            lines += [f"    http://{address}:{port}    ({name})" for name, address in addresses]
+            lines.append(qr_text(f"http://{addresses[0][1]}:{port}"))
+            shown = addresses[0][1]
+    if link:
+        url = f"http://{shown}:{port}/?{link}"
+        lines += [f"The link to this state: {url}", qr_text(url)]
     return "\n".join(lines)

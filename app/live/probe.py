@@ -224,6 +224,7 @@ class Probe:
                         )
                     self._cond.notify_all()
                 for message in messages:
+                    self._answer(message)
                     for listener in self._listeners:
                         listener(message, now)
         except websockets.ConnectionClosed:
@@ -232,6 +233,16 @@ class Probe:
             with self._cond:
                 self._closed = True
                 self._cond.notify_all()
+
+    def _answer(self, m: dict[str, Any]) -> None:
+        """Answer what the server asks of a page as a page that runs no JavaScript would: its
+        localStorage holds nothing (the server then opens its default scene at once)."""
+        if m["type"] == "LocalStorageGetItemRequestMessage":
+            self.send(
+                _messages.LocalStorageGetItemResponseMessage(
+                    value=None, error=None, request_uuid=str(m["request_uuid"])
+                )
+            )
 
     def _apply(self, m: dict[str, Any]) -> None:
         kind: str = m["type"]

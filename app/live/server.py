@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import logging
 import threading
 import warnings
@@ -10,6 +11,7 @@ from concurrent.futures import Future
 
 import viser
 
+from poinsot.app.live import links
 from poinsot.app.live.backlog import BacklogLimit, BacklogWatch
 from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.guard import WireGuard
@@ -18,8 +20,12 @@ from poinsot.app.live.session import MAX_FPS, Session
 from poinsot.app.live.upkeep import MemoryTrim, fixed_pool
 from poinsot.app.presets import DEFAULT_PRESET, Preset
 from poinsot.app.scenes.spec import SceneSpec
+from poinsot.app.viser_private import handshake_origin, page_address
 
 log = logging.getLogger(__name__)
+
+#: Seconds a new page has to say its address (its link) before it opens the default scene.
+PAGE_TIMEOUT = 10.0
 
 
 def _log_failure(future: Future[None]) -> None:
@@ -42,14 +48,17 @@ class PoinsotApp:
         verbose: bool = False,
         allow_origins: Iterable[str] = (),
         backlog: BacklogLimit | None = None,
+        landing_port: int = 0,
     ) -> None:
         """Each new browser starts with ``preset``, or with ``scene`` if one is given. A
         browser's websocket is refused unless it comes from a page this server served, or from
         one of ``allow_origins`` (``scheme://host[:port]``); see :mod:`.guard`. A browser that
         leaves more than ``backlog`` untaken for longer than its grace is disconnected
-        (:mod:`.backlog`; its defaults if None)."""
+        (:mod:`.backlog`; its defaults if None). ``landing_port``: a landing in front of this
+        server (:mod:`.landing`), named by the links copied from the pages served here."""
         self.preset = preset
         self.scene = scene
+        self.landing_port = landing_port
         self.max_fps = max_fps
         self._lock = threading.Lock()
         self._sessions: dict[int, Session] = {}
@@ -57,6 +66,7 @@ class PoinsotApp:
         # sync callbacks on a thread pool, so the disconnect handler may run before (or while)
         # the connect handler builds the session. Both handlers decide under ``_lock``.
         self._departed: set[int] = set()
+        self._arrivals: set[asyncio.Task[None]] = set()  # pages asked for their address
         #: Sessions built for a client that had already left, closed before they started.
         self.discarded = 0
         self._connected = threading.Condition(self._lock)
@@ -102,24 +112,40 @@ class PoinsotApp:
             return list(self._sessions.values())
 
     async def _on_connect(self, client: viser.ClientHandle) -> None:
+        if handshake_origin(self.server, client.client_id) is None:  # a tool: no page, no link
+            self._build(client, None)
+            return
+        # A web page says its address (the link it was opened with) once viser reads the
+        # socket, after this handler: asked in a task of its own, which then builds the session.
+        task = asyncio.get_running_loop().create_task(self._arrive(client))
+        self._arrivals.add(task)
+        task.add_done_callback(self._arrivals.discard)
+
+    async def _arrive(self, client: viser.ClientHandle) -> None:
+        self._build(client, await page_address(client, PAGE_TIMEOUT))
+
+    def _build(self, client: viser.ClientHandle, address: str | None) -> None:
         # Not awaited: viser goes on with the socket. A failure is logged, as viser's would be.
-        self.pool.submit(self._connect, client).add_done_callback(_log_failure)
+        self.pool.submit(self._connect, client, address).add_done_callback(_log_failure)
 
     async def _on_disconnect(self, client: viser.ClientHandle) -> None:
         self._disconnect(client)
         self.memory.departed()
 
-    def _connect(self, client: viser.ClientHandle) -> None:
+    def _connect(self, client: viser.ClientHandle, address: str | None = None) -> None:
         """Build the session outside the lock (30-300 ms), then register and start it under
-        the lock, unless the client left meanwhile: then it is closed and never started."""
+        the lock, unless the client left meanwhile: then it is closed and never started. The
+        page's ``address`` may carry a link to a state (:mod:`.links`)."""
         with self._lock:
             if client.client_id in self._departed:
                 self._departed.discard(client.client_id)
                 self.discarded += 1
                 return
+        link = links.opening(address, self.preset, self.scene, (self.port, self.landing_port))
         session = Session(
-            client, self.preset, max_fps=self.max_fps, budget=self.budget, scene=self.scene
+            client, link.preset, max_fps=self.max_fps, budget=self.budget, scene=link.scene
         )
+        links.apply(session, link)
         with self._connected:
             if client.client_id in self._departed:
                 self._departed.discard(client.client_id)

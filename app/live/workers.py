@@ -61,6 +61,7 @@ def _worker_main(
     preset: str,
     scene: str | None,
     origins: tuple[str, ...] = (),
+    landing: int = 0,
 ) -> None:
     """The worker: serve, report ``("ready", port)``, stop when told or when the parent's end
     of the pipe closes (then, whatever happens, the process ends within ``STOP_GRACE``).
@@ -73,7 +74,7 @@ def _worker_main(
     app = None
     status = 0
     try:
-        app = _serve(host, port, preset, scene, origins)
+        app = _serve(host, port, preset, scene, origins, landing)
         if port and app.port != port:  # viser moved on to the next free port: refuse
             conn.send(("error", port_problem(host, port)))
             return
@@ -95,7 +96,12 @@ def _worker_main(
 
 
 def _serve(
-    host: str, port: int, preset: str, scene: str | None, origins: tuple[str, ...]
+    host: str,
+    port: int,
+    preset: str,
+    scene: str | None,
+    origins: tuple[str, ...],
+    landing: int = 0,
 ) -> PoinsotApp:
     from poinsot.app.live.server import PoinsotApp
     from poinsot.app.presets import preset_by_key
@@ -103,7 +109,12 @@ def _serve(
 
     start_scene = scene_by_name(scene) if scene else None
     return PoinsotApp(
-        host, port, preset=preset_by_key(preset), scene=start_scene, allow_origins=origins
+        host,
+        port,
+        preset=preset_by_key(preset),
+        scene=start_scene,
+        allow_origins=origins,
+        landing_port=landing,
     )
 
 
@@ -118,6 +129,7 @@ class Worker:
         preset: str,
         scene: str | None,
         origins: tuple[str, ...] = (),
+        landing: int = 0,
     ):
         ctx = mp.get_context("spawn")
         self.index = index
@@ -125,7 +137,7 @@ class Worker:
         self.conn, child_end = ctx.Pipe()
         self.process = ctx.Process(
             target=_worker_main,
-            args=(child_end, self.load, host, port, preset, scene, origins),
+            args=(child_end, self.load, host, port, preset, scene, origins, landing),
             name=f"poinsot-worker-{index}",
             daemon=True,
         )
@@ -200,7 +212,8 @@ def start_workers(
     ports = [port + 1 + i if port else 0 for i in range(count)]
     for p in ports:
         check_port(host, p)
-    workers = [Worker(i, host, p, preset, scene, origins) for i, p in enumerate(ports)]
+    # Links copied from a worker's page name the landing (a fixed port: known now).
+    workers = [Worker(i, host, p, preset, scene, origins, port) for i, p in enumerate(ports)]
     try:
         for worker in workers:
             worker.wait_ready(START_TIMEOUT)
@@ -247,10 +260,12 @@ def serve_classroom(
     *,
     announce: bool = True,
     origins: tuple[str, ...] = (),
+    link: str = "",
 ) -> int:
     """Run ``count`` workers behind a landing on ``host:port`` until Ctrl-C (exit status 0),
     or until every worker has ended (1). A port that cannot be served raises
-    :class:`PortError` before anything runs."""
+    :class:`PortError` before anything runs. ``link``: a link's query printed with the board
+    (:func:`~poinsot.app.live.network.board`)."""
     from poinsot.app.live.landing import Balancer, LandingServer
     from poinsot.app.live.network import board
 
@@ -263,7 +278,7 @@ def serve_classroom(
         raise
     landing.start()
     if announce:
-        print(board(host, landing.port), flush=True)
+        print(board(host, landing.port, link), flush=True)
         ports = ", ".join(str(w.port) for w in workers)
         print(f"{count} workers on ports {ports}; each new browser goes to the least busy")
     try:
