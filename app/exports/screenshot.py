@@ -397,7 +397,8 @@ def pose_stage(
     labels, and return the picture's camera and time."""
     if strobe is not None:
         fixed = scene.view if isinstance(scene, SceneSpec) and view == "default" else None
-        camera = add_strobe(stage, strobe, fixed or space_view(view), stage.dark_mode)
+        aspect = size[0] / size[1]
+        camera = add_strobe(stage, strobe, fixed or space_view(view), stage.dark_mode, aspect)
         t = stage.frame.t
     else:
         t = t if t is not None else picture_time(stage)

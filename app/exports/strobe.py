@@ -20,6 +20,7 @@ import dataclasses
 import math
 
 import numpy as np
+import viser
 
 from poinsot.app.exports.stage import Stage
 from poinsot.app.scene.geometry import (
@@ -49,6 +50,8 @@ SLOT_FILL = 0.42
 MAX_COPY_RADIUS = 0.5
 #: The row's centres stand this many copy radii below the construction.
 ROW_GAP = 1.6
+#: Room kept above L's tip for its label [display units].
+LABEL_ROOM = 0.3
 #: Without a period, the strobe covers this much time.
 DEFAULT_SPAN = 20.0
 
@@ -128,13 +131,14 @@ def _basis(view: View) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
 
 
 def construction_points(geometry: Geometry) -> np.ndarray:
-    """Points that bound the construction (the plane's rim, L's tip, the ellipsoid's reach)."""
+    """Points that bound the construction (the plane's rim, L's tip and room for its label
+    above it, the ellipsoid's reach)."""
     angle = np.linspace(0.0, 2.0 * np.pi, 72, endpoint=False)
     h = geometry.plane_height
     rim = np.column_stack([PLANE_RADIUS * np.cos(angle), PLANE_RADIUS * np.sin(angle)])
     rim = np.column_stack([rim, np.full(angle.size, h)])
     reach = DISPLAY_RADIUS * np.vstack([np.eye(3), -np.eye(3)])
-    return np.vstack([rim, reach, [(0.0, 0.0, h + L_OVERSHOOT)]])
+    return np.vstack([rim, reach, [(0.0, 0.0, h + L_OVERSHOOT + LABEL_ROOM)]])
 
 
 @dataclasses.dataclass(frozen=True)
@@ -145,6 +149,12 @@ class Row:
     centres: np.ndarray
     scale: float
     camera: View
+    radius: float  # a copy's reach from its centre [display units]
+
+    def bounds(self) -> np.ndarray:
+        """Points around every copy (the corners of a cube of side 2 radius about each)."""
+        signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T
+        return (self.centres[:, None, :] + self.radius * signs[None]).reshape(-1, 3)
 
 
 def row_below(view: View, points: np.ndarray, copies: int, mesh_radius: float) -> Row:
@@ -169,7 +179,7 @@ def row_below(view: View, points: np.ndarray, copies: int, mesh_radius: float) -
         position=triple(np.asarray(view.position) + shift),
         look_at=triple(np.asarray(view.look_at) + shift),
     )
-    return Row(centres, radius / mesh_radius, camera)
+    return Row(centres, radius / mesh_radius, camera, radius)
 
 
 def geometry_of(stage: Stage | SceneStage) -> Geometry:
@@ -184,28 +194,60 @@ def body_of(stage: Stage | SceneStage) -> FreeRigidBody | None:
     return stage.body if isinstance(stage, Stage) else stage.poinsot.body
 
 
-def add_strobe(stage: Stage | SceneStage, strobe: Strobe, view: View, dark_mode: bool) -> View:
-    """Pose ``stage`` at the interval's end (traces drawn up to it) with the row of copies, and
-    return the camera that centres both (``view`` moved sideways)."""
-    times = strobe.times(body_of(stage))
-    attitudes = [stage.seek(float(t)).wxyz for t in times]  # forward in time: traces grow
-    geometry = geometry_of(stage)
+def add_copies(
+    api: viser.SceneApi,
+    geometry: Geometry,
+    attitudes: list[np.ndarray],
+    view: View,
+    dark_mode: bool,
+    prefix: str = "/strobe",
+) -> tuple[Row, list[viser.MeshHandle]]:
+    """The copies of the body at ``attitudes`` (wxyz, earliest first) in a row below the
+    construction as ``view`` sees it; the row and the copies' handles."""
     vertices, faces = body_mesh(geometry)
     radius = float(np.linalg.norm(vertices, axis=1).max())
-    row = row_below(view, construction_points(geometry), strobe.copies, radius)
-    opacity = np.linspace(FAINTEST, 1.0, strobe.copies)
+    row = row_below(view, construction_points(geometry), len(attitudes), radius)
+    opacity = np.linspace(FAINTEST, 1.0, len(attitudes))
+    handles = [
+        api.add_mesh_simple(
+            f"{prefix}/copy{k}",
+            (vertices * row.scale).astype(np.float32),
+            faces.astype(np.uint32),
+            color=STROBE_COLOR[dark_mode],
+            opacity=float(opacity[k]) if opacity[k] < 1.0 else None,
+            wxyz=np.asarray(wxyz, float),
+            position=centre,
+            cast_shadow=False,
+            receive_shadow=False,
+        )
+        for k, (wxyz, centre) in enumerate(zip(attitudes, row.centres, strict=True))
+    ]
+    return row, handles
+
+
+def framing_fov(view: View, points: np.ndarray, aspect: float, fill: float = 0.9) -> float:
+    """The vertical field of view [degrees] in which ``points`` fill ``fill`` of a picture of
+    ``aspect`` (width / height) seen from ``view`` (its direction kept)."""
+    forward, right, down, _ = _basis(view)
+    rel = points - np.asarray(view.position, float)
+    depth = rel @ forward
+    if np.any(depth <= 0.0):
+        raise StrobeError("the camera is inside the construction: no room for a strobe row")
+    x, y = np.abs(rel @ right / depth).max(), np.abs(rel @ down / depth).max()
+    return math.degrees(2.0 * math.atan(max(y, x / aspect) / fill))
+
+
+def add_strobe(
+    stage: Stage | SceneStage, strobe: Strobe, view: View, dark_mode: bool, aspect: float
+) -> View:
+    """Pose ``stage`` at the interval's end (traces drawn up to it) with the row of copies, and
+    return the camera that holds both in a picture of ``aspect`` (``view`` moved sideways, its
+    field of view widened or narrowed to frame them)."""
+    times = strobe.times(body_of(stage))
+    attitudes = [stage.seek(float(t)).wxyz for t in times]  # forward in time: traces grow
     construction = stage.scene if isinstance(stage, Stage) else stage.poinsot
+    geometry = geometry_of(stage)
     with stage.atomic():
-        for k, (wxyz, centre) in enumerate(zip(attitudes, row.centres, strict=True)):
-            construction.api.add_mesh_simple(
-                f"/strobe/copy{k}",
-                (vertices * row.scale).astype(np.float32),
-                faces.astype(np.uint32),
-                color=STROBE_COLOR[dark_mode],
-                opacity=float(opacity[k]) if opacity[k] < 1.0 else None,
-                wxyz=np.asarray(wxyz, float),
-                position=centre,
-                cast_shadow=False,
-                receive_shadow=False,
-            )
-    return row.camera
+        row, _ = add_copies(construction.api, geometry, attitudes, view, dark_mode)
+    points = np.vstack([construction_points(geometry), row.bounds()])
+    return dataclasses.replace(row.camera, fov_degrees=framing_fov(row.camera, points, aspect))
