@@ -459,7 +459,7 @@ def screenshot_command(
     strobe_text = ""
     if strobe is not None:
         t0, t1 = strobe.interval(body_of(stage))
-        strobe_text = f", strobe of {strobe.copies} copies over [{t0:g}, {t1:g}]"
+        strobe_text = f", strobe of {strobe.copies} copies over [{t0:.3f}, {t1:.3f}]"
     print(
         f"wrote {out} ({shot.width}x{shot.height}, scene {scene.key}, t = {t:g}, "
         f"view {view}, fov {shot.fov_degrees:.1f} deg{strobe_text}) in {shot.seconds:.1f} s"
