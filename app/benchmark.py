@@ -22,6 +22,11 @@ prints:
   rebuild time alone.
 
 Targets: <= 1 ms per client-frame, <= 30 ms per redraw.
+
+``poinsot benchmark --video`` instead films the video row (:func:`video_row`): 10 s of the
+T-handle at 1280x720 and 25 frames per second as MP4 (``poinsot video``'s pipeline: headless
+Chromium renders, imageio-ffmpeg encodes) and prints the seconds per rendered frame, the whole
+time and the file's size. Targets: <= 3 minutes and <= 5 MB.
 """
 
 from __future__ import annotations
@@ -282,12 +287,53 @@ def format_result(r: Result) -> str:
     )
 
 
-def main(clients: Sequence[int] = (1, 20), seconds: float = 5.0, redraws: int = 30) -> int:
-    """Run the benchmark for each number of ``clients`` and print the results."""
+#: The video row: what it films, and its targets.
+VIDEO_PRESET, VIDEO_SECONDS, VIDEO_SIZE, VIDEO_FPS = "t_handle", 10.0, (1280, 720), 25.0
+VIDEO_MAX_SECONDS, VIDEO_MAX_MB = 180.0, 5.0
+
+
+def video_row() -> str:
+    """Film the benchmark's clip (MP4, in a temporary folder) and describe it in one line."""
+    import tempfile
+    from pathlib import Path
+
+    from poinsot.app.exports.screenshot import THEME_BACKGROUND, find_chromium, open_stage
+    from poinsot.app.exports.video import Clip, film
+    from poinsot.app.presets import preset_by_key
+    from poinsot.app.scene.cameras import space_view
+
+    preset = preset_by_key(VIDEO_PRESET)
+    clip = Clip(VIDEO_SECONDS, VIDEO_FPS, VIDEO_SIZE, speed=preset.speed)
+    with tempfile.TemporaryDirectory() as folder:
+        made = film(
+            lambda client_of: open_stage(preset, dark_mode=True, client_of=client_of),
+            clip,
+            space_view("default"),
+            Path(folder) / "clip.mp4",
+            chromium=find_chromium(),
+            background=THEME_BACKGROUND[True],
+        )
+    width, height = VIDEO_SIZE
+    return (
+        f"video ({VIDEO_PRESET}, {VIDEO_SECONDS:g} s at {width}x{height}, {VIDEO_FPS:g} fps, MP4): "
+        f"{made.seconds_per_frame:.3f} s per rendered frame, {made.seconds:.0f} s in all "
+        f"(target <= {VIDEO_MAX_SECONDS:.0f} s), {made.bytes / 1e6:.2f} MB "
+        f"(target <= {VIDEO_MAX_MB:g} MB)"
+    )
+
+
+def main(
+    clients: Sequence[int] = (1, 20), seconds: float = 5.0, redraws: int = 30, video: bool = False
+) -> int:
+    """Run the benchmark for each number of ``clients`` and print the results (with
+    ``video``: the video row alone)."""
     print(
         f"Poinsot app benchmark (python {sys.version.split()[0]}, {os.cpu_count()} CPUs, "
         f"load average {os.getloadavg()[0]:.1f})"
     )
+    if video:
+        print(video_row(), flush=True)
+        return 0
     for n in clients:
         print(format_result(run(n, seconds, redraws)), flush=True)
     print(

@@ -34,6 +34,7 @@ from poinsot.app.arguments import (
     run_guarded,
 )
 from poinsot.app.check_engine import add_check_engine_arguments
+from poinsot.app.cli_motion import add_strobe_arguments, add_video_arguments
 from poinsot.app.cli_types import (
     fixed_view_type,
     link_type,
@@ -133,12 +134,23 @@ def screenshot(
     view: str,
     background: str,
     fit: bool,
+    strobe: int | None,
+    t_from: float | None,
+    t_to: float | None,
 ) -> int:
     """Write a PNG of a scene through headless Chromium (see
-    :mod:`poinsot.app.exports.screenshot`)."""
+    :mod:`poinsot.app.exports.screenshot`), with a strobe of the body if asked."""
+    from poinsot.app.cli_motion import strobe_of
     from poinsot.app.exports.screenshot import screenshot_command
 
-    return screenshot_command(out, scene, t=t, size=size, view=view, background=background, fit=fit)
+    try:
+        copies = strobe_of(strobe, t_from, t_to, t, view)
+    except ValueError as exc:
+        print(f"poinsot screenshot: error: {exc}", file=sys.stderr)
+        return 2
+    return screenshot_command(
+        out, scene, t=t, size=size, view=view, background=background, fit=fit, strobe=copies
+    )
 
 
 def export_html(
@@ -186,11 +198,11 @@ def fit(
     )
 
 
-def benchmark(clients: list[int], seconds: float, redraws: int) -> int:
-    """Measure the live server (see :mod:`poinsot.app.benchmark`)."""
+def benchmark(clients: list[int], seconds: float, redraws: int, video: bool) -> int:
+    """Measure the live server, or the video export (see :mod:`poinsot.app.benchmark`)."""
     from poinsot.app.benchmark import main as benchmark_main
 
-    return benchmark_main(clients, seconds, redraws)
+    return benchmark_main(clients, seconds, redraws, video)
 
 
 # -- the parser -----------------------------------------------------------------------------
@@ -308,6 +320,7 @@ def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_false",
         help="keep the view's field of view instead of framing the construction",
     )
+    add_strobe_arguments(parser)
     parser.add_argument("--out", type=output_file, required=True, help="output .png file")
     parser.set_defaults(func=screenshot)
 
@@ -356,6 +369,11 @@ def _add_benchmark_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--seconds", type=positive_float, default=5.0, help="steady-state window")
     parser.add_argument("--redraws", type=positive_int, default=30, help="slider moves per run")
+    parser.add_argument(
+        "--video",
+        action="store_true",
+        help="instead, film 10 s at 1280x720 (poinsot video): seconds per frame and MB",
+    )
     parser.set_defaults(func=benchmark)
 
 
@@ -409,6 +427,7 @@ _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] =
         "a standalone animated HTML page that plays from a file",
         _add_export_html_arguments,
     ),
+    "video": ("an MP4 or GIF of a scene, rendered by headless Chromium", add_video_arguments),
     "benchmark": (
         "server time per client-frame, bytes per frame and slider-to-redraw time",
         _add_benchmark_arguments,

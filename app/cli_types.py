@@ -6,8 +6,12 @@ from __future__ import annotations
 
 import argparse
 import math
+import pathlib
 
+from poinsot.app.arguments import output_file
 from poinsot.app.exports.screenshot import parse_size, resolve_scene
+from poinsot.app.exports.video import FORMATS as VIDEO_FORMATS
+from poinsot.app.exports.video import MAX_SIZE as VIDEO_MAX_SIZE
 from poinsot.app.live.links import LinkError, parse
 from poinsot.app.presets import Preset, preset_by_key
 from poinsot.app.scene.cameras import RIDE_ALONG, canonical
@@ -82,3 +86,21 @@ def link_type(text: str) -> str:
     if not query.strip():
         raise argparse.ArgumentTypeError("a link needs a state, as 'preset=t_handle&t=12'")
     return query.strip()
+
+
+def video_file(text: str) -> pathlib.Path:
+    """A video to write: a file name ending in .mp4 or .gif, in a folder that takes files."""
+    path = output_file(text)
+    if path.suffix.lower() not in VIDEO_FORMATS:
+        raise argparse.ArgumentTypeError(f"{text!r}: a video file ends in .mp4 or .gif")
+    return path
+
+
+def video_size(text: str) -> tuple[int, int]:
+    """WIDTHxHEIGHT of a video: at most 4K (3840x2160)."""
+    width, height = size_type(text)
+    if width > VIDEO_MAX_SIZE[0] or height > VIDEO_MAX_SIZE[1]:
+        raise argparse.ArgumentTypeError(
+            f"a video is at most {VIDEO_MAX_SIZE[0]}x{VIDEO_MAX_SIZE[1]} pixels, got {text!r}"
+        )
+    return width, height

@@ -35,7 +35,8 @@ import numpy as np
 import viser
 from scipy.spatial.transform import Rotation
 
-from poinsot.app.exports.stage import Stage
+from poinsot.app.exports.stage import ClientOf, Stage
+from poinsot.app.exports.strobe import Strobe, StrobeError, add_strobe, body_of
 from poinsot.app.presets import PRESETS, Preset, preset_by_key
 from poinsot.app.scene.cameras import space_view
 from poinsot.app.scene.frames import wxyz as to_wxyz
@@ -250,18 +251,21 @@ class Shot:
     seconds: float
 
 
-def _wait_for_client(stage: Stage | SceneStage, timeout: float) -> viser.ClientHandle:
+def _wait_for_client(server: viser.ViserServer, timeout: float) -> viser.ClientHandle:
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
-        clients = stage.server.get_clients()
+        clients = server.get_clients()
         if clients:
             return next(iter(clients.values()))
         time.sleep(0.05)
     raise TimeoutError("the browser did not connect to the scene server")
 
 
-def _open(browser: Browser, stage: Stage | SceneStage, size: tuple[int, int]) -> viser.ClientHandle:
-    """Open ``stage`` in a window of WINDOW_HEIGHT CSS pixels with the picture's aspect."""
+def open_window(
+    browser: Browser, server: viser.ViserServer, size: tuple[int, int]
+) -> viser.ClientHandle:
+    """Open ``server``'s page in a window of WINDOW_HEIGHT CSS pixels with the picture's
+    aspect; its client once it has connected."""
     width, height = size
     window: ViewportSize = {
         "width": max(16, round(WINDOW_HEIGHT * width / height)),
@@ -269,12 +273,18 @@ def _open(browser: Browser, stage: Stage | SceneStage, size: tuple[int, int]) ->
     }
     scale = min(MAX_WINDOW_SCALE, max(1.0, height / WINDOW_HEIGHT))
     context = browser.new_context(viewport=window, device_scale_factor=scale)
-    context.new_page().goto(stage.url, timeout=PAGE_TIMEOUT * 1000)
-    return _wait_for_client(stage, PAGE_TIMEOUT)
+    url = f"http://{server.get_host()}:{server.get_port()}"
+    context.new_page().goto(url, timeout=PAGE_TIMEOUT * 1000)
+    return _wait_for_client(server, PAGE_TIMEOUT)
+
+
+def _open(browser: Browser, stage: Stage | SceneStage, size: tuple[int, int]) -> viser.ClientHandle:
+    """Open ``stage`` in a window of WINDOW_HEIGHT CSS pixels with the picture's aspect."""
+    return open_window(browser, stage.server, size)
 
 
 @dataclasses.dataclass(frozen=True)
-class _Camera:
+class RenderCamera:
     """Renders of one browser's scene from one camera pose."""
 
     client: viser.ClientHandle
@@ -323,7 +333,9 @@ def capture(
     fov = math.radians(view.fov_degrees)
     with headless_chromium(chromium) as browser:
         client = _open(browser, stage, size)
-        camera = _Camera(client, camera_wxyz(view), np.asarray(view.position, dtype=np.float64))
+        camera = RenderCamera(
+            client, camera_wxyz(view), np.asarray(view.position, dtype=np.float64)
+        )
         probe = camera.settled(probe_w, probe_h, fov)
         if fit:
             fov = fitted_fov(fov, content_extent(probe))
@@ -356,11 +368,14 @@ def default_time(period: float) -> float:
     return period if math.isfinite(period) and 0 < period <= 120 else 20.0
 
 
-def open_stage(scene: Preset | SceneSpec, dark_mode: bool) -> Stage | SceneStage:
-    """The stage that draws a preset or a scene (stop it when done)."""
+def open_stage(
+    scene: Preset | SceneSpec, dark_mode: bool, client_of: ClientOf | None = None
+) -> Stage | SceneStage:
+    """The stage that draws a preset or a scene (stop it when done); ``client_of``: on one
+    browser's own scene (:data:`~poinsot.app.exports.stage.ClientOf`)."""
     if isinstance(scene, SceneSpec):
-        return SceneStage(scene, dark_mode=dark_mode)
-    return Stage.from_preset(scene, dark_mode=dark_mode)
+        return SceneStage(scene, dark_mode=dark_mode, client_of=client_of)
+    return Stage.from_preset(scene, dark_mode=dark_mode, client_of=client_of)
 
 
 def picture_time(stage: Stage | SceneStage) -> float:
@@ -368,6 +383,32 @@ def picture_time(stage: Stage | SceneStage) -> float:
     if isinstance(stage, SceneStage):
         return stage.spec.picture_time
     return default_time(float(stage.body.period))
+
+
+def pose_stage(
+    stage: Stage | SceneStage,
+    scene: Preset | SceneSpec,
+    t: float | None,
+    view: str,
+    size: tuple[int, int],
+    strobe: Strobe | None,
+) -> tuple[View, float]:
+    """Seek ``stage`` to the picture's time (with the strobe's copies, if any), lay out its
+    labels, and return the picture's camera and time."""
+    if strobe is not None:
+        fixed = scene.view if isinstance(scene, SceneSpec) and view == "default" else None
+        aspect = size[0] / size[1]
+        camera = add_strobe(stage, strobe, fixed or space_view(view), stage.dark_mode, aspect)
+        t = stage.frame.t
+    else:
+        t = t if t is not None else picture_time(stage)
+        camera = space_view(view, stage.seek(t).wxyz)
+        if isinstance(scene, SceneSpec) and view == "default":
+            camera = scene.view
+    stage.set_initial_camera(camera)
+    if isinstance(stage, Stage):  # the labels laid out for this camera and window
+        stage.lay_out_labels(camera, (round(WINDOW_HEIGHT * size[0] / size[1]), WINDOW_HEIGHT))
+    return camera, t
 
 
 def screenshot_command(
@@ -379,13 +420,17 @@ def screenshot_command(
     view: str = "default",
     background: str = "dark",
     fit: bool = True,
+    strobe: Strobe | None = None,
 ) -> int:
-    """``poinsot screenshot``: 0 on success, EXIT_NO_BROWSER without Chromium, 1 on failure.
+    """``poinsot screenshot``: 0 on success, EXIT_NO_BROWSER without Chromium, 1 on failure,
+    2 for a strobe that cannot be drawn.
 
     ``t``: simulation time of the picture (None: one period of omega, or a scene's own
     time); ``view``: a camera of :data:`~poinsot.app.scene.cameras.CAMERA_NAMES` ("default"
     is a scene's own framing); ``background``: "dark", "light" or
-    "transparent"; ``fit``: frame the construction (else keep the view's field of view).
+    "transparent"; ``fit``: frame the construction (else keep the view's field of view);
+    ``strobe``: copies of the body over an interval (:mod:`poinsot.app.exports.strobe`), the
+    picture taken at its end.
     """
     try:
         chromium = find_chromium()
@@ -395,20 +440,15 @@ def screenshot_command(
     with sigterm_exits():
         stage = open_stage(scene, dark_mode=background != "light")
         try:
-            t = t if t is not None else picture_time(stage)
-            camera = space_view(view, stage.seek(t).wxyz)
-            if isinstance(scene, SceneSpec) and view == "default":
-                camera = scene.view
-            stage.set_initial_camera(camera)
-            if isinstance(stage, Stage):  # the labels laid out for this camera and window
-                stage.lay_out_labels(
-                    camera, (round(WINDOW_HEIGHT * size[0] / size[1]), WINDOW_HEIGHT)
-                )
+            camera, t = pose_stage(stage, scene, t, view, size, strobe)
             ground = None if background == "transparent" else THEME_BACKGROUND[background == "dark"]
             shot = capture(stage, camera, size, chromium=chromium, background=ground, fit=fit)
         except BrowserMissing as exc:
             print(f"poinsot screenshot: {exc}", file=sys.stderr)
             return EXIT_NO_BROWSER
+        except StrobeError as exc:
+            print(f"poinsot screenshot: error: {exc}", file=sys.stderr)
+            return 2
         except Exception as exc:  # the command's boundary: say what failed, exit non-zero
             print(f"poinsot screenshot: failed: {type(exc).__name__}: {exc}", file=sys.stderr)
             return 1
@@ -416,8 +456,12 @@ def screenshot_command(
             stage.stop()
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_bytes(shot.png)
+    strobe_text = ""
+    if strobe is not None:
+        t0, t1 = strobe.interval(body_of(stage))
+        strobe_text = f", strobe of {strobe.copies} copies over [{t0:.3f}, {t1:.3f}]"
     print(
         f"wrote {out} ({shot.width}x{shot.height}, scene {scene.key}, t = {t:g}, "
-        f"view {view}, fov {shot.fov_degrees:.1f} deg) in {shot.seconds:.1f} s"
+        f"view {view}, fov {shot.fov_degrees:.1f} deg{strobe_text}) in {shot.seconds:.1f} s"
     )
     return 0

@@ -13,6 +13,8 @@ import contextlib
 import io
 import math
 import warnings
+from collections.abc import Callable
+from contextlib import AbstractContextManager
 from typing import Self
 
 import numpy as np
@@ -53,12 +55,33 @@ def open_server(host: str, port: int, dark_mode: bool) -> viser.ViserServer:
     return server
 
 
+#: Where a stage draws: None for the server's shared scene (every browser sees it), or a
+#: function that opens one browser on the (still empty) server and returns its client, whose
+#: own scene is then drawn on. A video draws on its one browser's scene, so that each frame's
+#: updates and the render request that follows them ride one queue, in order.
+ClientOf = Callable[[viser.ViserServer], viser.ClientHandle]
+
+
+def scene_target(
+    server: viser.ViserServer, client_of: ClientOf | None
+) -> tuple[viser.SceneApi, Callable[[], AbstractContextManager[None]], viser.ClientHandle | None]:
+    """The scene API a stage draws on, its ``atomic``, and the client if it is one browser's."""
+    if client_of is None:
+        return server.scene, server.atomic, None
+    client = client_of(server)
+    return client.scene, client.atomic, client
+
+
 def themed_construction(
-    server: viser.ViserServer, elements: frozenset[Element], trail_points: int, dark_mode: bool
+    api: viser.SceneApi,
+    atomic: Callable[[], AbstractContextManager[None]],
+    elements: frozenset[Element],
+    trail_points: int,
+    dark_mode: bool,
 ) -> PoinsotScene:
-    """The app's construction on the server's shared scene, in the theme's colours (the look a
-    browser of the app gets on that theme): what every stage draws on."""
-    scene = PoinsotScene(server.scene, elements, trail_points, atomic=server.atomic)
+    """The app's construction on a scene API, in the theme's colours (the look a browser of
+    the app gets on that theme): what every stage draws on."""
+    scene = PoinsotScene(api, elements, trail_points, atomic=atomic)
     scene.restyle(palette.look(dark_mode))
     return scene
 
@@ -75,6 +98,9 @@ class ServedStage:
 
     server: viser.ViserServer
     frame: Frame
+    #: The browser whose own scene the stage draws on (None: the shared scene).
+    client: viser.ClientHandle | None = None
+    atomic: Callable[[], AbstractContextManager[None]]
 
     def __enter__(self) -> Self:
         return self
@@ -133,14 +159,17 @@ class Stage(ServedStage):
         dark_mode: bool = True,
         host: str = "127.0.0.1",
         port: int = 0,
+        client_of: ClientOf | None = None,
     ) -> None:
-        """Raises ValueError (from physics or the scene) for parameters that describe no body."""
+        """Raises ValueError (from physics or the scene) for parameters that describe no body.
+        ``client_of``: draw on one browser's own scene (:data:`ClientOf`)."""
         body = params.build()
         self.params = params
         self.dark_mode = dark_mode
         self.server = open_server(host, port, dark_mode)
         try:
-            self.scene = themed_construction(self.server, elements, trail_points, dark_mode)
+            api, self.atomic, self.client = scene_target(self.server, client_of)
+            self.scene = themed_construction(api, self.atomic, elements, trail_points, dark_mode)
             self.frame: Frame = self.scene.load(body, solid, t=0.0)
         except BaseException:
             self.stop()
@@ -178,5 +207,5 @@ class Stage(ServedStage):
             float(width),
             float(height),
         )
-        with self.server.atomic():
+        with self.atomic():
             self.scene.lay_out_labels(camera)

@@ -14,8 +14,9 @@ The commands are also listed in the palette (Ctrl/Cmd+K).
 
 Threads: button callbacks run on viser's thread pool. A screenshot waits there for the
 browser's render, bounded by ``render_timeout``; one render at a time per session, and every
-failure ends in a message in the panel, never in a hang. The data come from the session's
-body and clock (physics), never from the drawing.
+failure ends in a message in the panel, never in a hang. A video
+(:mod:`poinsot.app.live.video_export`) is filmed on a thread of its own. The data come from the
+session's body and clock (physics), never from the drawing.
 """
 
 from __future__ import annotations
@@ -34,6 +35,8 @@ from poinsot.app.live.clock import SimClock
 from poinsot.app.live.display import LARGE_TEXT_PERCENT, Display
 from poinsot.app.live.links import link_of
 from poinsot.app.live.motion_window import MotionWindow
+from poinsot.app.live.strobe_shot import strobe_render
+from poinsot.app.live.video_export import VideoExport, browser_view
 from poinsot.app.live.widgets import Sent, on_user, set_value
 from poinsot.app.presets import Preset
 from poinsot.app.scene.batch import Frame
@@ -109,6 +112,8 @@ class LectureControls:
                 self.link,
                 lambda _: self.session.post(lambda: self._discard(self.copy_link()), "link"),
             ),
+            (self.video.button, lambda _: self._discard(self.video.start())),
+            (self.video.cancel_button, lambda _: self.video.cancel.set()),
             (self.dark, lambda sent: self.set_theme(dark=bool(sent.value))),
             (self.large, lambda sent: self.set_theme(large=bool(sent.value))),
             (self.projector, lambda sent: self.display.request(projector=bool(sent.value))),
@@ -133,6 +138,12 @@ class LectureControls:
         self.transparent = gui.add_checkbox(
             "Transparent PNG", False, hint="Leave the background transparent (for slides)."
         )
+        self.strobe = gui.add_checkbox(
+            "Strobe: 8 copies",
+            False,
+            hint="The screenshot adds 8 copies of the body over the flip (or period) that ends "
+            "now, the earliest faintest; the same as `poinsot screenshot --strobe 8`.",
+        )
         self.screenshot = gui.add_button("Screenshot (PNG)", icon=viser.Icon.CAMERA)
         self.csv = gui.add_button(
             "Data: t, ω, q (CSV)",
@@ -150,6 +161,7 @@ class LectureControls:
             hint="A link that opens exactly this: the scene or body, the time, the view, the "
             "speed, paused or playing.",
         )
+        self.video = VideoExport(self, gui)
         self.dark = gui.add_checkbox("Dark theme", True)
         self.large = gui.add_checkbox("Large text", False, hint="Scales every text of the panel.")
         self.projector = gui.add_checkbox(
@@ -299,9 +311,20 @@ class LectureControls:
             _, t, key = self._now()
             self.show(f"Rendering {width}×{height} …")
             start = time.perf_counter()
-            rgba = self.client.get_render(
-                height, width, transport_format="png", timeout=self.render_timeout
-            )
+            if self.strobe.value:
+                rgba = strobe_render(
+                    self.client,
+                    self.session.scene,
+                    t,
+                    browser_view(self.client),
+                    (width, height),
+                    dark_mode=self.dark_mode,
+                    timeout=self.render_timeout,
+                )
+            else:
+                rgba = self.client.get_render(
+                    height, width, transport_format="png", timeout=self.render_timeout
+                )
             background = None if self.transparent.value else THEME_BACKGROUND[self.dark_mode]
             name = filename(key, t)
             self.client.send_file_download(name, png_bytes(rgba, background), save_immediately=True)

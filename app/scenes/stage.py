@@ -8,7 +8,13 @@ T or a clip of S seconds is reproducible.
 
 from __future__ import annotations
 
-from poinsot.app.exports.stage import ServedStage, open_server, themed_construction
+from poinsot.app.exports.stage import (
+    ClientOf,
+    ServedStage,
+    open_server,
+    scene_target,
+    themed_construction,
+)
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scenes.runtime import Showcase
 from poinsot.app.scenes.spec import SceneSpec, Settings
@@ -25,16 +31,19 @@ class SceneStage(ServedStage):
         dark_mode: bool = True,
         host: str = "127.0.0.1",
         port: int = 0,
+        client_of: ClientOf | None = None,
     ) -> None:
-        """Raises ValueError (from physics or the scene) for settings that describe no body."""
+        """Raises ValueError (from physics or the scene) for settings that describe no body.
+        ``client_of``: draw on one browser's own scene (:data:`ClientOf`)."""
         self.spec = spec
         self.dark_mode = dark_mode
         self.server = open_server(host, port, dark_mode)
         try:
+            api, self.atomic, self.client = scene_target(self.server, client_of)
             self.poinsot = themed_construction(
-                self.server, frozenset(), spec.trail_points, dark_mode
+                api, self.atomic, frozenset(), spec.trail_points, dark_mode
             )
-            self.showcase = Showcase(spec, self.poinsot, atomic=self.server.atomic)
+            self.showcase = Showcase(spec, self.poinsot, atomic=self.atomic)
             self.frame = self.showcase.load(settings, t=0.0)
         except BaseException:
             self.stop()

@@ -36,7 +36,7 @@ def recording(tmp_path):
     return str(path)
 
 
-OUT_PNG, OUT_HTML = "{tmp}/x.png", "{tmp}/x.html"
+OUT_PNG, OUT_HTML, OUT_MP4 = "{tmp}/x.png", "{tmp}/x.html", "{tmp}/x.mp4"
 
 #: (argv, which command the one line names); every argument of every command, each broken.
 BAD = [
@@ -62,6 +62,20 @@ BAD = [
     (["screenshot", "--out", OUT_PNG, "--preset", "nope"], "poinsot screenshot"),
     (["screenshot", "--out", OUT_PNG, "--scene", "nope"], "poinsot screenshot"),
     (["screenshot", "--out", OUT_PNG, "--background", "plaid"], "poinsot screenshot"),
+    (["screenshot", "--out", OUT_PNG, "--strobe", "1"], "poinsot screenshot"),
+    (["screenshot", "--out", OUT_PNG, "--strobe", "99"], "poinsot screenshot"),
+    (["screenshot", "--out", OUT_PNG, "--strobe", "two"], "poinsot screenshot"),
+    (
+        ["screenshot", "--out", OUT_PNG, "--strobe", "4", "--from", "5", "--to", "2"],
+        "poinsot screenshot",
+    ),
+    (["screenshot", "--out", OUT_PNG, "--strobe", "4", "--to", "nan"], "poinsot screenshot"),
+    (["screenshot", "--out", OUT_PNG, "--from", "2"], "poinsot screenshot"),  # no --strobe
+    (["screenshot", "--out", OUT_PNG, "--strobe", "4", "--time", "3"], "poinsot screenshot"),
+    (
+        ["screenshot", "--out", OUT_PNG, "--strobe", "4", "--view", "ride-along"],
+        "poinsot screenshot",
+    ),
     # export-html
     (["export-html", "--out", OUT_HTML, "--seconds", "-5"], "poinsot export-html"),
     (["export-html", "--out", OUT_HTML, "--seconds", "inf"], "poinsot export-html"),
@@ -71,6 +85,20 @@ BAD = [
     (["export-html", "--out", OUT_HTML, "--view", "ride-along"], "poinsot export-html"),
     (["export-html", "--out", "/proc/x.html"], "poinsot export-html"),
     (["export-html", "--out", "{tmp}"], "poinsot export-html"),
+    # video
+    (["video"], "poinsot video"),  # --out is required
+    (["video", "--out", "{tmp}/x.avi"], "poinsot video"),
+    (["video", "--out", "/proc/x.mp4"], "poinsot video"),
+    (["video", "--out", OUT_MP4, "--size", "641x360"], "poinsot video"),  # yuv420p: even
+    (["video", "--out", OUT_MP4, "--size", "4000x2000"], "poinsot video"),
+    (["video", "--out", OUT_MP4, "--seconds", "0"], "poinsot video"),
+    (["video", "--out", OUT_MP4, "--seconds", "nan"], "poinsot video"),
+    (["video", "--out", OUT_MP4, "--fps", "0"], "poinsot video"),
+    (["video", "--out", OUT_MP4, "--fps", "120"], "poinsot video"),
+    (["video", "--out", OUT_MP4, "--from", "-1"], "poinsot video"),
+    (["video", "--out", OUT_MP4, "--view", "under"], "poinsot video"),
+    (["video", "--out", OUT_MP4, "--preset", "nope"], "poinsot video"),
+    (["video", "--out", OUT_MP4, "--scene", "nope"], "poinsot video"),
     # benchmark
     (["benchmark", "--clients", "0"], "poinsot benchmark"),
     (["benchmark", "--clients", "-3"], "poinsot benchmark"),

@@ -4,7 +4,8 @@ through SwiftShader):
 - the standalone HTML opened from a ``file://`` URL, with every network request refused,
   renders the scene and animates it;
 - ``poinsot screenshot`` writes a PNG of the requested size with the scene on it, and leaves no
-  process behind, neither when it finishes nor when it is killed;
+  process behind, neither when it finishes nor when it is killed; ``poinsot video`` killed
+  while it films leaves neither a process (Chromium, ffmpeg) nor a half-written file;
 - the in-app screenshot button hands the browser a PNG of the chosen size (current view,
   opaque on the theme's background; 1920×1080 transparent);
 - space pauses, 1-4 move the camera (4 rides along with the body), the theme and text-size
@@ -242,6 +243,39 @@ def test_cli_screenshot_killed_midway_leaves_no_process(tmp_path):
     assert proc.returncode != 0
     assert wait_until(lambda: not processes_with(token), 15), processes_with(token)
     assert not (tmp_path / "never.png").exists()
+
+
+def test_cli_video_killed_midway_leaves_no_process_and_no_file(tmp_path):
+    chromium_or_fail()
+    token = f"poinsot-{uuid.uuid4()}"
+    out = tmp_path / "never.mp4"
+    proc = cli(
+        "video",
+        "--preset",
+        "major",
+        "--seconds",
+        "30",
+        "--size",
+        "320x180",
+        "--out",
+        str(out),
+        token=token,
+    )
+    try:
+        # Killed while it films: the progress has begun (its plain lines go to stderr).
+        started = wait_until(
+            lambda: any("chrom" in c for c in processes_with(token).values()), 60, poll=0.1
+        )
+        assert started, "chromium never started"
+        assert wait_until(lambda: out.exists(), 120, poll=0.1), "ffmpeg never began the file"
+        proc.send_signal(signal.SIGTERM)
+        proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode != 0
+    assert wait_until(lambda: not processes_with(token), 15), processes_with(token)
+    assert not out.exists()  # no half-written video left behind
 
 
 # -- the in-app controls -----------------------------------------------------------------------

@@ -1,0 +1,88 @@
+"""The video's pieces without a browser: the encoder (imageio-ffmpeg's bundled ffmpeg) writes
+the frames it is given, H.264 yuv420p for MP4 and a looping GIF, read back by imageio and
+Pillow; a render is laid on the theme's background; the clip's bounds (command line and
+browser); a browser view's size brought within the browser's bound."""
+
+from __future__ import annotations
+
+import imageio.v2 as imageio
+import numpy as np
+import pytest
+from PIL import Image
+
+from poinsot.app.exports.video import Clip, check_clip, encoder, rgb_on
+from poinsot.app.live.video_export import fit_within
+
+
+def frames(count: int, size: tuple[int, int]) -> list[np.ndarray]:
+    """A bright square moving one step a frame on a dark ground."""
+    width, height = size
+    out = []
+    for i in range(count):
+        frame = np.full((height, width, 3), 20, np.uint8)
+        frame[8:24, 4 + 2 * i : 20 + 2 * i] = (255, 179, 71)
+        out.append(frame)
+    return out
+
+
+@pytest.mark.parametrize("suffix", [".mp4", ".gif"])
+def test_the_encoder_writes_every_frame_it_is_given(tmp_path, suffix):
+    path = tmp_path / f"clip{suffix}"
+    given = frames(12, (64, 36))
+    with encoder(path, (64, 36), 12.0) as sink:
+        for frame in given:
+            sink.send(frame)
+    if suffix == ".mp4":
+        reader = imageio.get_reader(path, format="FFMPEG")
+        meta = reader.get_meta_data()
+        read = np.stack([frame for frame in reader])
+        reader.close()
+        assert meta["codec"] == "h264" and meta["pix_fmt"].startswith("yuv420p"), meta
+    else:
+        with Image.open(path) as image:
+            assert image.info.get("loop") == 0 and image.n_frames == 12
+        read = np.asarray(imageio.mimread(path))[..., :3]
+    assert read.shape == (12, 36, 64, 3)
+    # The square is where it was put in each frame (lossy: compare its centre's colour).
+    for i, frame in enumerate(read):
+        assert np.abs(frame[16, 12 + 2 * i].astype(int) - (255, 179, 71)).max() < 40, i
+        assert np.abs(frame[30, 60].astype(int) - 20).max() < 12
+
+
+def test_a_render_is_laid_on_the_background():
+    rgba = np.zeros((2, 2, 4), np.uint8)
+    rgba[0, 0] = (200, 100, 50, 255)  # opaque
+    rgba[0, 1] = (200, 100, 50, 0)  # nothing drawn
+    rgba[1, 0] = (200, 100, 50, 128)  # half
+    rgb = rgb_on(rgba, (20, 20, 20))
+    assert rgb[0, 0].tolist() == [200, 100, 50] and rgb[0, 1].tolist() == [20, 20, 20]
+    assert rgb[1, 0].tolist() == [110, 60, 35]
+
+
+def test_the_clip_s_bounds():
+    check_clip(Clip(4.0, 25.0, (640, 360)), ".mp4")
+    check_clip(Clip(4.0, 25.0, (641, 361)), ".gif")  # a GIF may have odd sides
+    check_clip(Clip(600.0, 60.0, (3840, 2160)), ".mp4")
+    bad = [
+        (Clip(4.0, 25.0, (641, 360)), ".mp4", False),
+        (Clip(4.0, 25.0, (640, 360)), ".avi", False),
+        (Clip(0.0, 25.0, (640, 360)), ".mp4", False),
+        (Clip(4.0, 0.5, (640, 360)), ".mp4", False),
+        (Clip(4.0, 25.0, (640, 360), t0=-1.0), ".mp4", False),
+        (Clip(31.0, 25.0, (640, 360)), ".mp4", True),  # the browser: 30 s
+        (Clip(4.0, 25.0, (2560, 1440)), ".mp4", True),  # the browser: 1920x1080
+    ]
+    for clip, suffix, browser in bad:
+        with pytest.raises(ValueError):
+            check_clip(clip, suffix, browser=browser)
+    assert Clip(4.0, 25.0, (640, 360)).frames == 100
+    assert Clip(2.0, 10.0, (64, 64), t0=3.0, speed=0.5).time(4) == pytest.approx(3.2)
+
+
+def test_a_browser_view_is_brought_within_1920x1080_with_even_sides():
+    assert fit_within((1281, 721), (1920, 1080), even=True) == (1280, 720)
+    assert fit_within((1281, 721), (1920, 1080), even=False) == (1281, 721)
+    assert fit_within((3840, 2000), (1920, 1080), even=True) == (1920, 1000)
+    width, height = fit_within((2560, 1600), (1920, 1080), even=True)
+    assert width <= 1920 and height <= 1080 and width % 2 == 0 and height % 2 == 0
+    assert abs(width / height - 1.6) < 0.01

@@ -1,0 +1,70 @@
+"""``poinsot video`` in a real browser (Debian's Chromium, software WebGL): the MP4 and the GIF
+decode (imageio, through the ffmpeg of imageio-ffmpeg) to the frames asked for, of the size
+asked for, each different from the one before (every frame shows its own time); the MP4 is
+H.264 in yuv420p, the GIF loops."""
+
+from __future__ import annotations
+
+import imageio.v2 as imageio
+import imageio.v3 as iio
+import numpy as np
+import pytest
+from conftest import chromium_or_fail
+from PIL import Image
+
+from poinsot.app import cli
+from poinsot.app.exports.screenshot import THEME_BACKGROUND
+
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
+
+#: Mean absolute change between two successive frames [0-255] above which they count as
+#: different: the rolling body moves every frame (measured 1.0-3.3 at 640x360, 25 fps), while
+#: a frame rendered again unchanged differs by the encoder's noise only.
+MIN_CHANGE = 0.3
+
+
+def run_video(tmp_path, capsys, suffix: str):
+    chromium_or_fail()
+    out = tmp_path / f"v{suffix}"
+    argv = ["video", "--preset", "t_handle", "--seconds", "4", "--fps", "25"]
+    code = cli.main([*argv, "--size", "640x360", "--out", str(out)])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert f"wrote {out} (640x360, 100 frames at 25 fps" in captured.out, captured.out
+    assert "100/100 frames" in captured.err  # the progress (plain lines: not a terminal)
+    return out
+
+
+def assert_a_moving_scene(frames: np.ndarray) -> None:
+    assert frames.shape[:3] == (100, 360, 640), frames.shape
+    rgb = frames[..., :3]
+    changes = np.array(
+        [np.abs(b.astype(np.int16) - a).mean() for a, b in zip(rgb[:-1], rgb[1:], strict=True)]
+    )
+    assert changes.min() > MIN_CHANGE, np.flatnonzero(changes <= MIN_CHANGE)
+    # Opaque on the dark theme, something drawn in the middle.
+    corner = rgb[:, :4, :4].reshape(-1, 3).astype(np.int16)
+    assert np.abs(corner - THEME_BACKGROUND[True]).max() <= 6
+    drawn = np.abs(rgb[0].astype(np.int16) - THEME_BACKGROUND[True]).max(axis=2) > 24
+    assert 0.1 < drawn.mean() < 0.9, drawn.mean()
+
+
+def test_the_mp4_decodes_to_100_frames_of_640x360_that_change(tmp_path, capsys):
+    out = run_video(tmp_path, capsys, ".mp4")
+    reader = imageio.get_reader(out, format="FFMPEG")
+    meta = reader.get_meta_data()
+    # (not list(reader): its length is "inf" until read, and list() would preallocate it)
+    frames = np.stack([frame for frame in reader])
+    reader.close()
+    assert meta["codec"] == "h264" and meta["pix_fmt"].startswith("yuv420p"), meta
+    assert meta["fps"] == 25.0
+    assert_a_moving_scene(frames)
+
+
+def test_the_gif_decodes_to_100_frames_of_640x360_that_change_and_loops(tmp_path, capsys):
+    out = run_video(tmp_path, capsys, ".gif")
+    with Image.open(out) as image:
+        assert image.info.get("loop") == 0  # forever
+        assert image.info.get("duration") == 40  # 25 frames per second
+    frames = iio.imread(out, index=None)
+    assert_a_moving_scene(frames)
