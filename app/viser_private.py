@@ -23,6 +23,8 @@ Inventory (section, private name, what it is used for):
     ``on_client_connect``/``on_client_disconnect``/``unregister_handler``.
   - ``WebsockServer._live_connections`` (client id -> websockets ``ServerConnection``): the
     connection whose ``recv`` viser's consumer awaits (an instance attribute can wrap it).
+  - ``WebsockServer._client_state_from_id``: the connections viser holds state for (the load
+    test counts leaked ones).
   - ``ViserServer._connected_clients`` (client id -> ``ClientHandle``) and
     ``ClientHandle._websock_connection._incoming_handlers`` (a render response is expected
     only while a ``get_render`` handler is registered).
@@ -146,6 +148,11 @@ def live_connection(server: viser.ViserServer, client_id: int) -> ServerConnecti
     """The websockets connection viser reads ``client_id``'s messages from."""
     found: ServerConnection | None = infra(server)._live_connections.get(client_id)
     return found
+
+
+def connection_count(server: viser.ViserServer) -> int:
+    """The websocket connections viser holds state for (live ones, or leaked ones)."""
+    return len(infra(server)._client_state_from_id)
 
 
 def wrap_recv(

@@ -180,7 +180,10 @@ class HandshakeGate:
         if len(origins) > 1:
             return f"{len(origins)} Origin headers"
         if not host_allowed(hosts[0], self.listen, self.allowed_origins):
-            return f"Host {hosts[0][:60]!r} is not an address of this server"
+            return (
+                f"Host {hosts[0][:60]!r} is not an address of this server "
+                "(behind a proxy or another name: --allow-origin http://THAT-HOST:PORT)"
+            )
         origin = origins[0] if origins else None
         if origin is not None and not origin_allowed(origin, hosts[0], self.allowed_origins):
             return f"Origin {origin[:60]!r} is not this server's page nor --allow-origin"
