@@ -231,8 +231,8 @@ class ViewerCamera(msgspec.Struct, **_message("ViewerCameraMessage")):
     fov: Num
     near: Num
     far: Num
-    image_height: Count
-    image_width: Count
+    image_height: Num  # a canvas's size (not always a whole number)
+    image_width: Num
     look_at: V3
     up_direction: V3
 
