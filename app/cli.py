@@ -214,7 +214,8 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="ORIGIN",
-        help="also accept browsers from this page's origin (http://host:port); repeatable",
+        help="also accept browsers from this page's origin (http://host:port), and its host "
+        "name (a name students type, a proxy's address); repeatable",
     )
     which = parser.add_mutually_exclusive_group()
     which.add_argument(
