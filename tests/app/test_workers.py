@@ -179,8 +179,12 @@ def test_landing_sends_new_browsers_to_the_least_loaded_worker(classroom: Classr
 @pytest.mark.slow
 def test_a_crashed_worker_is_reported_and_gets_no_new_browsers(classroom: Classroom):
     first, second = classroom.workers()
+    browser = Probe(first["port"])  # a browser on the worker that will crash
+    assert wait_until(lambda: classroom.clients() == [1, 0], 60)
     os.kill(first["pid"], signal.SIGKILL)
     assert wait_until(lambda: any("stopped unexpectedly" in line for line in classroom.stderr), 30)
+    browser.close()
+    assert classroom.clients() == [0, 0]  # its last count was 1: a dead worker holds none
     report = [line for line in classroom.stderr if "stopped unexpectedly" in line]
     assert len(report) == 1 and f"port {first['port']}" in report[0]
     assert [w["alive"] for w in classroom.workers()] == [False, True]
