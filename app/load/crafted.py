@@ -157,7 +157,15 @@ HTTP10: dict[str, bytes] = {
 }
 
 
-def bad_handshakes(port: int, count: int) -> Counter[str]:
-    """``count`` refused handshakes, the kinds in turn; their outcomes."""
+def bad_handshakes(port: int, count: int, seconds: float = 0.0) -> Counter[str]:
+    """``count`` refused handshakes, the kinds in turn, spread evenly over ``seconds`` (0: as
+    fast as they go); their outcomes."""
     kinds = list(HANDSHAKES.values())
-    return Counter(exchange(port, kinds[k % len(kinds)](port)) for k in range(count))
+    outcomes: Counter[str] = Counter()
+    start = time.monotonic()
+    for k in range(count):
+        wait = start + k * seconds / count - time.monotonic()
+        if wait > 0:
+            time.sleep(wait)
+        outcomes[exchange(port, kinds[k % len(kinds)](port))] += 1
+    return outcomes

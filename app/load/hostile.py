@@ -11,7 +11,9 @@ Counted: each outcome, the tracebacks and share-tunnel lines in the server's log
 connections viser still holds once the hostile clients are gone, the server's memory after the
 bad handshakes against before them (after a warm-up of a tenth as many), and the frames of an
 innocent client during the barrage against its frames before and after (their mean). The
-barrage runs at the lowest CPU priority, as if from another machine.
+barrage runs at the lowest CPU priority, as if from another machine, and spreads its handshakes
+over as long as each reference window (``--hostile-quiet-seconds``), so that the three windows
+are alike: a sustained attack, not a blip that the frame pacing would smooth or exaggerate.
 """
 
 from __future__ import annotations
@@ -42,7 +44,9 @@ ROUNDS = 3
 JUNK: list[Any] = [math.nan, -math.inf, 1e300, "abc", None, [1, 2]]
 
 
-def _barrage_main(conn: Connection, port: int, handshakes: int, lifetime: float) -> None:
+def _barrage_main(
+    conn: Connection, port: int, handshakes: int, seconds: float, lifetime: float
+) -> None:
     """The child: warm up, report, wait for ``go``, replay everything, report the outcomes.
     It runs at the lowest priority: a student's script runs on the student's laptop, so its
     own CPU is not the server's to pay (on loopback it would be, on two cores most of one)."""
@@ -56,7 +60,7 @@ def _barrage_main(conn: Connection, port: int, handshakes: int, lifetime: float)
     for _ in range(ROUNDS):
         for payload in crafted.MESSAGES.values():
             messages[crafted.send_message(port, payload)] += 1
-    handshake_outcomes = crafted.bad_handshakes(port, handshakes)
+    handshake_outcomes = crafted.bad_handshakes(port, handshakes, seconds)
     http10 = Counter(crafted.exchange(port, r) for r in crafted.HTTP10.values() for _ in "abc")
     conn.send(("done", {"messages": messages, "handshakes": handshake_outcomes, "http10": http10}))
     if conn.poll(max(0.0, deadline - time.monotonic())):
@@ -121,7 +125,8 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         if not innocent.wait_frames(10, 60):
             raise RuntimeError("the innocent client got no frames")
         before = count.rate(cfg.hostile_quiet_seconds)
-        with Child("barrage", _barrage_main, port, cfg.hostile_handshakes, cfg.lifetime) as child:
+        barrage = (port, cfg.hostile_handshakes, cfg.hostile_quiet_seconds, cfg.lifetime)
+        with Child("barrage", _barrage_main, *barrage) as child:
             child.receive(300.0, "the barrage's warm-up")
             first = procfs.usage(server.pid)
             say(f"{PHASE}: the barrage ({cfg.hostile_handshakes} bad handshakes)")
