@@ -232,7 +232,8 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="ORIGIN",
-        help="also accept browsers from this page's origin (http://host:port); repeatable",
+        help="also accept browsers from this page's origin (http://host:port), and its host "
+        "name (a name students type, a proxy's address); repeatable",
     )
     parser.add_argument(
         "--link",

@@ -21,14 +21,15 @@ import socket
 import threading
 import time
 import urllib.parse
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
 from poinsot.app.live.network import PortError, bind_errno, port_problem
 
 #: A browser sent to a worker that has not connected within this many seconds is forgotten
-#: (it closed the tab, or reloaded straight on the worker's port).
-PENDING_SECONDS = 30.0
+#: (it closed the tab, reloaded straight on the worker's port, or was a tool that only follows
+#: redirects): a page and its websocket take well under a second on a classroom's network.
+PENDING_SECONDS = 5.0
 STATUS_PATH = "/poinsot-status"
 
 
@@ -55,32 +56,54 @@ class Backend(Protocol):
 class Balancer:
     """Choose the least-loaded live backend; thread-safe."""
 
-    def __init__(self, backends: Sequence[Backend]) -> None:
+    def __init__(
+        self, backends: Sequence[Backend], clock: Callable[[], float] = time.monotonic
+    ) -> None:
         self.backends = list(backends)
+        self._clock = clock
         self._lock = threading.Lock()
         self._pending = [collections.deque[float]() for _ in self.backends]
         self._connects = [b.connects for b in self.backends]
 
+    def replace(self, index: int, backend: Backend) -> None:
+        """Put a worker started again in the place of the one that ended: it is chosen again,
+        from its own counts (a new process counts from zero)."""
+        with self._lock:
+            self.backends[index] = backend
+            self._pending[index].clear()
+            self._connects[index] = backend.connects
+
+    def _clients(self, index: int) -> int:
+        """A dead backend holds no clients, whatever its last count said."""
+        backend = self.backends[index]
+        return backend.clients if backend.alive else 0
+
     def load(self, index: int) -> int:
-        """Connected clients plus browsers sent there and not arrived yet (under the lock)."""
+        """Connected clients plus browsers sent there and not arrived yet (under the lock);
+        0 for a dead backend."""
         backend, pending = self.backends[index], self._pending[index]
-        arrived = backend.connects - self._connects[index]
+        connects = backend.connects
+        if connects < self._connects[index]:  # a new process: its count starts again
+            self._connects[index] = connects
+        arrived = connects - self._connects[index]
         self._connects[index] += arrived
         for _ in range(min(arrived, len(pending))):
             pending.popleft()
-        while pending and pending[0] < time.monotonic() - PENDING_SECONDS:
+        while pending and (pending[0] < self._clock() - PENDING_SECONDS or not backend.alive):
             pending.popleft()
-        return backend.clients + len(pending)
+        return self._clients(index) + len(pending)
 
-    def choose(self) -> Backend | None:
-        """The live backend with the smallest load (the first on a tie), counted as sent to;
-        None when no backend is alive."""
+    def choose(self, *, counted: bool = True) -> Backend | None:
+        """The live backend with the smallest load (the first on a tie), counted as sent to
+        unless ``counted`` is False (a HEAD request: no browser follows it); None when no
+        backend is alive."""
         with self._lock:
             loads = [(self.load(i), i) for i, b in enumerate(self.backends) if b.alive]
             if not loads:
                 return None
             _, best = min(loads)
-            self._pending[best].append(time.monotonic())
+            if counted:
+                self._pending[best].append(self._clock())
             return self.backends[best]
 
     def status(self) -> list[dict[str, int | bool | None]]:
@@ -91,7 +114,7 @@ class Balancer:
                     "port": b.port,
                     "pid": b.pid,
                     "alive": b.alive,
-                    "clients": b.clients,
+                    "clients": self._clients(i),
                     "load": self.load(i),
                 }
                 for i, b in enumerate(self.backends)
@@ -127,7 +150,7 @@ class _Handler(http.server.BaseHTTPRequestHandler):
                 status = [{k: v for k, v in entry.items() if k != "pid"} for entry in status]
             self._reply(200, "application/json", json.dumps(status))
             return
-        backend = self.server.balancer.choose()
+        backend = self.server.balancer.choose(counted=self.command == "GET")
         if backend is None:
             self._reply(503, "text/plain; charset=utf-8", "No Poinsot worker is running.\n")
             return

@@ -178,6 +178,10 @@ class Probe:
     def send(self, message: _messages.Message) -> None:
         self._ws.send(msgspec.msgpack.encode(message.as_serializable_dict()))
 
+    def send_raw(self, frame: bytes | str) -> None:
+        """Any frame at all (binary for bytes, text for str): what a hostile script sends."""
+        self._ws.send(frame)
+
     def set_value(self, uuid: str, value: Any) -> None:
         """What the browser sends when the user moves a slider, ticks a box, picks an option,
         or clicks a button (``value=True``)."""

@@ -14,7 +14,7 @@ import viser
 from poinsot.app.live import links
 from poinsot.app.live.backlog import BacklogLimit, BacklogWatch
 from poinsot.app.live.budget import RebuildGate
-from poinsot.app.live.guard import WireGuard
+from poinsot.app.live.guard import WireGuard, guarded_viser
 from poinsot.app.live.pacing import frame_share
 from poinsot.app.live.session import MAX_FPS, Session
 from poinsot.app.live.upkeep import MemoryTrim, fixed_pool
@@ -71,11 +71,12 @@ class PoinsotApp:
         self.discarded = 0
         self._connected = threading.Condition(self._lock)
         self.budget = RebuildGate()
-        self.server = viser.ViserServer(host=host, port=port, verbose=verbose)
+        # Handshakes checked before viser sees them, the share tunnel off (:mod:`.guard`).
+        self.server, gate = guarded_viser(host, port, verbose=verbose, allow_origins=allow_origins)
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
         self.server.scene.world_axes.visible = False
-        # First of this app's handlers: a refused websocket never reaches the ones below.
-        self.guard = WireGuard(self.server, allow_origins)
+        # First of this app's handlers: every message passes the guard before viser's.
+        self.guard = WireGuard(self.server, gate)
         # A session's frame thread may draw one last frame between the browser leaving and the
         # disconnect callback stopping it; viser then warns once that the message is dropped.
         # That is expected here, not a leak: the thread stops right after.

@@ -176,7 +176,8 @@ class Worker:
 
     @property
     def clients(self) -> int:
-        return int(self.load[0])
+        """Browsers connected now: 0 once the process has ended (its last count is stale)."""
+        return int(self.load[0]) if self.alive else 0
 
     @property
     def connects(self) -> int:

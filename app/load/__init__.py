@@ -5,7 +5,8 @@ of its own (:mod:`~poinsot.app.load.server_process`) and clients in other proces
 the clients' decoding is not server time:
 
 - soak (:func:`~poinsot.app.load.phases.soak`), storm (:mod:`~poinsot.app.load.storm`), stall
-  and flood (:mod:`~poinsot.app.load.flood`), each with a fresh server;
+  and flood (:mod:`~poinsot.app.load.flood`), hostile (:mod:`~poinsot.app.load.hostile`, the
+  inputs in :mod:`~poinsot.app.load.crafted`), each with a fresh server;
 - the clients: :mod:`~poinsot.app.load.fleet` (decoding probes),
   :mod:`~poinsot.app.load.raw` (a bare-socket websocket that misbehaves on purpose);
 - what the kernel says about a process: :mod:`~poinsot.app.load.procfs`;

@@ -28,8 +28,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = OneLineParser(
         prog="python -m poinsot.app.load",
         description="Load test of the live server on this machine's loopback: a soak, a storm "
-        "of connections, a stalled client, a flooding client. Prints a table of figures and "
-        "goals; exits 1 when a goal is missed.",
+        "of connections, a stalled client, a flooding client, a hostile one. Prints a table of "
+        "figures and goals; exits 1 when a goal is missed.",
     )
     add = parser.add_argument
     add("--phase", nargs="+", choices=PHASES, default=list(PHASES), help="phases to run, in order")
@@ -49,6 +49,18 @@ def build_parser() -> argparse.ArgumentParser:
     add("--stall-seconds", type=positive_float, default=cfg.stall_seconds, help="one stalls [s]")
     add("--flood-seconds", type=positive_float, default=cfg.flood_seconds, help="one floods [s]")
     add("--flood-rate", type=positive_float, default=cfg.flood_rate, help="messages a second")
+    add(
+        "--hostile-handshakes",
+        type=positive_int,
+        default=cfg.hostile_handshakes,
+        help="refused handshakes in the hostile phase",
+    )
+    add(
+        "--hostile-quiet-seconds",
+        type=positive_float,
+        default=cfg.hostile_quiet_seconds,
+        help="the innocent client's reference windows [s]",
+    )
     add("--debug", action="store_true", help="show the traceback of a failure (else one line)")
     goals = parser.add_argument_group("goals")
     goals.add_argument("--min-fps", type=non_negative_float, default=bounds.min_fps)
@@ -57,6 +69,10 @@ def build_parser() -> argparse.ArgumentParser:
     goals.add_argument("--storm-tolerance", type=non_negative_float, default=bounds.storm_tolerance)
     goals.add_argument("--min-keep", type=fraction, default=bounds.min_keep)
     goals.add_argument("--max-errors", type=non_negative_int, default=bounds.max_errors)
+    goals.add_argument(
+        "--max-hostile-rss-growth", type=non_negative_float, default=bounds.max_hostile_rss_growth
+    )
+    goals.add_argument("--min-innocent-keep", type=fraction, default=bounds.min_innocent_keep)
     return parser
 
 

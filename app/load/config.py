@@ -38,6 +38,8 @@ class Config:
     stall_seconds: float = 45.0  # client 0 stalled
     flood_seconds: float = 20.0  # one client flooding
     flood_rate: float = 10_000.0  # its messages a second
+    hostile_handshakes: int = 2000  # refused handshakes in the hostile phase
+    hostile_quiet_seconds: float = 8.0  # the innocent client's frames before and after it
 
     @property
     def lifetime(self) -> float:

@@ -22,6 +22,8 @@ class Bounds:
     storm_tolerance: float = 0.10  # threads, RSS and sessions after the storm vs before
     min_keep: float = 0.80  # of their frame rate, for the others while one stalls or floods
     max_errors: int = 0  # server log error lines, silent clients, lost sessions in the soak
+    max_hostile_rss_growth: float = 0.05  # after the hostile phase's bad handshakes
+    min_innocent_keep: float = 0.95  # of its frame rate, for a client while the hostile plays
 
 
 @dataclasses.dataclass(frozen=True)

@@ -1,8 +1,9 @@
-"""The four phases, run one by one, each against a fresh server child (its log judged too).
+"""The five phases, run one by one, each against a fresh server child (its log judged too).
 
 - ``soak`` (:mod:`poinsot.app.load.soak`): many clients for minutes;
 - ``storm`` (:mod:`poinsot.app.load.storm`): connects and departures, clean and abrupt;
-- ``stall``, ``flood`` (:mod:`poinsot.app.load.contention`): one client misbehaves.
+- ``stall``, ``flood`` (:mod:`poinsot.app.load.contention`): one client misbehaves;
+- ``hostile`` (:mod:`poinsot.app.load.hostile`): crafted messages, handshakes and inputs.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import os
 import time
 from collections.abc import Callable
 
-from poinsot.app.load import contention, procfs, soak, storm
+from poinsot.app.load import contention, hostile, procfs, soak, storm
 from poinsot.app.load.config import Config, Report, Say, server_processes
 from poinsot.app.load.figures import COMPLETES, Figure, at_most, info
 from poinsot.app.load.server_process import ServerProcess
@@ -23,6 +24,7 @@ BODIES: dict[str, Phase] = {
     "storm": storm.phase,
     "stall": contention.stall,
     "flood": contention.flood,
+    "hostile": hostile.phase,
 }
 PHASES = tuple(BODIES)
 

@@ -22,6 +22,7 @@ import time
 from multiprocessing.connection import Connection
 from typing import Any
 
+from poinsot.app import viser_private
 from poinsot.app.load.children import Child
 
 #: What counts as an error in the server's log (case-insensitive).
@@ -49,6 +50,7 @@ def _status(app: Any) -> dict[str, Any]:
         "frames": sum(s.stats.frames for s in sessions.values()),
         "session_errors": sum(s.stats.errors for s in sessions.values()),
         "session_threads": kinds.get("poinsot-session", 0),
+        "connections": viser_private.connection_count(app.server),
         "threads": dict(kinds),
     }
 

@@ -32,6 +32,8 @@ TINY = Config(
     stall_seconds=2.0,
     flood_seconds=2.0,
     flood_rate=1000.0,
+    hostile_handshakes=100,
+    hostile_quiet_seconds=1.0,
 )
 #: Bounds every tiny run meets on a working server, however loaded the machine.
 LENIENT = Bounds(
@@ -41,6 +43,8 @@ LENIENT = Bounds(
     storm_tolerance=100.0,
     min_keep=0.01,
     max_errors=1000,
+    max_hostile_rss_growth=10.0,
+    min_innocent_keep=0.01,
 )
 LENIENT_ARGS = [
     "--min-fps=1",
@@ -49,6 +53,8 @@ LENIENT_ARGS = [
     "--storm-tolerance=100",
     "--min-keep=0.01",
     "--max-errors=1000",
+    "--max-hostile-rss-growth=10",
+    "--min-innocent-keep=0.01",
 ]
 
 
@@ -121,6 +127,21 @@ def test_flood_sends_and_measures_the_others(report):
         assert 0 <= report.figure(phase, "the machine meanwhile").detail["busy"] <= 1
 
 
+@pytest.mark.slow
+def test_hostile_replays_every_crafted_input_and_nothing_gets_through(report):
+    """Every crafted message closes its sender, every bad handshake is refused, HTTP/1.0 is
+    answered, the GUI's crafted inputs hurt no one; no traceback, no share request reaching
+    viser, no connection left behind (counts: they hold however loaded the machine)."""
+    for name in ("crafted messages", "bad handshakes", "HTTP/1.0", "crafted GUI inputs"):
+        figure = report.figure("hostile", name)
+        assert figure.value == 1.0, figure.text
+    assert report.figure("hostile", "bad handshakes").text == "100/100"
+    for name in ("tracebacks", "share tunnel", "leaked connections"):
+        assert report.figure("hostile", name).value == 0, report.figure("hostile", name).text
+    assert report.figure("hostile", "innocent client's frame rate").value > 0
+    assert report.figure("hostile", "server memory").value < 10.0
+
+
 # -- the goals, judged on the same figures -----------------------------------------------------
 @pytest.mark.slow
 def test_met_bounds_give_zero_and_each_impossible_bound_gives_one(report):
@@ -132,6 +153,8 @@ def test_met_bounds_give_zero_and_each_impossible_bound_gives_one(report):
         "storm_tolerance": -1.0,
         "min_keep": 1e9,
         "max_errors": -1,
+        "max_hostile_rss_growth": -1.0,
+        "min_innocent_keep": 1e9,
     }
     assert set(impossible) == {f.name for f in dataclasses.fields(Bounds)}
     for name, value in impossible.items():

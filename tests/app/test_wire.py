@@ -2,17 +2,22 @@
 
 from __future__ import annotations
 
+import collections
+import logging
 import math
+import socket
 import threading
 import time
 from typing import Any
 
 import numpy as np
 import pytest
+import websockets
 from conftest import session_of, wait_until
 from uploading import MESH
 from viser import _messages
 
+from poinsot.app import viser_private
 from poinsot.app.live import guard
 from poinsot.app.live import transfers as transfers_module
 from poinsot.app.live.budget import MessageBudget
@@ -21,6 +26,7 @@ from poinsot.app.live.motion_window import PLOT_SAMPLES, MotionWindow
 from poinsot.app.live.probe import Probe
 from poinsot.app.live.transfers import handle_id
 from poinsot.app.live.widgets import checked
+from poinsot.app.load import crafted
 from poinsot.app.parameters import TRAIL_RANGE, Parameters
 from poinsot.app.presets import DEFAULT_PRESET, MESH_BODY
 
@@ -62,16 +68,17 @@ def test_a_page_from_another_origin_gets_no_session(make_app, make_probe, origin
     app = make_app(allow_origins=["http://slides.example"])
     if origin == "same":
         origin = f"http://127.0.0.1:{app.port}"
-    probe = make_probe(app, origin=origin)
     if served:
+        probe = make_probe(app, origin=origin)
         assert _session_built(app, probe)
         assert app.guard.refused == 0
-    else:
-        assert wait_until(lambda: probe.closed, 10)
-        assert probe.close_code == POLICY_VIOLATION
-        time.sleep(0.5)  # a session built late would show now
-        assert len(app.sessions()) == 0 and app.guard.refused == 1
-        assert not any(n.startswith("/space/body") for n in probe.nodes)
+    else:  # refused at the HTTP upgrade: no connection, no client id, no state in viser
+        with pytest.raises(websockets.InvalidStatus) as refused:
+            make_probe(app, origin=origin)
+        assert refused.value.response.status_code == 403
+        assert app.guard.refused == 1
+        assert not viser_private.infra(app.server)._client_state_from_id
+        assert len(app.sessions()) == 0
 
 
 # -- raw values --------------------------------------------------------------------------------
@@ -300,3 +307,118 @@ def test_what_a_client_gets_through_is_bounded_by_its_budget():
     admitted = sum(budget.admit(now) for now in flood)
     assert admitted <= 100.0 * 3.0 + 1 and budget.sustained(flood[-1])
     assert not budget.sustained(flood[-1] + 1.5)  # it paused
+
+
+# -- the allow-list: only what viser's client sends --------------------------------------------
+def _quiet(caplog, capfd) -> tuple[list[str], str]:
+    """The guard's log lines, and whatever else reached the terminal (tracebacks, rich)."""
+    lines = [r.getMessage() for r in caplog.records if r.name == guard.__name__]
+    assert not [r for r in caplog.records if r.exc_info or r.levelno >= logging.ERROR]
+    out, err = capfd.readouterr()
+    return lines, out + err
+
+
+@pytest.mark.parametrize("name", list(crafted.MESSAGES))
+def test_a_message_viser_s_client_never_sends_closes_its_sender_with_one_line(
+    poinsot_app, make_probe, caplog, capfd, name
+):
+    """Valid msgpack that is wrong for viser, or no msgpack at all: the sender is closed with
+    1008 and one log line naming the type and the client, never a traceback; the share
+    tunnel is never asked for; another client plays on."""
+    caplog.set_level(logging.WARNING)
+    other = make_probe(poinsot_app)
+    assert other.wait_frames(3)
+    probe = make_probe(poinsot_app)
+    capfd.readouterr()
+    probe.send_raw(crafted.MESSAGES[name])
+    assert wait_until(lambda: probe.closed, 10)
+    assert probe.close_code == POLICY_VIOLATION
+    assert poinsot_app.guard.closed_for_message == 1
+    lines, terminal = _quiet(caplog, capfd)
+    assert len(lines) == 1 and "127.0.0.1:" in lines[0], lines
+    assert "Traceback" not in terminal and "Share URL" not in terminal, terminal[-2000:]
+    assert other.wait_frames(3) and not other.closed
+
+
+def test_the_share_tunnel_is_off_on_the_server_side_too(poinsot_app):
+    assert not viser_private.share_enabled(poinsot_app.server)
+    assert "ShareUrlRequest" not in viser_private.ALLOWED
+
+
+def test_many_bad_messages_give_few_lines(poinsot_app, caplog, capfd):
+    """50 refused messages, from 50 clients: the lines are rate-limited (one a second, the
+    rest counted in the next), and none is a traceback."""
+    caplog.set_level(logging.WARNING)
+    payloads = list(crafted.MESSAGES.values())
+    outcomes = collections.Counter(
+        crafted.send_message(poinsot_app.port, payloads[k % len(payloads)]) for k in range(50)
+    )
+    assert outcomes == {"closed 1008": 50}
+    lines, terminal = _quiet(caplog, capfd)
+    assert 1 <= len(lines) < 15 and "Traceback" not in terminal, (lines, terminal[-2000:])
+
+
+# -- handshakes --------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("host", "listen", "allowed", "expected"),
+    [
+        ("127.0.0.1:8080", "127.0.0.1", (), True),
+        ("localhost:8080", "127.0.0.1", (), True),
+        ("127.0.0.1:80", "127.0.0.1", (), True),  # nginx in front forwards the page's own Host
+        ("evil.example:8080", "0.0.0.0", (), False),  # DNS rebinding
+        ("evil.example:8080", "127.0.0.1", (), False),
+        ("192.0.2.7:8080", "0.0.0.0", (), False),  # not an address of this machine
+        ("room.example", "0.0.0.0", ("https://room.example",), True),
+        ("room.example:8080", "room.example", (), True),
+        ("[::1]:8080", "0.0.0.0", (), True),
+        ("", "0.0.0.0", (), False),
+        (None, "0.0.0.0", (), False),
+    ],
+)
+def test_which_hosts_may_connect(host, listen, allowed, expected):
+    assert guard.host_allowed(host, listen, allowed) is expected
+
+
+def _rss() -> int:
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) * 1024 for line in f if line.startswith("VmRSS:"))
+
+
+@pytest.mark.slow
+def test_two_thousand_bad_handshakes_leave_nothing_behind(poinsot_app, caplog, capfd):
+    """Duplicate and missing Host, DNS rebinding, foreign and null origins: each is answered
+    403 at the upgrade; memory stays within 5 % (after a warm-up), viser holds no connection
+    state, no traceback is printed."""
+    caplog.set_level(logging.WARNING)
+    port = poinsot_app.port
+    assert crafted.bad_handshakes(port, 200) == {"403": 200}  # warm-up: caches, allocator
+    before = _rss()
+    assert crafted.bad_handshakes(port, 2000) == {"403": 2000}
+    after = _rss()
+    infra = viser_private.infra(poinsot_app.server)
+    assert not infra._client_state_from_id and not infra._live_connections
+    assert poinsot_app.guard.refused == 2200 and not poinsot_app.sessions()
+    assert after <= 1.05 * before, (before, after)
+    _, terminal = _quiet(caplog, capfd)
+    assert "Traceback" not in terminal, terminal[-2000:]
+
+
+def test_a_rebinding_page_is_refused_and_the_own_page_is_not(poinsot_app, make_probe):
+    port = poinsot_app.port
+    rebinding = crafted.HANDSHAKES["DNS rebinding (Host and Origin evil.example)"](port)
+    assert crafted.exchange(port, rebinding) == "403"
+    probe = make_probe(poinsot_app, origin=f"http://127.0.0.1:{port}")
+    assert _session_built(poinsot_app, probe)
+
+
+@pytest.mark.parametrize("name", list(crafted.HTTP10))
+def test_an_http_1_0_get_gets_the_page(poinsot_app, caplog, capfd, name):
+    caplog.set_level(logging.WARNING)
+    with socket.create_connection(("127.0.0.1", poinsot_app.port), timeout=10) as sock:
+        sock.sendall(crafted.HTTP10[name])
+        answer = b"".join(iter(lambda: sock.recv(1 << 16), b""))
+    head, _, body = answer.partition(b"\r\n\r\n")
+    assert head.startswith(b"HTTP/1.1 200"), head[:200]
+    assert b"<html" in body.lower()
+    _, terminal = _quiet(caplog, capfd)
+    assert "Traceback" not in terminal

@@ -25,7 +25,7 @@ import segno
 
 from poinsot.app import cli
 from poinsot.app.live import network
-from poinsot.app.live.landing import Balancer, _loopback, resolve, status
+from poinsot.app.live.landing import PENDING_SECONDS, Balancer, _loopback, resolve, status
 from poinsot.app.live.probe import Probe
 from tests.conftest import wait_until
 
@@ -179,8 +179,12 @@ def test_landing_sends_new_browsers_to_the_least_loaded_worker(classroom: Classr
 @pytest.mark.slow
 def test_a_crashed_worker_is_reported_and_gets_no_new_browsers(classroom: Classroom):
     first, second = classroom.workers()
+    browser = Probe(first["port"])  # a browser on the worker that will crash
+    assert wait_until(lambda: classroom.clients() == [1, 0], 60)
     os.kill(first["pid"], signal.SIGKILL)
     assert wait_until(lambda: any("stopped unexpectedly" in line for line in classroom.stderr), 30)
+    browser.close()
+    assert classroom.clients() == [0, 0]  # its last count was 1: a dead worker holds none
     report = [line for line in classroom.stderr if "stopped unexpectedly" in line]
     assert len(report) == 1 and f"port {first['port']}" in report[0]
     assert [w["alive"] for w in classroom.workers()] == [False, True]
@@ -350,3 +354,57 @@ def test_only_a_client_on_this_machine_is_shown_the_workers_process_ids():
     """/poinsot-status gives pids to loopback clients (the tests, the load test) only."""
     assert all(_loopback(a) for a in ("127.0.0.1", "127.8.0.1", "::1", "::ffff:127.0.0.1"))
     assert not any(_loopback(a) for a in ("192.168.1.5", "10.0.0.1", "::ffff:10.0.0.1", "fe80::1"))
+
+
+# -- the status page tells the truth ------------------------------------------------------------
+class FakeClock:
+    def __init__(self) -> None:
+        self.now = 1000.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_a_dead_worker_shows_no_clients_and_no_load():
+    a, b = FakeWorker(1, clients=2, connects=2), FakeWorker(2, clients=1, connects=1)
+    balancer = Balancer([a, b])
+    balancer.choose()  # one browser on its way to b
+    a.alive = b.alive = False  # killed: their last counts stay in shared memory
+    assert [(row["clients"], row["load"]) for row in balancer.status()] == [(0, 0), (0, 0)]
+
+
+def test_a_redirect_that_never_connects_stops_counting_after_five_seconds():
+    assert PENDING_SECONDS <= 5.0
+    clock = FakeClock()
+    a = FakeWorker(1, clients=3, connects=3)
+    balancer = Balancer([a], clock=clock)
+    for _ in range(6):  # six redirects (curl, a closed tab): none connects
+        balancer.choose()
+    assert balancer.status()[0]["load"] == 9
+    clock.now += PENDING_SECONDS - 0.1
+    assert balancer.status()[0]["load"] == 9  # still on their way
+    clock.now += 0.2
+    assert balancer.status()[0]["load"] == 3  # only the real clients
+
+
+def test_a_head_request_is_not_a_browser_on_its_way():
+    a = FakeWorker(1)
+    balancer = Balancer([a])
+    assert balancer.choose(counted=False) is a
+    assert balancer.status()[0]["load"] == 0
+
+
+def test_a_worker_started_again_is_used_again():
+    a, b = FakeWorker(1, clients=4, connects=9), FakeWorker(2, clients=3, connects=3)
+    balancer = Balancer([a, b])
+    a.alive = False
+    assert balancer.choose() is b
+    # started again (a new process on the same port counts from zero)
+    a.alive, a.clients, a.connects = True, 0, 0
+    assert balancer.choose() is a
+    a.arrive()
+    assert [row["load"] for row in balancer.status()] == [1, 4]
+    # or put in its place as a new backend
+    fresh = FakeWorker(3)
+    balancer.replace(0, fresh)
+    assert balancer.choose() is fresh

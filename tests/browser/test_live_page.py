@@ -162,3 +162,27 @@ def test_two_browsers_have_independent_sessions(poinsot_app, open_page):
     assert first.dropdown_value("Preset") == preset_by_key("oblate").label
     assert a.scene.api is not b.scene.api
     assert first.errors == [] and second.errors == []
+
+
+def test_a_real_browser_sends_only_what_the_wire_allows(poinsot_app, open_page):
+    """Orbiting, a slider, a dropdown, a hotkey and a resize from Chromium's own viser client:
+    every message passes the guard's allow-list, none is dropped, the session plays on."""
+    page = open_page(poinsot_app.url)
+    session = started(poinsot_app)
+    box = page.canvas_box()
+    mouse = page.page.mouse
+    mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    mouse.down()
+    for k in range(20):  # an orbit: camera messages
+        mouse.move(box["x"] + box["width"] / 2 + 8 * k, box["y"] + box["height"] / 2 + 3 * k)
+    mouse.up()
+    page.press_slider("I₁", "ArrowRight", times=3)
+    assert wait_until(lambda: abs(session.params.inertia[0] - 1.03) < 1e-9, 10)
+    page.choose("Preset", preset_by_key("minor").label)
+    page.page.keyboard.press("Space")  # a command of the palette
+    page.page.set_viewport_size({"width": 1001, "height": 777})
+    frames = session.stats.frames
+    assert wait_until(lambda: session.stats.frames > frames + 10, 15)
+    guard = poinsot_app.guard
+    assert guard.closed_for_message == 0 and guard.malformed == 0 and guard.dropped == 0
+    assert len(poinsot_app.sessions()) == 1 and page.errors == []

@@ -1,0 +1,330 @@
+"""Every use of viser's private names, in one place: the adapter between Poinsot and viser 1.1.x.
+
+viser's public API does not reach the wire: it offers no hook before a message is decoded, none
+at the HTTP handshake, and no switch for the share tunnel's message handlers. What Poinsot needs
+there is done here, on names that viser may move in any release. Each is pinned by a test
+(``tests/app/test_viser_private.py``) that fails naming the viser version when it moves, and
+:func:`check` runs the same checks at start.
+
+Written for viser **1.1.x** (:data:`VISER_SERIES`), websockets 13 or later (its public
+``serve(process_request=..., create_connection=...)``).
+
+Inventory (section, private name, what it is used for):
+
+*Handshake*
+  - ``viser.infra._infra`` calls ``websockets.asyncio.server.serve`` (looked up on the module at
+    call time, inside ``WebsockServer.start``, before ``ViserServer()`` returns) with its own
+    ``process_request`` (the page server): :func:`hooked_server` wraps it for the duration of
+    one construction, adding a request check of ours before viser's and a connection class
+    that reads an HTTP/1.0 request line as HTTP/1.1.
+
+*Connections*
+  - ``ViserServer._websock_server`` (the infra ``WebsockServer``): its public
+    ``on_client_connect``/``on_client_disconnect``/``unregister_handler``.
+  - ``WebsockServer._live_connections`` (client id -> websockets ``ServerConnection``): the
+    connection whose ``recv`` viser's consumer awaits (an instance attribute can wrap it).
+  - ``WebsockServer._client_state_from_id``: the connections viser holds state for (the load
+    test counts leaked ones).
+  - ``ViserServer._connected_clients`` (client id -> ``ClientHandle``) and
+    ``ClientHandle._websock_connection._incoming_handlers`` (a render response is expected
+    only while a ``get_render`` handler is registered).
+
+*GUI*
+  - ``GuiApi._gui_input_handle_from_uuid`` (uuid -> handle): the widget a value is meant for.
+
+*Messages*
+  - ``viser._messages``: the client-to-server message classes whose fields
+    :data:`ALLOWED` mirrors (names and order checked by :func:`check`), and ``ShareUrlRequest``
+    / ``ShareUrlDisconnect``, whose server handlers :func:`disable_share` removes.
+
+*Page* (a page's own address, and the clipboard)
+  - ``ViserServer._websock_server._live_connections[client_id].request``: the websocket
+    handshake of a client (:func:`handshake_origin`). viser keeps the connection to itself; its
+    ``ClientHandle`` exposes no header. Used to tell a web page (it always sends ``Origin``) from
+    a tool (the probe, the load test), which runs no JavaScript.
+  - ``ClientHandle._websock_connection``: ``queue_message``, ``register_handler`` and
+    ``unregister_handler`` of one client's connection, with the message classes
+    ``viser._messages.RunJavascriptMessage``, ``LocalStorageGetItemRequestMessage`` and
+    ``LocalStorageGetItemResponseMessage`` (:func:`page_address`, :func:`copy_to_clipboard`).
+    viser's client connects its websocket to the page's address *without* the query
+    (``getDefaultServerFromUrl`` drops everything after ``?``) and sends nothing of the page's
+    address on connect, so a link's query never reaches the server by a public way. A line of
+    JavaScript run in the page writes ``window.location.href`` to the page's ``localStorage``
+    under a key of this connection alone, and viser's own localStorage request reads it back;
+    :meth:`viser.LocalStorageHandle.get_item` does the same read but blocks a thread, where this
+    awaits on the event loop (a page that never answers holds no thread).
+  - ``"viser-user:"``: the prefix viser's client puts before the keys of its localStorage API
+    (``LOCAL_STORAGE_PREFIX`` in the client's ``MessageHandler.tsx``).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import dataclasses
+import json
+import threading
+import uuid
+from collections.abc import Awaitable, Callable, Iterator
+from typing import Any
+
+import viser
+import websockets.asyncio.server
+from viser import _messages
+from websockets.asyncio.server import ServerConnection
+from websockets.http11 import Request, Response
+
+from poinsot.app.viser_private.messages import (
+    ALLOWED,
+    GetRenderResponse,
+    GuiUpdate,
+    Refused,
+    client_message,
+    message_type,
+)
+
+__all__ = ["ALLOWED", "GetRenderResponse", "GuiUpdate", "Refused", "client_message", "message_type"]
+
+#: The viser release series this module was written for.
+VISER_SERIES = "1.1"
+
+
+class ViserChanged(RuntimeError):
+    """A private name or shape this module relies on is not what viser 1.1.x had."""
+
+    def __init__(self, what: str) -> None:
+        super().__init__(
+            f"viser {viser.__version__} is not the viser {VISER_SERIES}.x that "
+            f"poinsot.app.viser_private was written for: {what}"
+        )
+
+
+# -- handshake ---------------------------------------------------------------------------------
+RequestCheck = Callable[[ServerConnection, Request], Response | None]
+_SERVE_LOCK = threading.Lock()
+#: The longest request line read before it is handed on as it is [bytes].
+_REQUEST_LINE_MAX = 8192
+
+
+class Http10Connection(ServerConnection):
+    """A websockets server connection that reads an ``HTTP/1.0`` request line as ``HTTP/1.1``
+    (websockets parses only 1.1 and would drop the request unanswered), so that an HTTP/1.0
+    GET gets viser's page (a 1.1 response with its length, which HTTP/1.0 clients read)."""
+
+    _head: bytes | None = b""
+
+    def data_received(self, data: bytes) -> None:
+        if self._head is not None:
+            self._head += data
+            if b"\n" not in self._head and len(self._head) < _REQUEST_LINE_MAX:
+                return
+            data, self._head = _as_http11(self._head), None
+        super().data_received(data)
+
+
+def _as_http11(head: bytes) -> bytes:
+    line, newline, rest = head.partition(b"\n")
+    crlf = line.endswith(b"\r")
+    bare = line[:-1] if crlf else line
+    if bare.endswith(b" HTTP/1.0"):
+        line = bare[: -len(b"1.0")] + b"1.1" + (b"\r" if crlf else b"")
+    return line + newline + rest
+
+
+@contextlib.contextmanager
+def hooked_server(
+    check: RequestCheck, on_error: Callable[[BaseException], Response]
+) -> Iterator[None]:
+    """Within this block, the one ``viser.ViserServer(...)`` built runs ``check`` on every HTTP
+    request before viser's page server (a response refuses it, None lets it through) and
+    answers with ``on_error(exc)`` when viser's page server raises. Raises :class:`ViserChanged`
+    if the server was built without going through ``websockets.asyncio.server.serve``."""
+    original = websockets.asyncio.server.serve
+    calls: list[int] = []
+
+    def serve(handler: Any, *args: Any, **kwargs: Any) -> Any:
+        page = kwargs.get("process_request")
+
+        def process_request(connection: ServerConnection, request: Request) -> Response | None:
+            refusal = check(connection, request)
+            if refusal is not None or page is None:
+                return refusal
+            try:
+                response: Response | None = page(connection, request)
+            except Exception as exc:  # a request viser's page server cannot take
+                return on_error(exc)
+            return response
+
+        kwargs["process_request"] = process_request
+        kwargs["create_connection"] = Http10Connection
+        calls.append(1)
+        return original(handler, *args, **kwargs)
+
+    with _SERVE_LOCK:
+        websockets.asyncio.server.serve = serve  # type: ignore[misc,assignment]
+        try:
+            yield
+        finally:
+            websockets.asyncio.server.serve = original  # type: ignore[misc]
+    if not calls:
+        raise ViserChanged("ViserServer() no longer calls websockets.asyncio.server.serve")
+
+
+# -- connections -------------------------------------------------------------------------------
+def infra(server: viser.ViserServer) -> Any:
+    """viser's infra-level websocket server of ``server``."""
+    return server._websock_server
+
+
+def live_connection(server: viser.ViserServer, client_id: int) -> ServerConnection | None:
+    """The websockets connection viser reads ``client_id``'s messages from."""
+    found: ServerConnection | None = infra(server)._live_connections.get(client_id)
+    return found
+
+
+def connection_count(server: viser.ViserServer) -> int:
+    """The websocket connections viser holds state for (live ones, or leaked ones)."""
+    return len(infra(server)._client_state_from_id)
+
+
+def wrap_recv(
+    connection: ServerConnection,
+    wrapper: Callable[[Callable[[], Awaitable[Any]]], Callable[[], Awaitable[Any]]],
+) -> None:
+    """Make viser's consumer read ``connection`` through ``wrapper(connection.recv)``."""
+    connection.recv = wrapper(connection.recv)  # type: ignore[method-assign,assignment]
+
+
+def render_requested(server: viser.ViserServer, client_id: int) -> bool:
+    """Is a ``get_render`` of this client waiting for its answer?"""
+    client = server._connected_clients.get(client_id)
+    if client is None:
+        return False
+    handlers = client._websock_connection._incoming_handlers
+    return bool(handlers.get(_messages.GetRenderResponseMessage))
+
+
+# -- GUI ---------------------------------------------------------------------------------------
+def gui_input_handle(server: viser.ViserServer, client_id: int, uuid: str) -> Any:
+    """The input widget ``uuid`` of the client's own GUI or the shared one, or None."""
+    client = server._connected_clients.get(client_id)
+    for gui in (client.gui if client is not None else None, server.gui):
+        handle = gui._gui_input_handle_from_uuid.get(uuid) if gui is not None else None
+        if handle is not None:
+            return handle
+    return None
+
+
+# -- share -------------------------------------------------------------------------------------
+SHARE_MESSAGES = (_messages.ShareUrlRequest, _messages.ShareUrlDisconnect)
+
+
+def disable_share(server: viser.ViserServer) -> None:
+    """Remove viser's handlers that open and close the public share tunnel: a message asking
+    for it then does nothing, even if it got past the wire."""
+    for message in SHARE_MESSAGES:
+        with contextlib.suppress(AssertionError, KeyError):
+            infra(server).unregister_handler(message)
+
+
+def share_enabled(server: viser.ViserServer) -> bool:
+    """Would a share request reach a handler?"""
+    handlers = infra(server)._incoming_handlers
+    return any(handlers.get(message) for message in SHARE_MESSAGES)
+
+
+# -- page ------------------------------------------------------------------------------------
+#: The client's prefix of the keys its localStorage API reads and writes.
+LOCAL_STORAGE_PREFIX = "viser-user:"
+
+
+def handshake_origin(server: viser.ViserServer, client_id: int) -> str | None:
+    """The ``Origin`` header of the client's websocket handshake (None: not a web page, or
+    the connection is gone)."""
+    connection: Any = server._websock_server._live_connections.get(client_id)
+    request = getattr(connection, "request", None)
+    if request is None:
+        return None
+    origin = request.headers.get("Origin")
+    return str(origin) if origin is not None else None
+
+
+def _run_javascript(client: viser.ClientHandle, source: str) -> None:
+    client._websock_connection.queue_message(_messages.RunJavascriptMessage(source=source))
+
+
+async def page_address(client: viser.ClientHandle, timeout: float) -> str | None:
+    """The address of the page of ``client`` (``window.location.href``, its query included),
+    or None if the page does not answer within ``timeout`` seconds or has no localStorage. Run
+    on viser's event loop, outside its connect handler (the answer arrives only once viser
+    reads the connection, after the handler)."""
+    key = f"poinsot-page-{uuid.uuid4().hex}"
+    request_uuid = uuid.uuid4().hex
+    answer: asyncio.Future[str | None] = asyncio.get_running_loop().create_future()
+
+    def got(client_id: int, message: _messages.LocalStorageGetItemResponseMessage) -> None:
+        del client_id
+        if message.request_uuid == request_uuid and not answer.done():
+            answer.set_result(message.value if message.error is None else None)
+
+    connection = client._websock_connection
+    connection.register_handler(_messages.LocalStorageGetItemResponseMessage, got)
+    try:
+        name = json.dumps(LOCAL_STORAGE_PREFIX + key)
+        _run_javascript(
+            client, f"try {{ localStorage.setItem({name}, window.location.href); }} catch (e) {{}}"
+        )
+        connection.queue_message(
+            _messages.LocalStorageGetItemRequestMessage(key=key, request_uuid=request_uuid)
+        )
+        client.flush()
+        return await asyncio.wait_for(answer, timeout)
+    except TimeoutError:
+        return None
+    finally:
+        connection.unregister_handler(_messages.LocalStorageGetItemResponseMessage, got)
+        client.local_storage.remove_item(key)
+
+
+_COPY_JS = """
+const text = %s;
+const fallback = () => {
+  const area = document.createElement("textarea");
+  area.value = text;
+  area.style.position = "fixed";
+  area.style.opacity = "0";
+  document.body.appendChild(area);
+  area.select();
+  try { document.execCommand("copy"); } catch (e) {}
+  area.remove();
+};
+if (navigator.clipboard && window.isSecureContext) {
+  navigator.clipboard.writeText(text).catch(fallback);
+} else {
+  fallback();
+}
+"""
+
+
+def copy_to_clipboard(client: viser.ClientHandle, text: str) -> None:
+    """Ask the page of ``client`` to put ``text`` on the clipboard (the browser may refuse:
+    the caller also shows the text)."""
+    _run_javascript(client, _COPY_JS % json.dumps(text))
+    client.flush()
+
+
+# -- checks --------------------------------------------------------------------------------------
+def check() -> None:
+    """Raise :class:`ViserChanged` if a private name or message shape used here has moved."""
+    if not viser.__version__.startswith(VISER_SERIES + "."):
+        raise ViserChanged(f"version {viser.__version__}")
+    for name, struct in ALLOWED.items():
+        original = getattr(_messages, name, None)
+        if original is None or not dataclasses.is_dataclass(original):
+            raise ViserChanged(f"no message class {name} in viser._messages")
+        theirs = [f.name for f in dataclasses.fields(original) if f.init]
+        if list(struct.__struct_fields__) != theirs:
+            raise ViserChanged(f"{name} has fields {theirs}, not {struct.__struct_fields__}")
+    for message in SHARE_MESSAGES:
+        if message.__name__ in ALLOWED:
+            raise ViserChanged(f"{message.__name__} is allowed")
