@@ -51,7 +51,9 @@ def _angles(epsilon: ArrayLike, what: str) -> NDArray[np.float64]:
     try:
         eps = np.asarray(epsilon, dtype=np.float64)
     except (TypeError, ValueError):
-        raise ValueError(f"{what} must be a number or an array of numbers, got {epsilon!r}")
+        raise ValueError(
+            f"{what} must be a number or an array of numbers, got {epsilon!r}"
+        ) from None
     if not np.all((eps > 0.0) & (eps < 0.5 * math.pi)):
         raise ValueError(
             f"{what} must lie in (0, π/2) rad, got {epsilon!r} (0 is a spin exactly about e2, "
@@ -121,9 +123,7 @@ class TwinClock:
     growth_rate: float
 
 
-def twin_clock(
-    inertia: ArrayLike, epsilon: float, epsilon2: float, spin: float = 1.0
-) -> TwinClock:
+def twin_clock(inertia: ArrayLike, epsilon: float, epsilon2: float, spin: float = 1.0) -> TwinClock:
     """The theory of the twins at ``ε`` and ``ε′`` [rad] (see the module docstring)."""
     t1, t2 = first_flip_times(inertia, [epsilon, epsilon2], spin)
     limit = float(lag_limit(inertia, epsilon, epsilon2, spin))
