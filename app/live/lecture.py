@@ -30,6 +30,7 @@ import viser
 from poinsot.app.exports.glb import scene_glb
 from poinsot.app.exports.run_csv import run_csv, run_span
 from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
+from poinsot.app.live.challenges import ChallengeControls, ChallengeSession, add_challenges
 from poinsot.app.live.clock import SimClock
 from poinsot.app.live.display import LARGE_TEXT_PERCENT, Display
 from poinsot.app.live.motion_window import MotionWindow
@@ -52,8 +53,8 @@ FOLDER_ORDER = 70.0
 CAMERA_HOTKEYS: tuple[Literal["1", "2", "3", "4"], ...] = ("1", "2", "3", "4")
 
 
-class LectureSession(Protocol):
-    """What the lecture controls use of a session."""
+class LectureSession(ChallengeSession, Protocol):
+    """What the lecture controls use of a session (and the challenges they mount)."""
 
     client: viser.ClientHandle
     clock: SimClock
@@ -81,6 +82,7 @@ class LectureControls:
         order: float = FOLDER_ORDER,
     ) -> None:
         self.session = session
+        self.challenges: ChallengeControls | None = None  # mounted by add_lecture_controls
         self.client = session.client
         self.render_timeout = float(render_timeout)
         self.camera = "default"
@@ -327,6 +329,9 @@ class LectureControls:
 
 
 def add_lecture_controls(session: LectureSession, **kwargs: float) -> LectureControls:
-    """Mount the lecture folder and hotkeys on ``session``'s panel; keep the returned object
-    and call its ``on_frame(frame)`` after each frame."""
-    return LectureControls(session, **kwargs)
+    """Mount the lecture folder and hotkeys on ``session``'s panel, and the challenges
+    (:mod:`~poinsot.app.live.challenges`, as ``.challenges``); keep the returned object and
+    call its ``on_frame(frame)`` after each frame."""
+    controls = LectureControls(session, **kwargs)
+    controls.challenges = add_challenges(session)
+    return controls
