@@ -9,13 +9,18 @@ ln(1/ε). A dropdown takes ε over the decades 1e-1 … 1e-12; the motion is exa
 (an integrator is not at 1e-12: ``python -m poinsot.physics.flip``). A plot shows
 log₁₀ sin(angle of ω from e₂) against time with the theory's slope σ.
 
+A twin (on by default, ε′ = ε/10; a dropdown takes ε/2 … ε/1000 or none) is the same handle
+started at ε′, drawn in cyan over the first: both exact, it flips later, by t₁(ε′) − t₁(ε) →
+ln(ε/ε′)/σ, so ten times closer buys only ln(10)/σ more, whatever ε.
+
 Readouts: the time between flips measured from the motion (the zeros of ω₂) against 2K(k)/λ and
 against its asymptote; the first flip against (K ± δ)/λ; the growth rate fitted to the motion
-against σ.
+against σ; the twin's first flip, its lag behind the first measured from the two motions
+against the theory, and that lag against its small-ε limit ln(ε/ε′)/σ.
 
 Physics: :func:`poinsot.physics.flip.flip_initial_omega`, :func:`~.flip_theory`,
-:func:`~.measure_flips`, :func:`~.measure_growth_rate`; :func:`poinsot.app.bodies.bundled_body`
-(the mesh and its moments).
+:func:`~.measure_flips`, :func:`~.measure_growth_rate`; :func:`poinsot.physics.twins.twin_clock`;
+:func:`poinsot.app.bodies.bundled_body` (the mesh and its moments).
 """
 
 from __future__ import annotations
@@ -57,11 +62,9 @@ PLOT_SAMPLES = 800
 GROWTH_WINDOWS = ((math.exp(5.0), 1e-3), (math.exp(3.0), 1e-2), (math.exp(2.0), 5e-2))
 HANDLE_NODE = "/space/body/handle"
 HANDLE = Part("handle", "T-handle (its mesh)", (HANDLE_NODE,), surface=colors.SOLID)
-#: The twin: the same handle started at ε′ = ε/n, overlaid and translucent.
+#: The twin: the same handle started at ε′ = ε/n, overlaid in cyan.
 TWIN_FRAME, TWIN_NODE = "/space/twin", "/space/twin/handle"
-TWIN = Part(
-    "twin-body", "its twin at ε′ (translucent)", (TWIN_FRAME, TWIN_NODE), surface=colors.TWIN
-)
+TWIN = Part("twin-body", "its twin at ε′ (cyan)", (TWIN_FRAME, TWIN_NODE), surface=colors.TWIN)
 #: The twin's ε/ε′ offered (0: no twin).
 TWIN_OPTIONS = ("no twin", "ε′ = ε/2", "ε′ = ε/10", "ε′ = ε/100", "ε′ = ε/1000")
 TWIN_RATIOS = (0.0, 2.0, 10.0, 100.0, 1000.0)
@@ -265,7 +268,7 @@ SPEC = SceneSpec(
             "twin at ε′ (a second start)",
             TWIN_OPTIONS,
             "ε′ = ε/10",
-            hint="A second handle, translucent, started at ε′: ten times closer to e₂ flips only "
+            hint="A second handle, in cyan, started at ε′: ten times closer to e₂ flips only "
             "ln(10)/σ later.",
             values=TWIN_RATIOS,
         ),

@@ -1,5 +1,9 @@
-"""A twin: a second copy of a scene's body, started a little off the first, drawn overlaid and
-translucent (:class:`TwinDrawing`), exact like the first.
+"""A twin: a second copy of a scene's body, started a little off the first, drawn overlaid in a
+colour of its own (:class:`TwinDrawing`), exact like the first.
+
+The twin is opaque, like the first body: a translucent mesh inside the translucent energy
+ellipsoid is hidden by it in the browser (the two are sorted by their common centre, and the
+ellipsoid, drawn first, writes the depth), so a translucent twin showed nothing.
 
 The twin's attitude is read from a :class:`~poinsot.app.scene.sampling.MotionSampler` of its
 own body (a batch of 512 grid times per physics call, converted to viser's quaternions once per
@@ -26,13 +30,11 @@ from poinsot.physics import FreeRigidBody
 #: The twin's grid step [time units]: a frame shows the twin at most this much behind the
 #: first body's grid time (a few hundredths of a turn at the scenes' spins).
 TWIN_STEP = 1.0 / 256.0
-#: The twin's surface opacity (the first body shows through it).
-TWIN_OPACITY = 0.45
 
 
 class TwinDrawing(RidingMesh):
     """The first body's mesh (``part``), and the same mesh in ``twin`` (a frame of its own,
-    beside the body frame under the construction's root, and the mesh in it, translucent)."""
+    beside the body frame under the construction's root, and the mesh in it, in ``color``)."""
 
     def __init__(
         self, canvas: Canvas, part: Part, twin: Part, mesh: trimesh.Trimesh, color: tuple[int, ...]
@@ -43,9 +45,7 @@ class TwinDrawing(RidingMesh):
         self.twin_frame = self.parts.frame(twin.key, frame_node)
         faces = np.asarray(mesh.faces)
         rgb = (int(color[0]), int(color[1]), int(color[2]))
-        self.twin_mesh = self.parts.surface(
-            twin.key, mesh_node, (self.vertices, faces), rgb, opacity=TWIN_OPACITY
-        )
+        self.twin_mesh = self.parts.surface(twin.key, mesh_node, (self.vertices, faces), rgb)
         self._sampler: MotionSampler | None = None
         self._source: Samples | None = None
         self._wxyz = np.zeros((0, 4))
