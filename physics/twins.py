@@ -41,9 +41,16 @@ from scipy import special
 from poinsot.physics.family import sorted_moments
 from poinsot.physics.flip import measure_flips
 from poinsot.physics.free_body import FreeRigidBody
-from poinsot.physics.validation import check_positive
+from poinsot.physics.validation import check_positive, check_vector
 
-__all__ = ["TwinClock", "first_flip_times", "lag_limit", "measured_lag", "twin_clock"]
+__all__ = [
+    "TwinClock",
+    "first_flip_times",
+    "lag_limit",
+    "measured_lag",
+    "neighbour_start",
+    "twin_clock",
+]
 
 
 def _angles(epsilon: ArrayLike, what: str) -> NDArray[np.float64]:
@@ -138,3 +145,21 @@ def measured_lag(first: FreeRigidBody, second: FreeRigidBody, t_end: float) -> f
     if len(a) == 0 or len(b) == 0:
         return math.nan
     return float(b[0] - a[0])
+
+
+def neighbour_start(omega0: ArrayLike, angle: float) -> NDArray[np.float64]:
+    """``omega0`` (3,) [rad/time] turned by ``angle`` [rad] (same length): a neighbour's start.
+
+    The turn is about the unit axis ``n = ω0 × e_j / |ω0 × e_j|``, ``e_j`` the body axis of
+    ω0's smallest component (never parallel to ω0), by Rodrigues' formula; for ω0 near a
+    principal axis it tilts ω0 towards or away from another one.
+    """
+    w = check_vector(omega0, "omega0")
+    eps = float(_angles(angle, "the neighbour's angle ε′"))
+    j = int(np.argmin(np.abs(w)))
+    n = np.cross(w, np.eye(3)[j])
+    norm = float(np.linalg.norm(n))
+    if norm == 0.0:
+        raise ValueError("omega0 = 0 has no neighbour at an angle: the body is at rest")
+    n /= norm
+    return np.asarray(w * math.cos(eps) + np.cross(n, w) * math.sin(eps), dtype=np.float64)

@@ -34,6 +34,7 @@ from poinsot.app.live.challenges import ChallengeControls, ChallengeSession, add
 from poinsot.app.live.clock import SimClock
 from poinsot.app.live.display import LARGE_TEXT_PERCENT, Display
 from poinsot.app.live.motion_window import MotionWindow
+from poinsot.app.live.neighbour import Neighbour, add_neighbour
 from poinsot.app.live.widgets import Sent, on_user, set_value
 from poinsot.app.presets import Preset
 from poinsot.app.scene.batch import Frame
@@ -83,6 +84,7 @@ class LectureControls:
     ) -> None:
         self.session = session
         self.challenges: ChallengeControls | None = None  # mounted by add_lecture_controls
+        self.neighbour: Neighbour | None = None  # likewise
         self.client = session.client
         self.render_timeout = float(render_timeout)
         self.camera = "default"
@@ -230,6 +232,8 @@ class LectureControls:
             if self.camera == RIDE_ALONG:
                 self._apply(ride_along(BODY_VIEW, frame.wxyz))
         self.display.on_frame(frame, time.monotonic())
+        if self.neighbour is not None:
+            self.neighbour.on_frame(frame)
 
     # -- theme ---------------------------------------------------------------------------
     @property
@@ -329,9 +333,11 @@ class LectureControls:
 
 
 def add_lecture_controls(session: LectureSession, **kwargs: float) -> LectureControls:
-    """Mount the lecture folder and hotkeys on ``session``'s panel, and the challenges
-    (:mod:`~poinsot.app.live.challenges`, as ``.challenges``); keep the returned object and
+    """Mount the lecture folder and hotkeys on ``session``'s panel, the challenges
+    (:mod:`~poinsot.app.live.challenges`, as ``.challenges``) and the neighbour
+    (:mod:`~poinsot.app.live.neighbour`, as ``.neighbour``); keep the returned object and
     call its ``on_frame(frame)`` after each frame."""
     controls = LectureControls(session, **kwargs)
     controls.challenges = add_challenges(session)
+    controls.neighbour = add_neighbour(session)
     return controls

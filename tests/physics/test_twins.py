@@ -23,6 +23,7 @@ from poinsot.physics.twins import (
     growth_rate,
     lag_limit,
     measured_lag,
+    neighbour_start,
     twin_clock,
 )
 
@@ -101,3 +102,16 @@ def test_lag_measured_from_two_motions() -> None:
 def test_bad_angles_refused(bad: object) -> None:
     with pytest.raises(ValueError, match="angle"):
         twin_clock((1.0, 2.0, 3.0), 1e-3, bad)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("angle", [1e-8, 1e-3, 0.3])
+def test_a_neighbour_starts_at_the_angle_with_the_same_spin(angle: float) -> None:
+    for w in ([0.0, 2.0, 0.0], [0.3, -1.2, 0.7], [1e-9, 0.0, 3.0]):
+        w0 = np.asarray(w)
+        w1 = neighbour_start(w0, angle)
+        assert np.linalg.norm(w1) == pytest.approx(np.linalg.norm(w0), rel=1e-15)
+        # the angle from atan2(|a × b|, a·b): accurate for tiny angles too
+        between = math.atan2(np.linalg.norm(np.cross(w0, w1)), float(w0 @ w1))
+        assert between == pytest.approx(angle, rel=1e-9)
+    with pytest.raises(ValueError, match="rest"):
+        neighbour_start([0.0, 0.0, 0.0], 1e-3)
