@@ -75,7 +75,8 @@ class Neighbour:
         self._sampler: MotionSampler | None = None
         self._source: Samples | None = None
         self._wxyz = np.zeros((0, 4))
-        self.frame = session.client.scene.add_frame(NODE, show_axes=False, visible=False)
+        #: The neighbour's nodes, made when one is first shown and removed when none is.
+        self.frame: viser.FrameHandle | None = None
         self.mesh: viser.MeshHandle | None = None
 
     def _chosen(self, sent: Sent) -> None:
@@ -91,7 +92,7 @@ class Neighbour:
             self._built = key
             self._build(body, angle)
         sampler = self._sampler
-        if sampler is None or frame is None:
+        if sampler is None or frame is None or self.frame is None:
             return
         k = max(0, sampler.index(frame.t))
         source = sampler.batch(k, k)
@@ -104,7 +105,7 @@ class Neighbour:
         solid = None if geometry is None else geometry.solid_base
         self._sampler, self._source, self.body = None, None, None
         if body is None or angle == 0.0 or solid is None or geometry is None:
-            self.frame.visible = False
+            self._remove()
             self.readout.content = "" if angle == 0.0 else "_No body to compare with here._"
             return
         try:
@@ -113,13 +114,14 @@ class Neighbour:
             sampler = MotionSampler(self.body, TWIN_STEP, 1)
             self._source = sampler.batch(0, 0)
         except ValueError as exc:
-            self.frame.visible = False
+            self._remove()
             self.readout.content = f"_No neighbour: {exc}_"
             return
         self._sampler, self._wxyz = sampler, wxyz_from_xyzw(self._source.quat_xyzw)
-        if self.mesh is not None:
-            self.mesh.remove()
-        self.mesh = self.session.client.scene.add_mesh_simple(
+        self._remove()
+        scene = self.session.client.scene
+        self.frame = scene.add_frame(NODE, show_axes=False)
+        self.mesh = scene.add_mesh_simple(
             f"{NODE}/solid",
             np.asarray(solid.vertices),
             np.asarray(solid.faces),
@@ -129,8 +131,14 @@ class Neighbour:
             cast_shadow=False,
             receive_shadow=False,
         )
-        self.frame.visible = True
         self.readout.content = readout(body, self.body, angle)
+
+    def _remove(self) -> None:
+        """Take the neighbour's nodes away (the mesh, then its frame)."""
+        for node in (self.mesh, self.frame):
+            if node is not None:
+                node.remove()
+        self.frame = self.mesh = None
 
 
 def readout(first: FreeRigidBody, second: FreeRigidBody, angle: float) -> str:

@@ -38,10 +38,12 @@ def test_a_neighbour_of_a_stable_preset_is_drawn_at_its_exact_attitude(poinsot_a
     t = session.frame.t
     grid = math.floor(t / TWIN_STEP + 1e-9) * TWIN_STEP
     x, y, z, w = body.attitude(grid).as_quat()
+    assert folder.frame is not None
     shown = np.asarray(folder.frame.wxyz)
     assert 2.0 * math.acos(min(1.0, abs(float(shown @ np.array([w, x, y, z]))))) < 1e-9
     _choose(probe, neighbour.OPTIONS[0])
-    assert wait_until(lambda: folder.body is None and not folder.frame.visible, 10)
+    assert wait_until(lambda: folder.body is None and folder.frame is None, 10)
+    assert probe.wait_for(lambda p: f"{neighbour.NODE}/solid" not in p.nodes, 10)
     assert session.stats.errors == 0, session.stats.last_error
 
 
