@@ -72,3 +72,21 @@ def test_the_twin_is_drawn_at_its_exact_attitude() -> None:
         assert not drawing.twin_frame.visible
         stage.showcase.set_visible("twin-body", True)
         assert not drawing.twin_frame.visible  # nothing to show
+
+
+def test_a_twin_costs_one_pose_message_per_frame() -> None:
+    """What makes the twins' frame cheap (poinsot benchmark measures ≤ 1.6x): a frame with a
+    twin queues exactly one message more than the same frame without (its pose)."""
+    from conftest import record_messages
+
+    counts = {}
+    for ratio in (0.0, 10.0):
+        with SceneStage(SPEC, {"epsilon": 1e-3, "twin-ratio": ratio}) as stage:
+            sent = record_messages(stage.server)
+            dt = SPEC.speed / 60.0
+            for k in range(1, 61):
+                stage.advance(k * dt)
+            counts[ratio] = len(sent)
+            poses = [m for m in sent if getattr(m, "name", "") == dzhanibekov.TWIN_FRAME]
+            assert len(poses) == (60 if ratio else 0)
+    assert counts[10.0] - counts[0.0] == 60
