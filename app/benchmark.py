@@ -19,9 +19,11 @@ prints:
   (:mod:`poinsot.app.live.pacing`);
 - slider-to-redraw time: from a client sending a slider value to that client receiving the new
   ellipsoid (the scale of ``/space/body/ellipsoid``), median and p95, and the server's
-  rebuild time alone.
+  rebuild time alone;
+- the twins' frame cost: the CPU time of one frame of the ``dzhanibekov`` scene in the thread
+  that draws it, with its twin (a second handle at ε′ = ε/10) over without (:func:`twins_cost`).
 
-Targets: <= 1 ms per client-frame, <= 30 ms per redraw.
+Targets: <= 1 ms per client-frame, <= 30 ms per redraw, twins <= 1.6 x a single body.
 
 ``poinsot benchmark --video`` instead films the video row (:func:`video_row`): 10 s of the
 T-handle at 1280x720 and 25 frames per second as MP4 (``poinsot video``'s pipeline: headless
@@ -263,6 +265,35 @@ def viser_floor(seconds: float = 4.0) -> float:
         server.stop()
 
 
+def twins_cost(frames: int = 600, rounds: int = 5) -> tuple[float, float]:
+    """CPU per frame [ms] of the ``dzhanibekov`` scene without and with its twin (medians).
+
+    Each round advances a stage of each through ``frames`` frames at the scene's speed and 60
+    frames per second (rounds alternate, so that a busy machine slows both alike); the time is
+    that of the thread that draws (physics batches, rows picked, messages queued), as the
+    per-client-frame figure above.
+    """
+    from poinsot.app.scenes import scene_by_name
+    from poinsot.app.scenes.stage import SceneStage
+
+    spec = scene_by_name("dzhanibekov")
+    dt = spec.speed / 60.0
+    costs: dict[float, list[float]] = {0.0: [], 10.0: []}
+    stages = {r: SceneStage(spec, {**spec.defaults(), "twin-ratio": r}) for r in costs}
+    try:
+        for _ in range(rounds):
+            for ratio, stage in stages.items():
+                stage.restart(0.0)
+                t0 = time.thread_time()
+                for k in range(1, frames + 1):
+                    stage.advance(k * dt)
+                costs[ratio].append(1e3 * (time.thread_time() - t0) / frames)
+    finally:
+        for stage in stages.values():
+            stage.stop()
+    return statistics.median(costs[0.0]), statistics.median(costs[10.0])
+
+
 def format_result(r: Result) -> str:
     return "\n".join(
         [
@@ -339,6 +370,11 @@ def main(
     print(
         f"viser floor: a bare viser server sending one pose per frame costs "
         f"{viser_floor():.3f} ms CPU per client-frame here (no Poinsot code)"
+    )
+    single, twins = twins_cost()
+    print(
+        f"twins (dzhanibekov, ε′ = ε/10): {twins:.3f} ms CPU per frame against {single:.3f} ms "
+        f"for one body: {twins / single:.2f}x   (target <= 1.6x)"
     )
     return 0
 

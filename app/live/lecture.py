@@ -31,10 +31,12 @@ import viser
 from poinsot.app.exports.glb import scene_glb
 from poinsot.app.exports.run_csv import run_csv, run_span
 from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
+from poinsot.app.live.challenges import ChallengeControls, ChallengeSession, add_challenges
 from poinsot.app.live.clock import SimClock
 from poinsot.app.live.display import LARGE_TEXT_PERCENT, Display
 from poinsot.app.live.links import link_of
 from poinsot.app.live.motion_window import MotionWindow
+from poinsot.app.live.neighbour import Neighbour, add_neighbour
 from poinsot.app.live.strobe_shot import strobe_render
 from poinsot.app.live.video_export import VideoExport, browser_view
 from poinsot.app.live.widgets import Sent, on_user, set_value
@@ -57,8 +59,8 @@ FOLDER_ORDER = 70.0
 CAMERA_HOTKEYS: tuple[Literal["1", "2", "3", "4"], ...] = ("1", "2", "3", "4")
 
 
-class LectureSession(Protocol):
-    """What the lecture controls use of a session."""
+class LectureSession(ChallengeSession, Protocol):
+    """What the lecture controls use of a session (and the challenges they mount)."""
 
     client: viser.ClientHandle
     clock: SimClock
@@ -87,6 +89,8 @@ class LectureControls:
         order: float = FOLDER_ORDER,
     ) -> None:
         self.session = session
+        self.challenges: ChallengeControls | None = None  # mounted by add_lecture_controls
+        self.neighbour: Neighbour | None = None  # likewise
         self.client = session.client
         self.render_timeout = float(render_timeout)
         self.camera = "default"
@@ -265,6 +269,8 @@ class LectureControls:
             if self.camera == RIDE_ALONG:
                 self._apply(ride_along(BODY_VIEW, frame.wxyz))
         self.display.on_frame(frame, time.monotonic())
+        if self.neighbour is not None:
+            self.neighbour.on_frame(frame)
 
     # -- theme ---------------------------------------------------------------------------
     @property
@@ -375,6 +381,11 @@ class LectureControls:
 
 
 def add_lecture_controls(session: LectureSession, **kwargs: float) -> LectureControls:
-    """Mount the lecture folder and hotkeys on ``session``'s panel; keep the returned object
-    and call its ``on_frame(frame)`` after each frame."""
-    return LectureControls(session, **kwargs)
+    """Mount the lecture folder and hotkeys on ``session``'s panel, the challenges
+    (:mod:`~poinsot.app.live.challenges`, as ``.challenges``) and the neighbour
+    (:mod:`~poinsot.app.live.neighbour`, as ``.neighbour``); keep the returned object and
+    call its ``on_frame(frame)`` after each frame."""
+    controls = LectureControls(session, **kwargs)
+    controls.challenges = add_challenges(session)
+    controls.neighbour = add_neighbour(session)
+    return controls

@@ -16,10 +16,11 @@ import numpy as np
 import viser
 import viser.uplot
 
-from poinsot.app.live import readouts
+from poinsot.app.live import plots, readouts
 from poinsot.app.live.legend import Legend
 from poinsot.app.live.overlay import LEGEND, Measured, measured_series, merge
 from poinsot.app.scene import palette
+from poinsot.physics import FreeRigidBody
 
 #: Number of plot samples kept (one per plot refresh, 10 per second: the last 30 s).
 PLOT_SAMPLES = 300
@@ -38,6 +39,8 @@ class MotionWindow:
             self.legend = Legend(gui, order=-2.0)
             self.time = gui.add_markdown(readouts.time_markdown(0.0, False), order=0.0)
             self.readouts = gui.add_markdown("", order=1.0)
+            #: What the ω plot draws: ω, the angles of L to the axes, the Euler angles.
+            self.choice = plots.PlotChoice(gui, order=1.9)
             #: The text size's style element (:mod:`poinsot.app.live.display`; the control
             #: panel has one too: a folded column's content, and its style, is not on the page).
             self.style = gui.add_html("", order=100.0)
@@ -47,6 +50,9 @@ class MotionWindow:
         self.plot: viser.GuiUplotHandle | None = None
         self._t: list[float] = []
         self._omega: list[np.ndarray] = []
+        self._wxyz: list[np.ndarray] = []
+        #: The motion the readouts describe (the plot's angles are read off its moments and L).
+        self.body: FreeRigidBody | None = None
         #: An uploaded toss's samples, drawn when the plot was added with ``measured=True``.
         self.measured = Measured(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))
         self._with_measured = False
@@ -76,6 +82,8 @@ class MotionWindow:
                 order=2.0,
             )
         self.clear_plot()
+        self.choice.reset()
+        self.choice.show(not measured)
         return self.plot
 
     def show_measured(self, measured: Measured) -> None:
@@ -89,15 +97,22 @@ class MotionWindow:
         self.plot = plot
         self._with_measured = False
         self.clear_plot()
+        self.choice.show(True)
 
     def forget_plot(self) -> None:
         """The plot was removed (by the panel): stop recording."""
         self.plot = None
         self._with_measured = False
+        self.choice.show(False)
 
     # -- mirroring the session's state ---------------------------------------------------
     def show_readouts(self, text: str) -> None:
         self.readouts.content = text
+
+    def show_body(self, body: FreeRigidBody) -> None:
+        """The readouts of ``body``, whose moments and L the plot's angles are read with."""
+        self.body = body
+        self.show_readouts(readouts.markdown(body))
 
     def show_time(self, t: float, paused: bool) -> None:
         text = readouts.time_markdown(t, paused)
@@ -105,9 +120,9 @@ class MotionWindow:
             self.time.content = text
 
     def clear_plot(self) -> None:
-        self._t, self._omega = [], []
+        self._t, self._omega, self._wxyz = [], [], []
 
-    def record_plot(self, t: float, omega: np.ndarray) -> None:
+    def record_plot(self, t: float, omega: np.ndarray, wxyz: np.ndarray | None = None) -> None:
         """Add a sample (the session does, at the plot's refresh rate, then sends)."""
         if self.plot is None:
             return
@@ -117,14 +132,18 @@ class MotionWindow:
             return
         self._t.append(float(t))
         self._omega.append(np.array(omega, dtype=np.float64))  # a copy: not a batch's view
+        self._wxyz.append(np.array((1.0, 0.0, 0.0, 0.0) if wxyz is None else wxyz, np.float64))
         if len(self._t) > PLOT_SAMPLES:
-            del self._t[0], self._omega[0]
+            del self._t[0], self._omega[0], self._wxyz[0]
 
     def send_plot(self) -> bool:
         if self.plot is None or len(self._t) < 2:
             return False
         w = np.asarray(self._omega)
-        data: tuple[np.ndarray, ...] = (np.asarray(self._t), *(w[:, i].copy() for i in range(3)))
+        y = w
+        if not self._with_measured:
+            y = plots.values(self.choice.apply(self.plot), self.body, w, np.asarray(self._wxyz))
+        data: tuple[np.ndarray, ...] = (np.asarray(self._t), *(y[:, i].copy() for i in range(3)))
         if self._with_measured:
             data = merge(data[0], w, self.measured)
         if all(np.all(np.isfinite(a)) for a in data[:4]):  # measured NaN: no sample there

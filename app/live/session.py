@@ -19,7 +19,6 @@ from collections.abc import Callable
 import viser
 
 from poinsot.app.elements import ALL_ELEMENTS, Element
-from poinsot.app.live import readouts
 from poinsot.app.live.actions import MAX_ACTIONS, ActionQueue
 from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.clock import SimClock
@@ -284,7 +283,7 @@ class Session:
         self._frames_since_plot += 1
         if now - self._last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
             self._last_plot = now
-            motion.record_plot(self.frame.t, self.frame.omega)
+            motion.record_plot(self.frame.t, self.frame.omega, self.frame.wxyz)
             self._plot_unsent = True
         busy = self.scene.sent_traces or self.lecture.display.laid_out_now  # a layout step
         if self._plot_unsent and self._frames_since_plot >= PLOT_MIN_FRAMES and not busy:
@@ -477,9 +476,9 @@ class Session:
         self.body, self.params, self.frame = body, params, frame
         self.panel.show_parameters(params)
         motion = self.panel.motion
-        motion.show_readouts(readouts.markdown(body))
+        motion.show_body(body)
         motion.clear_plot()
-        motion.record_plot(0.0, frame.omega)
+        motion.record_plot(0.0, frame.omega, frame.wxyz)
         self._set_status("")
 
     def _toggle_pause(self) -> None:

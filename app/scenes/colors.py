@@ -44,12 +44,15 @@ HANDLE_PATH: RGB = (255, 210, 60)
 NORMAL_PATH: RGB = (140, 235, 165)
 #: Solid bodies drawn from their own meshes.
 SOLID: RGB = palette.SOLID
+#: A twin of a body, started a little off it (translucent over the first).
+TWIN: RGB = (80, 220, 255)
 
 #: Plot series (uPlot strokes).
 PLOT_MEASURED = "#ff40a0"
 PLOT_THEORY = "#ffe64a"
 PLOT_LEVEL = "#9aa4ae"
 PLOT_SECOND = "#00e5ff"
+PLOT_TWIN = "#50dcff"
 
 
 def hex_color(rgb: RGB) -> str:

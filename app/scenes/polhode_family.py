@@ -53,6 +53,7 @@ from poinsot.app.scenes.spec import (
     number,
 )
 from poinsot.physics import FreeRigidBody, Regime
+from poinsot.physics.axis_angles import measure_wobble, wobble_theory
 from poinsot.physics.family import (
     MomentumView,
     PolhodeCurve,
@@ -85,6 +86,11 @@ LANDAU_ROOT = f"{ROOT}/landau"
 CHECK_SAMPLES = 64
 #: Tolerance of the readouts: every one is read off the exact motion (rounding only).
 EXACT = 1e-12
+#: The wobble is compared with its small-oscillation theory within this tilt of L from the
+#: stable axis [rad] (20°), to the tilt squared (the theory's error is O(tilt²)).
+NEAR_AXIS = math.radians(20.0)
+WOBBLE = "wobble about the stable axis"
+WOBBLE_FORMULAS = {0: "ω₁√((I₂−I₁)(I₃−I₁)/(I₂I₃))", 2: "ω₃√((I₃−I₁)(I₃−I₂)/(I₁I₂))"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -120,6 +126,7 @@ class FamilyModel(SceneModel):
             Readout("family", _family(body.regime), _kept_sign(w)),
             Readout("k²", number(body.parameter), "—"),
             _period(body.period, self.measured_period),
+            _wobble(body),
             Readout(
                 "|m| on Landau's curve",
                 number(landau.sphere_radius),
@@ -147,6 +154,29 @@ def _period(theory: float, measured: float) -> Readout:
     if math.isfinite(theory):
         return Readout.compare("period of ω (4K/λ)", theory, measured, EXACT, note)
     return Readout("period of ω (4K/λ)", number(theory), number(measured), note)
+
+
+def _wobble(body: FreeRigidBody) -> Readout:
+    """The wobble's frequency read off the angle between L and a transverse axis, against
+    the small-oscillation theory about the axis the polhode circles (none on the separatrix)."""
+    axis = {Regime.MINOR_AXIS: 0, Regime.MAJOR_AXIS: 2}.get(body.regime)
+    if axis is None:
+        return Readout(WOBBLE, "—", "—", "no stable axis circled")
+    G = float(np.linalg.norm(body.angular_momentum))
+    theory = float(wobble_theory(INERTIA, axis, G / INERTIA[axis]))
+    fit = measure_wobble(body, axis)
+    e = "₁₂₃"[axis]
+    formula = WOBBLE_FORMULAS[axis] + " [rad/time]"
+    tilt = f"tilt of L from e{e} ≤ {math.degrees(fit.amplitude):.1f}°"
+    if fit.amplitude > NEAR_AXIS:
+        return Readout(
+            WOBBLE,
+            number(theory),
+            number(fit.frequency),
+            f"{formula} holds near the axis only ({tilt})",
+        )
+    note = f"{formula}; measured: the angle between L and a transverse axis ({tilt})"
+    return Readout.compare(WOBBLE, theory, fit.frequency, max(fit.amplitude**2, EXACT), note)
 
 
 def _family(regime: Regime) -> str:
@@ -272,6 +302,7 @@ SPEC = SceneSpec(
         "family",
         "k²",
         "period of ω (4K/λ)",
+        WOBBLE,
         "|m| on Landau's curve",
         "Σ mᵢ²/Iᵢ on Landau's curve",
     ),
@@ -282,5 +313,5 @@ SPEC = SceneSpec(
     speed=1.0,
     trail_points=1600,
     picture_time=6.0,
-    table_settings=({}, {"D": 2.3}, {"D": I2}),
+    table_settings=({}, {"D": 2.3}, {"D": I2}, {"D": 1.005}, {"D": 2.595}),
 )

@@ -120,13 +120,17 @@ def test_dzhanibekov_flips_and_growth_read_off_the_plot(make_app, make_probe):
     sent_at(session, probe, span + 1.0)  # past the plot's span: the whole plot is shown
     title = spec.plots[0].title
     assert probe.wait_for(lambda p: len(plot_data(p, title)[0]) == dzhanibekov.PLOT_SAMPLES, 10)
-    t, log_p, _ = plot_data(probe, title)
+    t, log_p, _, twin_log_p = plot_data(probe, title)
     step = t[1] - t[0]
-    peaks = [
-        t[k]
-        for k in range(1, len(t) - 1)
-        if log_p[k] > -0.05 and log_p[k] >= log_p[k - 1] and log_p[k] >= log_p[k + 1]
-    ]
+
+    def peaks_of(y: np.ndarray) -> list[float]:
+        return [
+            t[k]
+            for k in range(1, len(t) - 1)
+            if y[k] > -0.05 and y[k] >= y[k - 1] and y[k] >= y[k + 1]
+        ]
+
+    peaks, twin_peaks = peaks_of(log_p), peaks_of(twin_log_p)
     rows = wait_readouts(probe, spec.readouts)
     first = number_in(rows["first flip, (K ± δ)/λ"][0])
     between = number_in(rows["time between flips, 2K(k)/λ"][0])
@@ -136,6 +140,9 @@ def test_dzhanibekov_flips_and_growth_read_off_the_plot(make_app, make_probe):
     slope = np.polyfit(t[stretch], log_p[stretch], 1)[0] * math.log(10.0)
     assert slope == pytest.approx(number_in(rows["growth rate σ"][0]), rel=2e-3)
     assert number_in(rows["growth rate σ"][1]) == pytest.approx(slope, rel=2e-3)
+    # the twin (ε′ = ε/10 by default) flips later by the lag the readouts give
+    lag = number_in(rows["lag of the twin, t₁(ε′) − t₁(ε)"][0])
+    assert twin_peaks[0] - peaks[0] == pytest.approx(lag, abs=2.0 * step)
     asymptote = number_in(rows["… its asymptote ln(16/(1−k²))/λ"][0])
     assert asymptote == pytest.approx(between, rel=1e-12)  # exact at 1e-12
 

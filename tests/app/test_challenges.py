@@ -1,0 +1,117 @@
+"""Predict, then play: the challenge set and one session's folder, driven as a browser does
+(through a probe).
+
+* A set has eight challenges from easy to hard, the same for the same seed; every answer is
+  the theory's, checked here by independent means: flip or stay against DOP853 (does the
+  spin's component change sign), the first flip against DOP853's, the twin's lag against the
+  two exact motions.
+* An answer that is not a number is answered with a message and the challenge stays; a right
+  answer loads the challenge's motion at t = 0, reveals the theory and counts in the score.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import session_of, wait_until
+from scipy.integrate import solve_ivp
+
+from poinsot.app.live import challenges
+from poinsot.app.live.challenge_set import AXES, OUTCOMES, challenge_set, parse_time
+from poinsot.physics import FreeRigidBody
+from poinsot.physics.flip import integrated_flip_times
+from poinsot.physics.twins import measured_lag
+
+
+def _dop853_zeros(J: np.ndarray, w0: np.ndarray, axis: int, t_end: float) -> np.ndarray:
+    """The zeros of ω_axis in a DOP853 integration of Euler's equations (rtol 1e-12)."""
+
+    def euler(_t: float, w: np.ndarray) -> np.ndarray:
+        return np.array(
+            [
+                (J[1] - J[2]) * w[1] * w[2] / J[0],
+                (J[2] - J[0]) * w[2] * w[0] / J[1],
+                (J[0] - J[1]) * w[0] * w[1] / J[2],
+            ]
+        )
+
+    def zero(_t: float, w: np.ndarray) -> float:
+        return float(w[axis])
+
+    sol = solve_ivp(euler, (0.0, t_end), w0, "DOP853", rtol=1e-12, atol=1e-14, events=zero)
+    return np.asarray(sol.t_events[0])
+
+
+@pytest.mark.parametrize("seed", [0, 1, 19])
+def test_a_set_is_seeded_and_its_answers_meet_independent_references(seed: int) -> None:
+    one, again = challenge_set(seed), challenge_set(seed)
+    assert 6 <= len(one) <= 10
+    assert [c.prompt for c in one] == [c.prompt for c in again]
+    assert [c.kind for c in one] == ["axis"] * 4 + ["time"] * 2 + ["lag"] * 2
+    for c in one:
+        J, w0 = np.asarray(c.params.inertia), np.asarray(c.params.omega0 or c.params.build().omega0)
+        if c.kind == "axis":
+            flips, axis = c.answer  # type: ignore[misc]
+            body = c.params.build()
+            caller_axis = int(np.argsort(J)[axis])
+            assert caller_axis == int(np.argmax(np.abs(J * body.omega0)))
+            # DOP853: the spin's component changes sign within a period iff it flips
+            times = _dop853_zeros(J, body.omega0, caller_axis, 1.05 * body.period)
+            assert (len(times) > 0) == flips, c.title
+        elif c.kind == "time":
+            dop = integrated_flip_times(J, w0, 1.5 * c.answer)  # type: ignore[operator]
+            assert c.answer == pytest.approx(dop[0], rel=1e-7)
+        else:
+            first = FreeRigidBody(J, w0)
+            w1 = w0.copy()
+            eps = float(np.arctan2(w0[0], w0[1]))
+            w1[0], w1[1] = 2.0 * np.sin(eps / c.twin_ratio), 2.0 * np.cos(eps / c.twin_ratio)
+            lag = measured_lag(first, FreeRigidBody(J, w1), 3.0 * c.answer + 50.0)  # type: ignore[operator]
+            assert c.answer == pytest.approx(lag, rel=1e-9)
+    assert challenge_set(seed + 1)[3].params != one[3].params or seed == 0
+
+
+def test_a_time_is_read_as_people_type_it() -> None:
+    assert parse_time(" 7,5 ") == 7.5 and parse_time("1e1") == 10.0
+    for bad in ("soon", "", "nan", "-3"):
+        with pytest.raises(ValueError):
+            parse_time(bad)
+
+
+def test_answer_then_play_in_a_session(poinsot_app, probe) -> None:
+    session = session_of(poinsot_app)
+    assert probe.wait_for(lambda p: challenges.NEXT in p.labels(), 15)
+    folder = session.lecture.challenges
+    assert folder is not None
+    first = folder.current
+    assert first.kind == "axis"
+    flips, axis = first.answer  # type: ignore[misc]
+    probe.set_value(probe.widget("Flip or stay?")[0], OUTCOMES[0 if flips else 1])
+    probe.set_value(probe.widget("About which axis?")[0], AXES[axis])
+    assert wait_until(lambda: folder.axis.value == AXES[axis], 10)
+    probe.set_value(probe.widget(challenges.PLAY)[0], True)
+    assert wait_until(lambda: folder.revealed, 10)
+    assert "Right!" in folder.reveal.content and first.explanation in folder.reveal.content
+    assert folder.score == folder.answered == 1
+    assert wait_until(lambda: session.params == first.params, 10)  # its motion plays
+    assert not session.clock.paused
+    # the next three, all answered "it stays, about e₁": the score counts the right ones
+    for n in range(2, 5):
+        probe.set_value(probe.widget(challenges.NEXT)[0], True)
+        assert wait_until(lambda: not folder.revealed, 10)
+        probe.set_value(probe.widget("Flip or stay?")[0], OUTCOMES[1])
+        probe.set_value(probe.widget("About which axis?")[0], AXES[0])
+        assert wait_until(lambda: folder.axis.value == AXES[0], 10)
+        probe.set_value(probe.widget(challenges.PLAY)[0], True)
+        assert wait_until(lambda n=n: folder.answered == n, 10)
+    right = 1 + sum(c.answer == (False, 0) for c in folder.challenges[1:4])
+    assert folder.score == right
+    assert f"Score: **{right} / 4**" in folder.scoreboard.content
+    probe.set_value(probe.widget(challenges.NEXT)[0], True)
+    assert wait_until(lambda: not folder.revealed, 10)
+    assert folder.current.kind == "time"
+    probe.set_value(probe.widget(challenges.ANSWER)[0], "soon")
+    probe.set_value(probe.widget(challenges.PLAY)[0], True)
+    assert wait_until(lambda: "not a number" in folder.message.content, 10)
+    assert not folder.revealed and folder.answered == 4
+    assert session.stats.errors == 0, session.stats.last_error
