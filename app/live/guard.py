@@ -125,8 +125,14 @@ class WireGuard:
         #: Messages dropped: beyond a budget, or not one a browser sends.
         self.dropped = 0
         self.malformed = 0
+        self._agents: dict[int, str] = {}  # each connected browser's User-Agent header
         self._infra.on_client_connect(self._accept)
         self._infra.on_client_disconnect(self._forget)
+
+    def user_agent(self, client_id: int) -> str:
+        """The ``User-Agent`` a connected browser gave in its handshake ("" if none)."""
+        with self._lock:
+            return self._agents.get(client_id, "")
 
     def budget(self, client_id: int) -> MessageBudget | None:
         """The budget of a connected client (tests)."""
@@ -148,11 +154,13 @@ class WireGuard:
         budget = MessageBudget(*self._limits)
         with self._lock:
             self._budgets[connection.client_id] = budget
+            self._agents[connection.client_id] = str(headers.get("User-Agent") or "")
         websocket.recv = self._budgeted(connection.client_id, websocket, budget)
 
     def _forget(self, connection: Any) -> None:
         with self._lock:
             self._budgets.pop(connection.client_id, None)
+            self._agents.pop(connection.client_id, None)
 
     def _acceptable(self, client_id: int, raw: Any) -> bool:
         """A message a browser could send, whose value (for a GUI update) fits its widget."""

@@ -1,8 +1,9 @@
 """Point at a start: a click, a tap or a drag on the energy ellipsoid chooses where ω starts.
 
-The browser reports a click anywhere in the scene with its ray (viser's scene ``on_click``),
-and a drag on the ellipsoid (the mesh's ``on_drag``) with the pointer on a plane facing the
-camera, so the ray runs from the camera through that point. The physics
+The browser reports a click or a tap on the ellipsoid with its ray (the mesh's ``on_click``;
+viser's scene-wide ``on_click`` hears no tap: its camera holds a touch pointer), and a drag on
+it (the mesh's ``on_drag``) with the pointer on a plane facing the camera, so the ray runs from
+the camera through that point. The physics
 (:mod:`poinsot.physics.pointing`) meets the ray with the ellipsoid of the body as it is turned
 in the frame on screen, and gives the ω of the energy kept there; D follows from it. Within
 :data:`SNAP_PX` pixels of the separatrix the start is snapped onto it, and the body built from
@@ -67,14 +68,17 @@ class PointerSession(Protocol):
 class Pointer:
     """The pointer of one session (see the module's docstring)."""
 
-    def __init__(self, session: PointerSession) -> None:
+    def __init__(self, session: PointerSession, drag: bool = True) -> None:
+        """``drag``: a drag on the ellipsoid draws the start's polhode (else a drag on it turns
+        the camera, as on a touch screen, where viser's drag binding on a node costs the
+        browser a console error and one finger turns the camera everywhere)."""
         self.session = session
+        self.dragging = drag
         self.preview: viser.LineSegmentsHandle | None = None
         self.last: Start | None = None  # the start drawn last while dragging
         self._paused_before: bool | None = None  # the clock's state when a drag began
         #: Starts set, and polhodes drawn while dragging (tests, benchmark).
         self.starts = self.previews = 0
-        session.client.scene.on_click()(self._on_click)
         session.scene.on_create = self._bind
         drawing = session.scene.drawing(Element.ELLIPSOID)
         if drawing is not None:
@@ -83,9 +87,11 @@ class Pointer:
     # -- viser's event loop: post only ------------------------------------------------------
     def _bind(self, element: Element, drawing: Drawing) -> None:
         if element is Element.ELLIPSOID and isinstance(drawing, Ellipsoid):
-            drawing.mesh.on_drag(self._on_drag)
+            if self.dragging:
+                drawing.mesh.on_drag(self._on_drag)
+            drawing.mesh.on_click(self._on_click)
 
-    async def _on_click(self, event: viser.SceneClickEvent) -> None:
+    async def _on_click(self, event: viser.SceneNodePointerEvent) -> None:
         ray: Ray = (event.ray_origin, event.ray_direction)
         self.session.post(lambda: self.release(ray))
 
@@ -168,6 +174,13 @@ class Pointer:
         segments = np.stack([points[:-1], points[1:]], axis=1)
         if not np.all(np.isfinite(segments)):
             return
+        with s.client.atomic():
+            self._send_polhode(segments)
+        s.client.flush()  # out now, not at viser's next 1/60 s window
+        self.previews += 1
+
+    def _send_polhode(self, segments: np.ndarray) -> None:
+        s = self.session
         if self.preview is None:
             self.preview = s.client.scene.add_line_segments(
                 f"{s.scene.root}/body/pointed_polhode",
@@ -179,7 +192,6 @@ class Pointer:
         else:
             self.preview.points = segments
             self.preview.visible = True
-        self.previews += 1
 
 
 def pixel_angle(fov: float, height_px: float) -> float:

@@ -118,7 +118,12 @@ class PoinsotApp:
                 self.discarded += 1
                 return
         session = Session(
-            client, self.preset, max_fps=self.max_fps, budget=self.budget, scene=self.scene
+            client,
+            self.preset,
+            max_fps=self.max_fps,
+            budget=self.budget,
+            scene=self.scene,
+            user_agent=self.guard.user_agent(client.client_id),
         )
         with self._connected:
             if client.client_id in self._departed:

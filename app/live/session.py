@@ -24,6 +24,7 @@ from poinsot.app.live.actions import MAX_ACTIONS, ActionQueue
 from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.clock import SimClock
 from poinsot.app.live.ghost_controls import add_ghost_controls
+from poinsot.app.live.layout import Layout
 from poinsot.app.live.lecture import add_lecture_controls
 from poinsot.app.live.pacing import Outbox, Pacer, SessionStats
 from poinsot.app.live.panel import ControlPanel
@@ -69,11 +70,13 @@ class Session:
         budget: RebuildGate | None = None,
         scene: SceneSpec | None = None,
         max_actions: int = MAX_ACTIONS,
+        user_agent: str = "",
     ) -> None:
         """``budget``: the server's rebuild gate, through which a rebuild goes first (one per
         session if None); ``scene``: start with this scene (:mod:`poinsot.app.scenes`) instead
         of ``preset``. Frames: as many as the client takes, up to ``max_fps`` (:attr:`pacer`).
-        At most ``max_actions`` actions queued (:mod:`.actions`)."""
+        At most ``max_actions`` actions queued (:mod:`.actions`). ``user_agent``: the browser's
+        (a phone's or a tablet's page is laid out for it: :mod:`.layout`)."""
         self.client = client
         self.max_fps = float(max_fps)
         self.budget = budget if budget is not None else RebuildGate()
@@ -100,25 +103,19 @@ class Session:
 
         apply_theme(client)
         view.apply(client.camera)
-        self.scene = PoinsotScene(
-            client.scene,
-            preset.elements if scene is None else frozenset(),
-            preset.trail_points,
-            atomic=client.atomic,
-        )
+        elements = preset.elements if scene is None else frozenset()
+        self.scene = PoinsotScene(client.scene, elements, preset.trail_points, atomic=client.atomic)
         #: Widgets removed from the panel, deleted a moment later (frame thread).
         self.retirement = Retirement()
         self.panel = ControlPanel(
             client.gui, self, preset if scene is None else scene.identity(), self.retirement
         )
-        if scene is None:
-            self._apply_preset(preset)
-        else:
-            self._apply_scene(scene)
+        self._apply_preset(preset) if scene is None else self._apply_scene(scene)
         self._rebuild()
         self.lecture = add_lecture_controls(self)  # exports, views, theme, hotkeys
         self.ghost = add_ghost_controls(self)  # its controls; the ghost when switched on
-        self.pointer = Pointer(self)  # a start pointed at on the ellipsoid
+        self.layout = Layout(self, self.panel.motion, user_agent)  # a phone's, a tablet's page
+        self.pointer = Pointer(self, drag=not self.layout.touch)  # a start pointed at
         self._fit_ghost()
 
     # -- lifecycle -----------------------------------------------------------------------
