@@ -124,3 +124,20 @@ def test_the_page_on_a_phone_and_a_tablet(poinsot_app, open_page, device) -> Non
         page.page.get_by_text("What you see", exact=True).first.tap()
     assert wait_until(lambda: shown in page.page.evaluate("() => document.body.innerText"), 10)
     assert page.errors == []
+
+
+def test_the_camera_frames_the_construction_again_when_the_phone_turns(
+    poinsot_app, open_page
+) -> None:
+    page = open_device(open_page, poinsot_app.url, "phone-portrait")
+    session = session_of(poinsot_app)
+    assert wait_until(lambda: session.layout.framings >= 1, 20)
+    upright = np.asarray(session.client.camera.position, float)
+    page.page.set_viewport_size({"width": 844, "height": 390})
+    assert wait_until(lambda: session.layout.framings >= 2, 20)
+    # Wide, the construction needs less distance than upright (its width limits it there).
+    assert wait_until(
+        lambda: np.linalg.norm(session.client.camera.position) < 0.8 * np.linalg.norm(upright),
+        20,
+    )
+    assert page.errors == []
