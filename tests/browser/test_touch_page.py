@@ -97,7 +97,7 @@ def test_the_page_on_a_phone_and_a_tablet(poinsot_app, open_page, device) -> Non
     if DEVICES[device][0] < 576:
         # viser's bottom sheet is open at first, held low, the legend at its top; one tap on
         # its bar closes it, the next opens it again.
-        assert page.page.evaluate(_LEGEND_SHOWN_JS, LEGEND_ENTRY)
+        assert wait_until(lambda: page.page.evaluate(_LEGEND_SHOWN_JS, LEGEND_ENTRY), 10)
         sheet_toggle(page, device, opening=False).tap()
         assert wait_until(lambda: not page.page.evaluate(_LEGEND_SHOWN_JS, LEGEND_ENTRY), 10)
     else:
