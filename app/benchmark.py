@@ -23,7 +23,9 @@ prints:
 - the twins' frame cost: the CPU time of one frame of the ``dzhanibekov`` scene in the thread
   that draws it, with its twin (a second handle at ε′ = ε/10) over without (:func:`twins_cost`).
 
-Targets: <= 1 ms per client-frame, <= 30 ms per redraw, twins <= 1.6 x a single body.
+Targets: <= 1 ms per client-frame, <= 30 ms per redraw, twins <= 1.6 x a single body. Then the
+drag rows (:mod:`poinsot.app.drag_benchmark`): a drag update on the ellipsoid to its polhode
+drawn, p95 <= 50 ms with one client, <= 100 ms with ten on two workers.
 
 ``poinsot benchmark --video`` instead films the video row (:func:`video_row`): 10 s of the
 T-handle at 1280x720 and 25 frames per second as MP4 (``poinsot video``'s pipeline: headless
@@ -356,8 +358,10 @@ def video_row() -> str:
 def main(
     clients: Sequence[int] = (1, 20), seconds: float = 5.0, redraws: int = 30, video: bool = False
 ) -> int:
-    """Run the benchmark for each number of ``clients`` and print the results (with
-    ``video``: the video row alone)."""
+    """Run the benchmark for each number of ``clients`` and print the results, then the drag
+    rows and the twins' row (with ``video``: the video row alone)."""
+    from poinsot.app.drag_benchmark import main as drag_main
+
     print(
         f"Poinsot app benchmark (python {sys.version.split()[0]}, {os.cpu_count()} CPUs, "
         f"load average {os.getloadavg()[0]:.1f})"
@@ -367,6 +371,7 @@ def main(
         return 0
     for n in clients:
         print(format_result(run(n, seconds, redraws)), flush=True)
+    drag_main()  # the drag rows (:mod:`poinsot.app.drag_benchmark`)
     print(
         f"viser floor: a bare viser server sending one pose per frame costs "
         f"{viser_floor():.3f} ms CPU per client-frame here (no Poinsot code)"

@@ -18,6 +18,7 @@ from poinsot.physics import (
     box_dimensions,
     check_real_body,
 )
+from poinsot.physics.pointing import body_from_start, energy_parameter
 
 #: Slider ranges.
 INERTIA_RANGE = (0.1, 5.0)
@@ -52,6 +53,7 @@ class Parameters:
     omega_norm: float = 1.0
     omega0: Vector | None = None
     D_asked: float | None = None
+    separatrix: bool = False
 
     @classmethod
     def from_preset(cls, preset: Preset) -> Parameters:
@@ -81,7 +83,12 @@ class Parameters:
         asked = self.D if self.D_asked is None else self.D_asked
         D = min(max(asked, min(inertia)), max(inertia))
         return dataclasses.replace(
-            self, inertia=inertia, D=D, omega0=None, D_asked=None if D == asked else asked
+            self,
+            inertia=inertia,
+            D=D,
+            omega0=None,
+            separatrix=False,
+            D_asked=None if D == asked else asked,
         )
 
     def with_D(self, D: float, snap: float = 0.0) -> Parameters:
@@ -93,7 +100,7 @@ class Parameters:
         D = min(max(float(D), lo), hi)
         if self.has_separatrix and abs(D - self.intermediate) <= snap:
             D = self.intermediate
-        return dataclasses.replace(self, D=D, omega0=None, D_asked=None)
+        return dataclasses.replace(self, D=D, omega0=None, separatrix=False, D_asked=None)
 
     @property
     def has_separatrix(self) -> bool:
@@ -102,13 +109,15 @@ class Parameters:
         return lo < self.intermediate < hi
 
     def with_pole(self, sign: int) -> Parameters:
-        return dataclasses.replace(self, pole_sign=1 if sign >= 0 else -1, omega0=None)
+        return dataclasses.replace(
+            self, pole_sign=1 if sign >= 0 else -1, omega0=None, separatrix=False
+        )
 
     def with_omega_norm(self, value: float) -> Parameters:
         """|ω₀|; a value that is not a positive number changes nothing."""
         if not (math.isfinite(value) and value > 0):
             return self
-        return dataclasses.replace(self, omega_norm=float(value), omega0=None)
+        return dataclasses.replace(self, omega_norm=float(value), omega0=None, separatrix=False)
 
     def mirrored(self, side: str) -> Parameters:
         """Move D to the ``side`` ("minor" or "major") of the separatrix D = I2, keeping its
@@ -123,7 +132,25 @@ class Parameters:
             D = mid - frac * (mid - lo)
         else:
             return self
-        return dataclasses.replace(self, D=D, omega0=None, D_asked=None)
+        return dataclasses.replace(self, D=D, omega0=None, separatrix=False, D_asked=None)
+
+    def with_start(self, omega0: Vector, separatrix: bool = False) -> Parameters:
+        """Start at ``omega0`` (a point of the energy ellipsoid pointed at): D follows from it
+        (I₂ exactly when it was snapped onto the ``separatrix``), |ω₀| is its length."""
+        w = _vector(omega0)
+        D = self.intermediate if separatrix else float(energy_parameter(self.inertia, w))
+        norm = math.sqrt(sum(x * x for x in w))
+        if not (math.isfinite(D) and norm > 0.0):
+            return self
+        lo, hi = self.D_range
+        return dataclasses.replace(
+            self,
+            D=min(max(D, lo), hi),
+            omega_norm=norm,
+            omega0=w,
+            D_asked=None,
+            separatrix=separatrix and self.has_separatrix,
+        )
 
     def side(self) -> str:
         return "major" if self.D >= self.intermediate else "minor"
@@ -160,6 +187,8 @@ def _body(p: Parameters) -> FreeRigidBody:
     """The one place the app asks physics for a body, L along +z: from D, |ω₀| and the pole
     (:meth:`FreeRigidBody.from_energy`, which checks its input once), or from a preset's exact
     ω₀."""
+    if p.separatrix and p.omega0 is not None:  # a start snapped onto the separatrix
+        return body_from_start(p.inertia, p.omega0, separatrix=True)
     if p.omega0 is None:
         return FreeRigidBody.from_energy(
             p.inertia, p.D, omega_norm=p.omega_norm, pole_sign=p.pole_sign

@@ -274,8 +274,9 @@ def _dismiss_software_webgl_notice(page, timeout: float = 30.0) -> None:
 def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
     contexts = []
 
-    def open_(url: str, width: int = 1280, height: int = 720) -> BrowserPage:
-        context = chromium.new_context(viewport={"width": width, "height": height})
+    def open_(url: str, width: int = 1280, height: int = 720, **options) -> BrowserPage:
+        """``options``: more of playwright's context options (touch, a User-Agent...)."""
+        context = chromium.new_context(viewport={"width": width, "height": height}, **options)
         contexts.append(context)
         page = context.new_page()
         errors: list[str] = []

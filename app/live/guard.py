@@ -271,6 +271,7 @@ class WireGuard:
         #: Messages dropped: beyond a budget; GUI values that do not fit their widget.
         self.dropped = 0
         self.malformed = 0
+        self._agents: dict[int, str] = {}  # each connected browser's User-Agent header
         infra = viser_private.infra(server)
         infra.on_client_connect(self._accept)
         infra.on_client_disconnect(self._forget)
@@ -279,6 +280,11 @@ class WireGuard:
     def refused(self) -> int:
         """Websocket handshakes refused (:class:`HandshakeGate`)."""
         return self.gate.refused
+
+    def user_agent(self, client_id: int) -> str:
+        """The ``User-Agent`` a connected browser gave in its handshake ("" if none)."""
+        with self._lock:
+            return self._agents.get(client_id, "")
 
     def budget(self, client_id: int) -> MessageBudget | None:
         """The budget of a connected client (tests)."""
@@ -292,6 +298,10 @@ class WireGuard:
         budget = MessageBudget(*self._limits)
         with self._lock:
             self._budgets[connection.client_id] = budget
+            request = websocket.request
+            self._agents[connection.client_id] = (
+                str(request.headers.get("User-Agent") or "") if request is not None else ""
+            )
         viser_private.wrap_recv(
             websocket, lambda receive: self._budgeted(connection.client_id, websocket, budget)
         )
@@ -299,6 +309,7 @@ class WireGuard:
     def _forget(self, connection: Any) -> None:
         with self._lock:
             self._budgets.pop(connection.client_id, None)
+            self._agents.pop(connection.client_id, None)
 
     def _verdict(self, client_id: int, raw: Any) -> str | None:
         """None to pass the message on, "drop" to drop it, else why the client is closed."""

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import html
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from typing import Literal
 
 import viser
@@ -149,6 +149,8 @@ class Legend:
         self._elements: frozenset[Element] = frozenset()
         self._extra: tuple[Entry, ...] = ()
         self._look = palette.DARK
+        #: Other places that show the legend too, each with its wrapping (a phone's sheet).
+        self._mirrors: list[tuple[viser.GuiHtmlHandle, Callable[[str], str]]] = []
 
     def show_caption(self, text: str) -> None:
         """Say what the picture shows (a preset's caption, or a scene's at any time)."""
@@ -166,6 +168,11 @@ class Legend:
         self._look = look
         self._render()
 
+    def mirror(self, place: viser.GuiHtmlHandle, wrap: Callable[[str], str]) -> None:
+        """Show the legend in ``place`` too, as ``wrap(the legend's HTML)``, kept up to date."""
+        self._mirrors.append((place, wrap))
+        self._render()
+
     def items(self) -> list[Entry]:
         return [*entries(self._elements, self._look), *self._extra]
 
@@ -174,3 +181,6 @@ class Legend:
         content = legend_html(items) if items else ""
         if self.legend.content != content:
             self.legend.content = content
+        for place, wrap in self._mirrors:
+            if place.content != (text := wrap(content)):
+                place.content = text

@@ -33,6 +33,7 @@ class Node:
     wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
     position: tuple[float, float, float] = (0.0, 0.0, 0.0)
     visible: bool = True
+    owner: str = ""  # the scope viser stamped on it (a client's id for a client's node)
 
 
 @dataclasses.dataclass
@@ -187,6 +188,25 @@ class Probe:
         or clicks a button (``value=True``)."""
         self.send(_messages.GuiUpdateMessage(uuid, {"value": value}))
 
+    def drag(self, name: str, phase: str, end: tuple[float, float, float]) -> None:
+        """What the browser sends while the left button drags the node ``name`` (a drag on a
+        node with a drag binding), the pointer at the world point ``end``."""
+        node = self.nodes.get(name)
+        self.send(
+            _messages.SceneNodeDragMessage(
+                phase=phase,  # type: ignore[arg-type]
+                name=name,
+                instance_index=None,
+                start_position=end,
+                start_screen_pos=(0.5, 0.5),
+                end_position=end,
+                end_screen_pos=(0.5, 0.5),
+                button="left",
+                modifier=None,
+                owner="" if node is None else node.owner,
+            )
+        )
+
     # -- receiving -----------------------------------------------------------------------
     def wait_frames(self, count: int, timeout: float = 60.0) -> bool:
         """Wait until ``count`` more frames (poses of the body) have arrived."""
@@ -271,7 +291,7 @@ class Probe:
         elif kind == "SceneNodeUpdateMessage" and node is not None:
             node.props.update(m["updates"])
         elif isinstance(m.get("props"), dict):
-            self.nodes[name] = Node(kind, dict(m["props"]))
+            self.nodes[name] = Node(kind, dict(m["props"]), owner=str(m.get("owner") or ""))
 
     def _apply_widget(self, kind: str, m: dict[str, Any]) -> None:
         if kind == "GuiRemoveMessage":

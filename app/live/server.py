@@ -144,7 +144,12 @@ class PoinsotApp:
                 return
         link = links.opening(address, self.preset, self.scene, (self.port, self.landing_port))
         session = Session(
-            client, link.preset, max_fps=self.max_fps, budget=self.budget, scene=link.scene
+            client,
+            link.preset,
+            max_fps=self.max_fps,
+            budget=self.budget,
+            scene=link.scene,
+            user_agent=self.guard.user_agent(client.client_id),
         )
         links.apply(session, link)
         with self._connected:

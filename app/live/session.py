@@ -2,10 +2,10 @@
 
 Threads: viser runs GUI callbacks on its thread pool; they only post small actions to this
 session's queue and wake its frame thread, which alone touches the scene and the body. So a
-callback never blocks and never raises into viser, a slider drag is coalesced into one rebuild
-per wake-up, and a slow or departed browser never stalls another (each session has its own
-thread; viser gives each client its own send buffer, and :mod:`poinsot.app.live.pacing` sends
-a client a new frame only once it has taken the ones before, so that buffer never grows).
+callback never blocks or raises into viser, a slider drag is coalesced into one rebuild per
+wake-up, and a slow or departed browser never stalls another (each session has its own thread;
+viser gives each client its own send buffer, and :mod:`.pacing` sends a client a new frame only
+once it has taken the ones before, so that buffer never grows).
 """
 
 from __future__ import annotations
@@ -18,14 +18,16 @@ from collections.abc import Callable
 
 import viser
 
-from poinsot.app.elements import ALL_ELEMENTS, Element
+from poinsot.app.elements import ALL_ELEMENTS, Control, Element, Plot
 from poinsot.app.live.actions import MAX_ACTIONS, ActionQueue
 from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.clock import SimClock
 from poinsot.app.live.ghost_controls import add_ghost_controls
+from poinsot.app.live.layout import Layout
 from poinsot.app.live.lecture import add_lecture_controls
 from poinsot.app.live.pacing import Outbox, Pacer, SessionStats
 from poinsot.app.live.panel import ControlPanel
+from poinsot.app.live.pointer import Pointer
 from poinsot.app.live.showcase import LiveShowcase
 from poinsot.app.live.uploads import UploadControls
 from poinsot.app.live.widgets import Retirement
@@ -67,11 +69,13 @@ class Session:
         budget: RebuildGate | None = None,
         scene: SceneSpec | None = None,
         max_actions: int = MAX_ACTIONS,
+        user_agent: str = "",
     ) -> None:
         """``budget``: the server's rebuild gate, through which a rebuild goes first (one per
         session if None); ``scene``: start with this scene (:mod:`poinsot.app.scenes`) instead
         of ``preset``. Frames: as many as the client takes, up to ``max_fps`` (:attr:`pacer`).
-        At most ``max_actions`` actions queued (:mod:`.actions`)."""
+        At most ``max_actions`` actions queued (:mod:`.actions`). ``user_agent``: the browser's
+        (a phone's or a tablet's page is laid out for it: :mod:`.layout`)."""
         self.client = client
         self.max_fps = float(max_fps)
         self.budget = budget if budget is not None else RebuildGate()
@@ -98,24 +102,19 @@ class Session:
 
         apply_theme(client)
         view.apply(client.camera)
-        self.scene = PoinsotScene(
-            client.scene,
-            preset.elements if scene is None else frozenset(),
-            preset.trail_points,
-            atomic=client.atomic,
-        )
+        elements = preset.elements if scene is None else frozenset()
+        self.scene = PoinsotScene(client.scene, elements, preset.trail_points, atomic=client.atomic)
         #: Widgets removed from the panel, deleted a moment later (frame thread).
         self.retirement = Retirement()
         self.panel = ControlPanel(
             client.gui, self, preset if scene is None else scene.identity(), self.retirement
         )
-        if scene is None:
-            self._apply_preset(preset)
-        else:
-            self._apply_scene(scene)
+        self._apply_preset(preset) if scene is None else self._apply_scene(scene)
         self._rebuild()
         self.lecture = add_lecture_controls(self)  # exports, views, theme, hotkeys
         self.ghost = add_ghost_controls(self)  # its controls; the ghost when switched on
+        self.layout = Layout(self, self.panel.motion, user_agent)  # a phone's, a tablet's page
+        self.pointer = Pointer(self, drag=not self.layout.touch)  # a start pointed at
         self._fit_ghost()
 
     # -- lifecycle -----------------------------------------------------------------------
@@ -352,15 +351,7 @@ class Session:
             self.scene.trail_points = preset.trail_points
             self._dirty = True
         self.scene.declare(preset.elements)
-        self.panel.declare(
-            preset.controls,
-            preset.plots,
-            preset.elements,
-            self._desired,
-            self.clock.speed,
-            self.scene.trail_points,
-            self.scene.is_visible,
-        )
+        self._declare(preset.controls, preset.plots, preset.elements, self._desired)
         self.panel.show_preset(preset, menu_count)
         self._show_playback()
 
@@ -375,19 +366,22 @@ class Session:
         self.showcase = LiveShowcase(
             scene, self.client, self.scene, self.panel.motion, self, self.retirement
         )
-        self.panel.declare(
-            scene.shared,
-            frozenset(),
-            scene.elements,
-            self._desired,
-            self.clock.speed,
-            self.scene.trail_points,
-            self.scene.is_visible,
-        )
+        self._declare(scene.shared, frozenset(), scene.elements, self._desired)
         self.panel.show_preset(self.preset, menu_count)
         self._show_playback()
         scene.view.apply(self.client.camera)
         self._dirty = True
+
+    def _declare(
+        self,
+        controls: frozenset[Control],
+        plots: frozenset[Plot],
+        elements: frozenset[Element],
+        params: Parameters,
+    ) -> None:
+        """Show exactly these groups in the panel, with the session's playback settings."""
+        speed, trail = self.clock.speed, self.scene.trail_points
+        self.panel.declare(controls, plots, elements, params, speed, trail, self.scene.is_visible)
 
     def _leave_scene(self) -> None:
         """Remove the current scene (if any); the next preset rebuilds its body."""
@@ -421,15 +415,7 @@ class Session:
             # additions happen here, so the slider being dragged stays in place.
             self.preset = CUSTOM
             self.scene.declare(ALL_ELEMENTS)
-            self.panel.declare(
-                CUSTOM.controls,
-                CUSTOM.plots,
-                CUSTOM.elements,
-                new,
-                self.clock.speed,
-                self.scene.trail_points,
-                self.scene.is_visible,
-            )
+            self._declare(CUSTOM.controls, CUSTOM.plots, CUSTOM.elements, new)
             self.panel.show_preset(CUSTOM, menu_count)
 
     def _rebuild(self) -> None:

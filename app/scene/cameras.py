@@ -64,3 +64,46 @@ def ride_along(body_view: View, attitude_wxyz: np.ndarray) -> View:
         up=triple(up),
         fov_degrees=body_view.fov_degrees,
     )
+
+
+def framed(view: View, aspect: float, points: np.ndarray, margin: float = 0.06) -> View:
+    """``view``'s direction, moved along it so that all ``points`` (N, 3) are in frame for a
+    picture ``aspect`` (width / height) wide, with ``margin`` of the half-width free at the
+    tightest edge; it looks at the middle of the points' bounding box.
+
+    Each point asks for a distance: at distance ``d`` from the centre ``c`` along the view's
+    forward ``f``, a point ``c + q`` is ``d + q·f`` deep and must lie within ``tan(fov/2)``
+    (vertically; times ``aspect`` across) of that depth.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    forward = np.subtract(view.look_at, view.position)
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, view.up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    q = pts - centre
+    depth = q @ forward
+    ty = np.tan(np.radians(view.fov_degrees) / 2.0) * (1.0 - margin)
+    tx = ty * max(float(aspect), 1e-3)
+    need = np.maximum(np.abs(q @ right) / tx, np.abs(q @ up) / ty) - depth
+    distance = float(np.max(need))
+    return View(
+        position=triple(centre - distance * forward),
+        look_at=triple(centre),
+        up=view.up,
+        fov_degrees=view.fov_degrees,
+    )
+
+
+def construction_points(
+    plane_height: float, plane_radius: float, arrow_top: float, n: int = 48
+) -> np.ndarray:
+    """Points that bound Poinsot's construction in space (display units): the sphere that holds
+    the turning ellipsoid (radius 1), the plane's disc at ``plane_height`` and L's tip."""
+    a = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    ring = np.stack([np.cos(a), np.sin(a), np.zeros(n)], axis=1)
+    u = np.linspace(-1.0, 1.0, 9)
+    sphere = np.concatenate([ring * np.sqrt(1.0 - z * z) + [0.0, 0.0, z] for z in u])
+    disc = ring * plane_radius + [0.0, 0.0, plane_height]
+    return np.concatenate([sphere, disc, [[0.0, 0.0, arrow_top]]])

@@ -108,6 +108,8 @@ class PoinsotScene:
         self._sent_traces = False  # by the last advance()
         self._label_epoch = 0  # a layout begun before a change of it sends nothing
         self._look: Look = palette.DARK
+        #: Called with each drawing made (a pointer binds its callbacks to the ellipsoid's).
+        self.on_create: Callable[[Element, Drawing], None] | None = None
         self.space = api.add_frame(root, show_axes=False)
         self.body_frame = api.add_frame(f"{root}/body", show_axes=False)
         self.tip = api.add_frame(f"{root}/tip", show_axes=False)
@@ -167,7 +169,13 @@ class PoinsotScene:
         if element in self._hidden:
             drawing.set_visible(False)
         self._drawings[element] = drawing
+        if self.on_create is not None:
+            self.on_create(element, drawing)
         return drawing
+
+    def drawing(self, element: Element) -> Drawing | None:
+        """The drawing of ``element``, if it is drawn."""
+        return self._drawings.get(element)
 
     # -- look and labels -------------------------------------------------------------------
     @property

@@ -1,0 +1,143 @@
+"""The page on a phone and a tablet, in Chromium with touch emulation: the scene fills the
+screen, the legend opens in one tap, a tap on the ellipsoid sets a new start that the readouts
+show, and no console error (app/live/layout.py, app/live/pointer.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import BrowserPage, session_of, wait_until
+
+from poinsot.app.live.session import Session
+
+IPHONE = (
+    "Mozilla/5.0 (iPhone; CPU iPhone OS 17_0 like Mac OS X) AppleWebKit/605.1.15 "
+    "(KHTML, like Gecko) Version/17.0 Mobile/15E148 Safari/604.1"
+)
+ANDROID_TABLET = (
+    "Mozilla/5.0 (Linux; Android 13; SM-X700) AppleWebKit/537.36 (KHTML, like Gecko) "
+    "Chrome/120.0.0.0 Safari/537.36"
+)
+DEVICES = {
+    "phone-portrait": (390, 844, IPHONE),
+    "phone-landscape": (844, 390, IPHONE),
+    "tablet-portrait": (820, 1180, ANDROID_TABLET),
+}
+#: The scene must be the topmost element on at least this share of the screen.
+SCENE_SHARE = 0.60
+LEGEND_ENTRY = "herpolhode (plane)"
+
+_SCENE_SHARE_JS = """() => {
+  let hits = 0, n = 0;
+  for (let i = 0; i < 24; i++) for (let j = 0; j < 24; j++) {
+    const e = document.elementFromPoint((i + 0.5) * innerWidth / 24, (j + 0.5) * innerHeight / 24);
+    n++;
+    if (e && e.tagName === 'CANVAS') hits++;
+  }
+  return hits / n;
+}"""
+
+_LEGEND_SHOWN_JS = """(name) => {
+  const e = document.querySelector(`[data-legend="${name}"]`);
+  if (!e) return false;
+  const r = e.getBoundingClientRect();
+  if (r.width === 0 || r.height === 0 || r.bottom < 0 || r.top > innerHeight) return false;
+  const top = document.elementFromPoint(r.left + r.width / 2, r.top + r.height / 2);
+  return top !== null && (e.contains(top) || top.contains(e));
+}"""
+
+
+def open_device(open_page, url: str, device: str) -> BrowserPage:
+    width, height, agent = DEVICES[device]
+    return open_page(
+        url, width, height, has_touch=True, is_mobile=True, user_agent=agent, device_scale_factor=1
+    )
+
+
+def screen_point(session: Session, page: BrowserPage, point: np.ndarray) -> tuple[float, float]:
+    """Where the browser's camera draws the world ``point``, in the page's CSS pixels."""
+    camera = session.client.camera
+    position = np.asarray(camera.position, float)
+    forward = np.asarray(camera.look_at, float) - position
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, np.asarray(camera.up_direction, float))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    q = point - position
+    depth = q @ forward
+    half = math.tan(camera.fov / 2.0)
+    box = page.canvas_box()
+    scale = box["height"] / 2.0 / half
+    x = box["x"] + box["width"] / 2.0 + scale * (q @ right) / depth
+    y = box["y"] + box["height"] / 2.0 - scale * (q @ up) / depth
+    return float(x), float(y)
+
+
+def sheet_toggle(page: BrowserPage, device: str, opening: bool):
+    """What one tap opens or closes the sheet with: on a phone held upright, viser's bottom
+    sheet's bar either way; otherwise the folded column's rail ("What you see", the first
+    entry) opens it and the column's collapse control closes it."""
+    if DEVICES[device][0] < 576:
+        return page.page.get_by_text("Poinsot: free rigid body", exact=True).first
+    if opening:
+        return page.page.get_by_text("What you see", exact=True).first
+    return page.page.locator('[aria-label="Collapse panel area"]').first
+
+
+@pytest.mark.parametrize("device", list(DEVICES))
+def test_the_page_on_a_phone_and_a_tablet(poinsot_app, open_page, device) -> None:
+    page = open_device(open_page, poinsot_app.url, device)
+    session = session_of(poinsot_app)
+    assert wait_until(lambda: session.layout.compact and session.layout.framings >= 1, 20)
+    assert wait_until(lambda: page.page.evaluate(_SCENE_SHARE_JS) >= SCENE_SHARE, 10), (
+        f"the scene is on top on only {page.page.evaluate(_SCENE_SHARE_JS):.0%} of the screen"
+    )
+    if DEVICES[device][0] < 576:
+        # viser's bottom sheet is open at first, held low, the legend at its top; one tap on
+        # its bar closes it, the next opens it again.
+        assert wait_until(lambda: page.page.evaluate(_LEGEND_SHOWN_JS, LEGEND_ENTRY), 10)
+        sheet_toggle(page, device, opening=False).tap()
+        assert wait_until(lambda: not page.page.evaluate(_LEGEND_SHOWN_JS, LEGEND_ENTRY), 10)
+    else:
+        assert not page.page.evaluate(_LEGEND_SHOWN_JS, LEGEND_ENTRY)
+    # One tap opens the sheet, and the legend is on screen; one tap closes it.
+    sheet_toggle(page, device, opening=True).tap()
+    assert wait_until(lambda: page.page.evaluate(_LEGEND_SHOWN_JS, LEGEND_ENTRY), 10)
+    sheet_toggle(page, device, opening=False).tap()
+    assert wait_until(lambda: page.page.evaluate(_SCENE_SHARE_JS) >= SCENE_SHARE, 10)
+    # A tap on the ellipsoid (at the picture of its centre) starts the motion there.
+    body = session.body
+    assert body is not None
+    x, y = screen_point(session, page, np.zeros(3))
+    page.page.touchscreen.tap(x, y)
+    assert wait_until(lambda: session.pointer.starts == 1 and session.body is not body, 10)
+    new = session.body
+    assert new is not None and new.energy == pytest.approx(body.energy, rel=1e-12)
+    shown = f"{new.D:.6g}"
+    assert shown != f"{body.D:.6g}"
+    # ... and the readouts in the sheet show its D (on the bottom sheet, in its "What you see"
+    # section, which opens with one more tap).
+    sheet_toggle(page, device, opening=True).tap()
+    if DEVICES[device][0] < 576:
+        page.page.get_by_text("What you see", exact=True).first.tap()
+    assert wait_until(lambda: shown in page.page.evaluate("() => document.body.innerText"), 10)
+    assert page.errors == []
+
+
+def test_the_camera_frames_the_construction_again_when_the_phone_turns(
+    poinsot_app, open_page
+) -> None:
+    page = open_device(open_page, poinsot_app.url, "phone-portrait")
+    session = session_of(poinsot_app)
+    assert wait_until(lambda: session.layout.framings >= 1, 20)
+    upright = np.asarray(session.client.camera.position, float)
+    page.page.set_viewport_size({"width": 844, "height": 390})
+    assert wait_until(lambda: session.layout.framings >= 2, 20)
+    # Wide, the construction needs less distance than upright (its width limits it there).
+    assert wait_until(
+        lambda: np.linalg.norm(session.client.camera.position) < 0.8 * np.linalg.norm(upright),
+        20,
+    )
+    assert page.errors == []
