@@ -5,6 +5,8 @@ frame only poses and trail increments are sent."""
 
 from __future__ import annotations
 
+import logging
+import os
 import time
 
 import pytest
@@ -94,7 +96,22 @@ def test_each_scene_creates_only_what_it_declares(spec, make_app, make_probe, el
     assert session.stats.errors == 0, session.stats.last_error
 
 
-def test_the_menu_switches_scenes_and_presets_exactly(make_app, make_probe, element_nodes):
+def viser_warnings(recwarn: pytest.WarningsRecorder, caplog: pytest.LogCaptureFixture) -> list:
+    """What viser warned about (a warning raised in viser's code, or logged by viser)."""
+    raised = [str(w.message) for w in recwarn if f"{os.sep}viser{os.sep}" in w.filename]
+    logged = [
+        r.getMessage()
+        for r in caplog.records
+        if r.name.startswith("viser") and r.levelno >= logging.WARNING
+    ]
+    return raised + logged
+
+
+def test_the_menu_switches_scenes_and_presets_exactly(
+    make_app, make_probe, element_nodes, recwarn, caplog
+):
+    """... and viser warns about nothing meanwhile (a node removed twice, a handle used after
+    its removal): the server's terminal stays quiet."""
     app = make_app()
     probe = make_probe(app)
     session = session_of(app)
@@ -128,6 +145,7 @@ def test_the_menu_switches_scenes_and_presets_exactly(make_app, make_probe, elem
     assert probe.wait_for(lambda p: plot_titles(p) == {"ω in the body frame"}, 10)
     assert wait_until(lambda: session.body is not None and session.body.inertia[2] > 3.0, 10)
     assert session.stats.errors == 0, session.stats.last_error
+    assert viser_warnings(recwarn, caplog) == []
 
 
 def test_bad_input_keeps_the_last_scene_and_says_why(make_app, make_probe):
