@@ -11,12 +11,13 @@ Reusable pieces (also for the screenshot and export tests):
   (:mod:`poinsot.app.live.probe`);
 - ``chromium`` (session scope): a launched playwright Browser;
 - ``open_page``: ``open_page(url, width=..., height=...) -> BrowserPage`` with the console
-  errors collected, the canvas ready and the software-WebGL notice dismissed;
+  errors collected, the canvas ready and the software-WebGL notice hidden;
 - ``BrowserPage`` helpers to drive viser's widgets by their label, and ``screenshot_rgb``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import io
 import os
@@ -67,6 +68,40 @@ def chromium_or_fail() -> str:
     if in_ci():
         pytest.fail(message + " [CI=true: browser tests must run]")
     pytest.skip(message)
+
+
+# -- how the suite is split (`make test-fast`, pytest-xdist) --------------------------------
+#: Fixtures that start a live server or a browser: a test that uses one is marked ``server``
+#: (or ``browser``), which ``make test-fast`` leaves out.
+SERVER_FIXTURES = frozenset({"make_app", "poinsot_app", "make_probe", "probe"})
+BROWSER_FIXTURES = frozenset({"chromium", "open_page"})
+#: Session fixtures that take long to build: the tests that use one run in one xdist group
+#: (one worker), so that it is built once, not once per worker.
+SHARED_SESSION_FIXTURES = ("quick_report", "small_study")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Mark the tests by what they start, and group them for pytest-xdist (``--dist
+    loadgroup``): every real-browser test in one group, so that one worker drives one Chromium
+    at a time (its rendering takes a core of its own) and starts it first (it is the longest
+    group); the tests of a long session fixture in one group; every other test in its
+    module's group (a module's fixtures are built once). The order is the same in every
+    worker, as xdist requires."""
+    for item in items:
+        fixtures = set(getattr(item, "fixturenames", ()))
+        if fixtures & BROWSER_FIXTURES and item.get_closest_marker("browser") is None:
+            item.add_marker(pytest.mark.browser)
+        if fixtures & SERVER_FIXTURES:
+            item.add_marker(pytest.mark.server)
+        if item.get_closest_marker("xdist_group") is not None:
+            continue
+        if item.get_closest_marker("browser") is not None:
+            group = "browser"
+        else:
+            shared = [f for f in SHARED_SESSION_FIXTURES if f in fixtures]
+            group = shared[0] if shared else item.nodeid.split("::")[0]
+        item.add_marker(pytest.mark.xdist_group(group))
+    items.sort(key=lambda item: item.get_closest_marker("browser") is None)
 
 
 # -- servers and probes ------------------------------------------------------------------
@@ -242,32 +277,17 @@ class BrowserPage:
         return box
 
 
-_CLOSE_NOTICE_JS = """() => {
-  const notice = document.getElementById('webgl-software-rendering');
-  if (!notice) return false;
-  const button = notice.querySelector('button.mantine-Notification-closeButton');
-  if (button) button.click();
-  return true;
-}"""
-
-
-def _dismiss_software_webgl_notice(page, timeout: float = 30.0) -> None:
-    """Close viser's "Software WebGL rendering detected" notice (SwiftShader) so that it does
-    not cover the canvas. Done in page JavaScript (no locator waits: the page's main thread is
-    busy rendering, so playwright's actionability checks can take seconds); repeated until the
-    notice has stayed away for a moment, since it can appear late. A GPU browser never shows it."""
-    deadline = time.monotonic() + timeout
-    seen = False
-    absent_since: float | None = None
-    while time.monotonic() < deadline:
-        if page.evaluate(_CLOSE_NOTICE_JS):
-            seen, absent_since = True, None
-        elif absent_since is None:
-            absent_since = time.monotonic()
-        elif time.monotonic() - absent_since > (1.0 if seen else 4.0):
-            return
-        page.wait_for_timeout(250)
-    raise AssertionError("the software-WebGL notice could not be dismissed")
+#: Hides viser's "Software WebGL rendering detected" notice (SwiftShader; a GPU browser never
+#: shows it) with a style sheet that is in the page before viser's script runs: the notice never
+#: covers the canvas, and no test waits for it to appear in order to close it.
+HIDE_SOFTWARE_WEBGL_NOTICE_JS = """(() => {
+  const hide = () => {
+    const style = document.createElement('style');
+    style.textContent = '#webgl-software-rendering { display: none !important; }';
+    document.head.appendChild(style);
+  };
+  if (document.head) hide(); else document.addEventListener('DOMContentLoaded', hide);
+})();"""
 
 
 @pytest.fixture
@@ -277,6 +297,7 @@ def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
     def open_(url: str, width: int = 1280, height: int = 720) -> BrowserPage:
         context = chromium.new_context(viewport={"width": width, "height": height})
         contexts.append(context)
+        context.add_init_script(HIDE_SOFTWARE_WEBGL_NOTICE_JS)
         page = context.new_page()
         errors: list[str] = []
         page.on(
@@ -290,7 +311,6 @@ def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
         page.on("pageerror", lambda e: errors.append(f"pageerror: {e}"))
         page.goto(url)
         page.locator("canvas").first.wait_for(state="visible", timeout=20000)
-        _dismiss_software_webgl_notice(page)
         return BrowserPage(page, errors)
 
     yield open_
@@ -307,10 +327,18 @@ def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
 SMALL_STUDY_CASES = ("Toutatis", "near-separatrix 1-m=1e-14", "separatrix")
 
 
+#: What ``quick_report``'s run wrote on stderr (a file, as with ``poinsot report 2> file``).
+STDERR_NAME = "stderr.txt"
+
+
 @pytest.fixture(scope="session")
 def quick_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("report")
-    assert cli_main(["report", "--quick", "--out", str(out)]) == 0
+    with pytest.MonkeyPatch.context() as patch:  # stderr is a file: no variable says otherwise
+        for name in ("FORCE_COLOR", "TTY_COMPATIBLE", "TTY_INTERACTIVE"):
+            patch.delenv(name, raising=False)
+        with open(out / STDERR_NAME, "w") as err, contextlib.redirect_stderr(err):
+            assert cli_main(["report", "--quick", "--out", str(out)]) == 0
     return out
 
 
