@@ -182,6 +182,31 @@ def wait_until(predicate: Callable[[], bool], timeout: float = 10.0, poll: float
     return predicate()
 
 
+def after_frames(session: Session, frames: int = 10, timeout: float = 30.0) -> None:
+    """Wait until ``session`` drew ``frames`` more frames: what was asked of it before has been
+    drained (its frame thread drains its actions before each frame) and drawn. The event to
+    wait for instead of a sleep before checking that something did NOT happen."""
+    first = session.stats.frames
+    assert wait_until(lambda: session.stats.frames >= first + frames, timeout), "no more frames"
+
+
+def record_frame_times(session: Session) -> list[float]:
+    """The frame thread's own clock reading for every frame ``session`` draws from now on
+    (the time it hands to the frame): the gaps between them show its pacing by its own logic,
+    whatever the machine's load."""
+    drawn_at: list[float] = []
+    frame_if_taken = session._frame_if_taken
+
+    def recording(now: float) -> bool:
+        drawn = frame_if_taken(now)
+        if drawn:
+            drawn_at.append(now)
+        return drawn
+
+    session._frame_if_taken = recording  # type: ignore[method-assign]
+    return drawn_at
+
+
 def record_messages(server) -> list:
     """Every message ``server`` queues from now on (appended as it is queued)."""
     sent: list = []

@@ -7,10 +7,9 @@ from __future__ import annotations
 
 import logging
 import os
-import time
 
 import pytest
-from conftest import session_of, wait_until
+from conftest import after_frames, session_of, wait_until
 from scene_probing import (
     ALWAYS,
     CONSTRUCTION_TRAILS,
@@ -71,7 +70,9 @@ def common_labels(make_app, make_probe) -> set[str]:
     probe = make_probe(app)
     session = session_of(app)
     assert wait_until(lambda: session.stats.frames > 3, 15)
-    time.sleep(0.5)
+    received = len(probe.batches)
+    after_frames(session)  # the panel was built before the first frame; these reached the probe
+    assert probe.wait_for(lambda p: len(p.batches) >= received + 5, 15)
     own = {ELEMENT_LABELS[e] for e in sphere.elements}
     for control in sphere.controls:
         own |= SHARED_LABELS.get(control, set())
@@ -197,8 +198,9 @@ def test_per_frame_only_poses_and_trail_increments(name, make_app, make_probe):
     trails = trails_of(spec)
     assert wait_until(lambda: session.stats.frames > 30, 10)
     start_batch, frames = len(probe.batches), session.stats.frames
-    time.sleep(1.5)
-    assert session.stats.frames - frames > 30
+    after_frames(session, 90)
+    assert probe.wait_for(lambda p: len(p.batches) >= start_batch + 45, 10)
+    assert session.stats.frames - frames >= 90
     for batch in probe.batches[start_batch:]:
         for kind, node in zip(batch.types, batch.names, strict=True):
             assert kind in PER_FRAME_TYPES, (kind, node)
