@@ -44,20 +44,20 @@ chromium:
 run: install
 	$(VENV)/bin/poinsot serve --host $(HOST) --port $(PORT)
 
-# The suite on JOBS pytest-xdist workers. tests/conftest.py groups the tests (--dist loadgroup):
-# every real-browser test in one group (one Chromium drawing at a time, started first, as it is
-# the longest), the tests of a session fixture in one, every other module in its own. Then the
+# The suite on JOBS pytest-xdist workers. tests/conftest.py groups the tests (--dist loadgroup,
+# xdist_group): every real-browser test in one group (one Chromium drawing at a time, started
+# first, as it is the longest), tests/report/ in one, every other module in its own. Then the
 # few `serial` tests, alone (they measure what the machine gives them). Both stages always run.
 JOBS ?= 4
 test: install-test chromium
 	status=0; \
-	$(PY) -m pytest -n $(JOBS) --dist loadgroup -m "not serial" || status=1; \
+	$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not serial" || status=1; \
 	$(PY) -m pytest -m serial || status=1; \
 	exit $$status
 
 # The inner loop: no browser, no live server, nothing slow (physics, report, the app's logic).
 test-fast: install-test
-	$(PY) -m pytest -n $(JOBS) --dist loadgroup -m "not browser and not server and not slow"
+	$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not browser and not server and not slow"
 
 bench: install
 	$(PY) -m poinsot.physics.benchmark

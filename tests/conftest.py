@@ -75,33 +75,53 @@ def chromium_or_fail() -> str:
 #: (or ``browser``), which ``make test-fast`` leaves out.
 SERVER_FIXTURES = frozenset({"make_app", "poinsot_app", "make_probe", "probe"})
 BROWSER_FIXTURES = frozenset({"chromium", "open_page"})
-#: Session fixtures that take long to build: the tests that use one run in one xdist group
-#: (one worker), so that it is built once, not once per worker.
-SHARED_SESSION_FIXTURES = ("quick_report", "small_study")
+#: Real-browser tests outside tests/browser/ (collection fails if one is not listed).
+BROWSER_ELSEWHERE = frozenset(
+    {"tests/app/test_ghost.py::test_the_ghost_shows_a_second_ellipsoid_in_the_browser"}
+)
+
+
+def xdist_group(nodeid: str) -> str:
+    """The worker group of a test (``make test``: pytest-xdist, ``--dist loadgroup``): every
+    real-browser test in one group, so that one worker drives one Chromium at a time (its
+    software rendering takes a core of its own); tests/report/ in one (``quick_report`` and
+    ``small_study`` are built once); every other module in its own (its fixtures are built
+    once). From the node id alone: xdist's controller collects nothing."""
+    path = nodeid.split("::")[0]
+    if path.startswith("tests/browser/") or nodeid.split("[")[0] in BROWSER_ELSEWHERE:
+        return "browser"
+    if path.startswith("tests/report/"):
+        return "report"
+    return path
+
+
+def pytest_xdist_make_scheduler(config: pytest.Config, log):
+    """``--dist loadgroup`` by :func:`xdist_group` (xdist's own reads ``xdist_group`` marks
+    through ``item._nodeid``, which pytest 9 no longer has). A worker takes a group whole."""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class SuiteGroups(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return xdist_group(nodeid)
+
+    return SuiteGroups(config, log)
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Mark the tests by what they start, and group them for pytest-xdist (``--dist
-    loadgroup``): every real-browser test in one group, so that one worker drives one Chromium
-    at a time (its rendering takes a core of its own) and starts it first (it is the longest
-    group); the tests of a long session fixture in one group; every other test in its
-    module's group (a module's fixtures are built once). The order is the same in every
-    worker, as xdist requires."""
+    """Mark the tests by what they start; the browser group first (it is the longest: with
+    ``--no-loadscope-reorder`` a worker starts on it at once). The same order in every worker,
+    as xdist requires."""
     for item in items:
         fixtures = set(getattr(item, "fixturenames", ()))
         if fixtures & BROWSER_FIXTURES and item.get_closest_marker("browser") is None:
             item.add_marker(pytest.mark.browser)
         if fixtures & SERVER_FIXTURES:
             item.add_marker(pytest.mark.server)
-        if item.get_closest_marker("xdist_group") is not None:
-            continue
-        if item.get_closest_marker("browser") is not None:
-            group = "browser"
-        else:
-            shared = [f for f in SHARED_SESSION_FIXTURES if f in fixtures]
-            group = shared[0] if shared else item.nodeid.split("::")[0]
-        item.add_marker(pytest.mark.xdist_group(group))
-    items.sort(key=lambda item: item.get_closest_marker("browser") is None)
+        if item.get_closest_marker("browser") and xdist_group(item.nodeid) != "browser":
+            raise pytest.UsageError(f"{item.nodeid} drives a browser: add it to BROWSER_ELSEWHERE")
+    items.sort(key=lambda item: xdist_group(item.nodeid) != "browser")
 
 
 # -- servers and probes ------------------------------------------------------------------
