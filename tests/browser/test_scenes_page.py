@@ -85,7 +85,7 @@ def check_parts(page, session, spec: SceneSpec, shown: np.ndarray) -> None:
             assert int(np.sum(gone & near)) >= MIN_COLOUR_PIXELS, (spec.name, part.key, color)
         page.set_checkbox(part.label, True)
         assert wait_until(lambda p=part: drawing.parts.is_visible(p.key), 10), part.key
-        render_until(session, lambda picture: changed(shown, picture) <= 2e-4, 20)  # back
+        render_until(session, lambda picture, h=hidden: changed(h, picture) > 2e-4)  # again
 
 
 def test_every_scene_draws_its_parts_distinctly(make_app, open_page):
