@@ -1,4 +1,5 @@
-# Two entry points: `make run` and `make test`. Everything else is plumbing.
+# Entry points: `make run`, `make test` (everything, as CI) and `make test-fast` (the inner loop).
+# Everything else is plumbing.
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -7,7 +8,7 @@ PORT   ?= 8080
 CHROMIUM ?= /usr/bin/chromium
 SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: run test install install-test chromium bench bench-compare load lint clean
+.PHONY: run test test-fast install install-test chromium bench bench-compare load lint clean
 
 $(VENV)/bin/activate:
 	$(PYTHON) -m venv $(VENV)
@@ -43,8 +44,20 @@ chromium:
 run: install
 	$(VENV)/bin/poinsot serve --host $(HOST) --port $(PORT)
 
+# The suite on JOBS pytest-xdist workers. tests/conftest.py groups the tests (--dist loadgroup,
+# xdist_group): every real-browser test in one group (one Chromium drawing at a time, started
+# first, as it is the longest), tests/report/ in one, every other module in its own. Then the
+# few `serial` tests, alone (they measure what the machine gives them). Both stages always run.
+JOBS ?= 4
 test: install-test chromium
-	$(PY) -m pytest
+	status=0; \
+	$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not serial" || status=1; \
+	$(PY) -m pytest -m serial || status=1; \
+	exit $$status
+
+# The inner loop: no browser, no live server, nothing slow (physics, report, the app's logic).
+test-fast: install-test
+	$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not browser and not server and not slow"
 
 bench: install
 	$(PY) -m poinsot.physics.benchmark

@@ -11,12 +11,13 @@ Reusable pieces (also for the screenshot and export tests):
   (:mod:`poinsot.app.live.probe`);
 - ``chromium`` (session scope): a launched playwright Browser;
 - ``open_page``: ``open_page(url, width=..., height=...) -> BrowserPage`` with the console
-  errors collected, the canvas ready and the software-WebGL notice dismissed;
+  errors collected, the canvas ready and the software-WebGL notice hidden;
 - ``BrowserPage`` helpers to drive viser's widgets by their label, and ``screenshot_rgb``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import io
 import os
@@ -67,6 +68,60 @@ def chromium_or_fail() -> str:
     if in_ci():
         pytest.fail(message + " [CI=true: browser tests must run]")
     pytest.skip(message)
+
+
+# -- how the suite is split (`make test-fast`, pytest-xdist) --------------------------------
+#: Fixtures that start a live server or a browser: a test that uses one is marked ``server``
+#: (or ``browser``), which ``make test-fast`` leaves out.
+SERVER_FIXTURES = frozenset({"make_app", "poinsot_app", "make_probe", "probe"})
+BROWSER_FIXTURES = frozenset({"chromium", "open_page"})
+#: Real-browser tests outside tests/browser/ (collection fails if one is not listed).
+BROWSER_ELSEWHERE = frozenset(
+    {"tests/app/test_ghost.py::test_the_ghost_shows_a_second_ellipsoid_in_the_browser"}
+)
+
+
+def xdist_group(nodeid: str) -> str:
+    """The worker group of a test (``make test``: pytest-xdist, ``--dist loadgroup``): every
+    real-browser test in one group, so that one worker drives one Chromium at a time (its
+    software rendering takes a core of its own); tests/report/ in one (``quick_report`` and
+    ``small_study`` are built once); every other module in its own (its fixtures are built
+    once). From the node id alone: xdist's controller collects nothing."""
+    path = nodeid.split("::")[0]
+    if path.startswith("tests/browser/") or nodeid.split("[")[0] in BROWSER_ELSEWHERE:
+        return "browser"
+    if path.startswith("tests/report/"):
+        return "report"
+    return path
+
+
+def pytest_xdist_make_scheduler(config: pytest.Config, log):
+    """``--dist loadgroup`` by :func:`xdist_group` (xdist's own reads ``xdist_group`` marks
+    through ``item._nodeid``, which pytest 9 no longer has). A worker takes a group whole."""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class SuiteGroups(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return xdist_group(nodeid)
+
+    return SuiteGroups(config, log)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Mark the tests by what they start; the browser group first (it is the longest: with
+    ``--no-loadscope-reorder`` a worker starts on it at once). The same order in every worker,
+    as xdist requires."""
+    for item in items:
+        fixtures = set(getattr(item, "fixturenames", ()))
+        if fixtures & BROWSER_FIXTURES and item.get_closest_marker("browser") is None:
+            item.add_marker(pytest.mark.browser)
+        if fixtures & SERVER_FIXTURES:
+            item.add_marker(pytest.mark.server)
+        if item.get_closest_marker("browser") and xdist_group(item.nodeid) != "browser":
+            raise pytest.UsageError(f"{item.nodeid} drives a browser: add it to BROWSER_ELSEWHERE")
+    items.sort(key=lambda item: xdist_group(item.nodeid) != "browser")
 
 
 # -- servers and probes ------------------------------------------------------------------
@@ -145,6 +200,31 @@ def wait_until(predicate: Callable[[], bool], timeout: float = 10.0, poll: float
             return True
         time.sleep(poll)
     return predicate()
+
+
+def after_frames(session: Session, frames: int = 10, timeout: float = 30.0) -> None:
+    """Wait until ``session`` drew ``frames`` more frames: what was asked of it before has been
+    drained (its frame thread drains its actions before each frame) and drawn. The event to
+    wait for instead of a sleep before checking that something did NOT happen."""
+    first = session.stats.frames
+    assert wait_until(lambda: session.stats.frames >= first + frames, timeout), "no more frames"
+
+
+def record_frame_times(session: Session) -> list[float]:
+    """The frame thread's own clock reading for every frame ``session`` draws from now on
+    (the time it hands to the frame): the gaps between them show its pacing by its own logic,
+    whatever the machine's load."""
+    drawn_at: list[float] = []
+    frame_if_taken = session._frame_if_taken
+
+    def recording(now: float) -> bool:
+        drawn = frame_if_taken(now)
+        if drawn:
+            drawn_at.append(now)
+        return drawn
+
+    session._frame_if_taken = recording  # type: ignore[method-assign]
+    return drawn_at
 
 
 def record_messages(server) -> list:
@@ -242,32 +322,17 @@ class BrowserPage:
         return box
 
 
-_CLOSE_NOTICE_JS = """() => {
-  const notice = document.getElementById('webgl-software-rendering');
-  if (!notice) return false;
-  const button = notice.querySelector('button.mantine-Notification-closeButton');
-  if (button) button.click();
-  return true;
-}"""
-
-
-def _dismiss_software_webgl_notice(page, timeout: float = 30.0) -> None:
-    """Close viser's "Software WebGL rendering detected" notice (SwiftShader) so that it does
-    not cover the canvas. Done in page JavaScript (no locator waits: the page's main thread is
-    busy rendering, so playwright's actionability checks can take seconds); repeated until the
-    notice has stayed away for a moment, since it can appear late. A GPU browser never shows it."""
-    deadline = time.monotonic() + timeout
-    seen = False
-    absent_since: float | None = None
-    while time.monotonic() < deadline:
-        if page.evaluate(_CLOSE_NOTICE_JS):
-            seen, absent_since = True, None
-        elif absent_since is None:
-            absent_since = time.monotonic()
-        elif time.monotonic() - absent_since > (1.0 if seen else 4.0):
-            return
-        page.wait_for_timeout(250)
-    raise AssertionError("the software-WebGL notice could not be dismissed")
+#: Hides viser's "Software WebGL rendering detected" notice (SwiftShader; a GPU browser never
+#: shows it) with a style sheet that is in the page before viser's script runs: the notice never
+#: covers the canvas, and no test waits for it to appear in order to close it.
+HIDE_SOFTWARE_WEBGL_NOTICE_JS = """(() => {
+  const hide = () => {
+    const style = document.createElement('style');
+    style.textContent = '#webgl-software-rendering { display: none !important; }';
+    document.head.appendChild(style);
+  };
+  if (document.head) hide(); else document.addEventListener('DOMContentLoaded', hide);
+})();"""
 
 
 @pytest.fixture
@@ -278,6 +343,7 @@ def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
         """``options``: more of playwright's context options (touch, a User-Agent...)."""
         context = chromium.new_context(viewport={"width": width, "height": height}, **options)
         contexts.append(context)
+        context.add_init_script(HIDE_SOFTWARE_WEBGL_NOTICE_JS)
         page = context.new_page()
         errors: list[str] = []
         page.on(
@@ -291,7 +357,6 @@ def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
         page.on("pageerror", lambda e: errors.append(f"pageerror: {e}"))
         page.goto(url)
         page.locator("canvas").first.wait_for(state="visible", timeout=20000)
-        _dismiss_software_webgl_notice(page)
         return BrowserPage(page, errors)
 
     yield open_
@@ -308,10 +373,18 @@ def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
 SMALL_STUDY_CASES = ("Toutatis", "near-separatrix 1-m=1e-14", "separatrix")
 
 
+#: What ``quick_report``'s run wrote on stderr (a file, as with ``poinsot report 2> file``).
+STDERR_NAME = "stderr.txt"
+
+
 @pytest.fixture(scope="session")
 def quick_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("report")
-    assert cli_main(["report", "--quick", "--out", str(out)]) == 0
+    with pytest.MonkeyPatch.context() as patch:  # stderr is a file: no variable says otherwise
+        for name in ("FORCE_COLOR", "TTY_COMPATIBLE", "TTY_INTERACTIVE"):
+            patch.delenv(name, raising=False)
+        with open(out / STDERR_NAME, "w") as err, contextlib.redirect_stderr(err):
+            assert cli_main(["report", "--quick", "--out", str(out)]) == 0
     return out
 
 

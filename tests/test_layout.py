@@ -149,3 +149,136 @@ def test_cited_keys_are_in_the_reference_list():
     for f in _code_files():
         cited.update(re.findall(r"\[([A-Z][A-Za-z]*\d\d)[\] ,§]", f.read_text()))
     assert cited - listed == set(), f"cited but not in docs/REFERENCES.md: {sorted(cited - listed)}"
+
+
+# -- tests wait for events, not for the clock ----------------------------------------------------
+#: Clock readings: an assert on a value computed from one turns red on a loaded machine (rates
+#: and latencies are ``poinsot benchmark``'s figures, not the tests').
+CLOCKS = {"monotonic", "perf_counter", "time", "monotonic_ns", "perf_counter_ns", "time_ns"}
+#: Tests that read the clock once as the origin of times they make up, by (file, function).
+CLOCK_ALLOWED: dict[tuple[str, str], str] = {
+    ("tests/app/test_wire.py", "test_what_a_client_gets_through_is_bounded_by_its_budget"): (
+        "synthetic arrival times after one reading (the budget starts at time.monotonic())"
+    ),
+}
+#: The sleeps the tests may keep, by (file, function), with the reason: each one is a rhythm or a
+#: sampling period, or a render for which the page gives no event. Any other sleep must become a
+#: wait on the event it stands for (``wait_until``, ``probe.wait_for``, ``after_frames``).
+SLEEPS_ALLOWED: dict[tuple[str, str], str] = {
+    ("tests/conftest.py", "wait_until"): "the poll period of the one waiting primitive",
+    ("tests/scene_probing.py", "_settled_names"): "the poll period while node names settle",
+    ("tests/app/test_server.py", "test_random_input_never_raises_nor_sends_nan"): (
+        "the storm's irregular rhythm of input, not a wait"
+    ),
+    ("tests/app/test_wire.py", "frames_in"): (
+        "two equal windows, quiet and flooded, in which the frames are counted and compared"
+    ),
+    ("tests/app/test_wire.py", "poll"): "the sampling period of a peak-memory poller",
+    ("tests/app/test_ghost.py", "test_the_ghost_shows_a_second_ellipsoid_in_the_browser"): (
+        "a software-WebGL render: no page event says the picture shows the new state"
+    ),
+}
+#: Browser tests: the same reason as above, for each module (the page gives no "drawn" event).
+SLEEPS_ALLOWED_IN = {
+    "tests/browser/test_exports_page.py",
+    "tests/browser/test_live_page.py",
+    "tests/browser/test_loopback.py",
+    "tests/browser/test_picture_page.py",
+    "tests/browser/test_scenes_page.py",
+    "tests/browser/test_uploads_page.py",
+}
+
+
+def _is_clock_call(node: ast.AST) -> bool:
+    if not isinstance(node, ast.Call):
+        return False
+    func = node.func
+    name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+    return name in CLOCKS and (not isinstance(func, ast.Attribute) or _dotted(func.value) == "time")
+
+
+def _dotted(node: ast.AST) -> str:
+    return node.id if isinstance(node, ast.Name) else ""
+
+
+def _clock_names(function: ast.AST) -> set[str]:
+    """Names bound (directly or through other such names) to a value read off a clock."""
+    names: set[str] = set()
+    assigns = [n for n in ast.walk(function) if isinstance(n, ast.Assign | ast.AugAssign)]
+    changed = True
+    while changed:
+        changed = False
+        for node in assigns:
+            if _touches_clock(node.value, names):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                for target in targets:
+                    for leaf in ast.walk(target):
+                        if isinstance(leaf, ast.Name) and leaf.id not in names:
+                            names.add(leaf.id)
+                            changed = True
+    return names
+
+
+def _touches_clock(node: ast.AST, names: set[str]) -> bool:
+    return any(
+        _is_clock_call(n) or (isinstance(n, ast.Name) and n.id in names) for n in ast.walk(node)
+    )
+
+
+def _test_functions() -> list[tuple[str, ast.FunctionDef]]:
+    found = []
+    for path in sorted((ROOT / "tests").rglob("*.py")):
+        tree = ast.parse(path.read_text())
+        rel = str(path.relative_to(ROOT))
+        found += [(rel, f) for f in ast.walk(tree) if isinstance(f, ast.FunctionDef)]
+    return found
+
+
+def test_no_test_asserts_on_the_wall_clock():
+    found = []
+    for rel, function in _test_functions():
+        if (rel, function.name) in CLOCK_ALLOWED:
+            continue
+        names = _clock_names(function)
+        for node in ast.walk(function):
+            if isinstance(node, ast.Assert) and _touches_clock(node.test, names):
+                found.append(f"{rel}:{node.lineno}")
+    assert not found, f"asserts on the wall clock (count events instead): {found}"
+
+
+def _own_nodes(function: ast.FunctionDef) -> list[ast.AST]:
+    """The function's nodes, without those of the functions defined inside it."""
+    nodes, todo = [], list(ast.iter_child_nodes(function))
+    while todo:
+        node = todo.pop()
+        nodes.append(node)
+        if not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.Lambda):
+            todo.extend(ast.iter_child_nodes(node))
+    return nodes
+
+
+def _sleeps(function: ast.FunctionDef) -> list[int]:
+    lines = []
+    for node in _own_nodes(function):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+            if node.func.attr == "wait_for_timeout" or (
+                node.func.attr == "sleep" and _dotted(node.func.value) in ("time", "asyncio")
+            ):
+                lines.append(node.lineno)
+        elif isinstance(node, ast.Call) and _dotted(node.func) == "sleep":
+            lines.append(node.lineno)
+    return lines
+
+
+def test_tests_sleep_only_where_the_list_says_why():
+    """A new ``time.sleep`` (or a page's ``wait_for_timeout``) in a test fails here: wait for
+    the event it stands for, or add it to SLEEPS_ALLOWED with the reason."""
+    found, seen = [], set()
+    for rel, function in _test_functions():
+        lines = _sleeps(function)
+        if lines and (rel, function.name) in SLEEPS_ALLOWED:
+            seen.add((rel, function.name))
+        elif lines and rel not in SLEEPS_ALLOWED_IN:
+            found += [f"{rel}:{line} in {function.name}" for line in lines]
+    assert not found, f"sleeps in tests (wait for the event instead): {found}"
+    assert seen == set(SLEEPS_ALLOWED), f"allowed but gone: {set(SLEEPS_ALLOWED) - seen}"

@@ -1,22 +1,42 @@
-"""The console progress bar of a report run (stderr, one line)."""
+"""The progress of a report run on stderr, drawn by rich: a bar on an interactive terminal, a few
+plain lines (one per tenth of the run) when stderr is a file, a pipe or a CI log."""
 
 from __future__ import annotations
 
-import sys
-import time
+from rich.console import Console
+from rich.progress import BarColumn, TaskProgressColumn, TextColumn, TimeElapsedColumn
+from rich.progress import Progress as RichProgress
 
-__all__ = ["Progress"]
+__all__ = ["PLAIN_STEPS", "Progress"]
+
+#: Lines written when stderr is not a terminal: one at each tenth of the run, and the last.
+PLAIN_STEPS = 10
 
 
 class Progress:
-    """A one-line text bar on stderr: ``[#####.....]  45%  case / method setting``."""
+    """``advance`` the run by units of work, ``show`` what runs now, ``close`` at the end.
 
-    def __init__(self, total: int, enabled: bool = True, width: int = 30) -> None:
+    ``console`` is where it goes (stderr by default); ``enabled=False`` writes nothing.
+    """
+
+    def __init__(self, total: int, enabled: bool = True, console: Console | None = None) -> None:
         self.total = max(total, 1)
         self.done = 0
         self.enabled = enabled
-        self.width = width
-        self.start = time.perf_counter()
+        self.console = console if console is not None else Console(stderr=True)
+        self._step = 0  # plain lines: the last tenth written
+        self._bar: RichProgress | None = None
+        if enabled and self.console.is_interactive:
+            self._bar = RichProgress(
+                TextColumn("[progress.description]{task.description:<48}"),
+                BarColumn(),
+                TaskProgressColumn(),
+                TimeElapsedColumn(),
+                console=self.console,
+                transient=False,
+            )
+            self._task = self._bar.add_task("", total=self.total)
+            self._bar.start()
 
     def advance(self, label: str, units: int = 1) -> None:
         self.done = min(self.done + units, self.total)
@@ -25,17 +45,22 @@ class Progress:
     def show(self, label: str) -> None:
         if not self.enabled:
             return
-        filled = int(self.width * self.done / self.total)
-        bar = "#" * filled + "." * (self.width - filled)
-        elapsed = time.perf_counter() - self.start
-        sys.stderr.write(
-            f"\r[{bar}] {100 * self.done // self.total:3d}% {elapsed:6.1f}s  {label[:48]:<48}"
-        )
-        sys.stderr.flush()
+        if self._bar is not None:
+            self._bar.update(self._task, completed=self.done, description=label[:48])
+            return
+        step = PLAIN_STEPS * self.done // self.total
+        if step > self._step:
+            self._step = step
+            percent = 100 * self.done // self.total
+            self.console.print(f"report: {percent:3d}%  {label}", markup=False, highlight=False)
 
     def close(self) -> None:
-        if self.enabled:
-            self.done = self.total
-            self.show("done")
-            sys.stderr.write("\n")
-            sys.stderr.flush()
+        if not self.enabled:
+            return
+        self.done = self.total
+        if self._bar is not None:
+            self._bar.update(self._task, completed=self.total, description="done")
+            self._bar.stop()
+        elif self._step < PLAIN_STEPS:
+            self._step = PLAIN_STEPS
+            self.console.print("report: 100%  done", markup=False, highlight=False)

@@ -78,8 +78,12 @@ class Drawing:
             handle.visible = visible
 
     def remove(self) -> None:
+        """Remove the nodes that are under none of the others: viser removes the nodes under
+        them (an axis's label, the plane's grid) and warns if one is removed again."""
+        names = [handle.name for handle in self.handles]
         for handle in self.handles:
-            handle.remove()
+            if not any(handle.name.startswith(name + "/") for name in names):
+                handle.remove()
         self.handles = []
 
 

@@ -133,6 +133,7 @@ def test_a_layout_outdated_by_a_new_body_sends_nothing(scene_and_sent):
     assert scene.lay_out_labels(_camera())  # a new layout does place them
 
 
+@pytest.mark.serial  # the plot samples by the clock and sends by frames: it needs the frame rate
 def test_a_frame_carries_at_most_one_of_traces_plot_and_a_layout_step(poinsot_app, probe):
     """In a live session, per frame drawn: at most one step of the labels' layout, and never
     with the traces or the plot on the same frame; layouts still complete, in five steps, and

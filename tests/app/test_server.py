@@ -9,11 +9,11 @@ import time
 
 import numpy as np
 import pytest
-from conftest import session_of, wait_until
+from conftest import after_frames, record_frame_times, session_of, wait_until
 from test_scene_geometry import check_finite
 
 from poinsot.app.elements import Control, Element, Plot
-from poinsot.app.live.display import LABEL_HZ
+from poinsot.app.live.display import LABEL_MIN_FRAMES
 from poinsot.app.live.panel import ELEMENT_LABELS
 from poinsot.app.live.session import MAX_FPS, STEP_SECONDS
 from poinsot.app.parameters import Parameters
@@ -124,9 +124,11 @@ def test_switching_preset_creates_and_removes_exactly(poinsot_app, probe):
     assert session.stats.errors == 0, session.stats.last_error
 
 
-def frame_traffic(probe, seconds: float) -> list:
-    start = len(probe.batches)
-    time.sleep(seconds)
+def frame_traffic(probe, session, frames: int) -> list:
+    """What ``probe`` received while ``session`` drew ``frames`` more frames (and took them)."""
+    start, first = len(probe.batches), session.stats.frames
+    assert wait_until(lambda: session.stats.frames >= first + frames, 30)
+    assert probe.wait_for(lambda p: len(p.batches) >= start + frames // 2, 10)
     return probe.batches[start:]
 
 
@@ -145,9 +147,9 @@ def test_per_frame_only_poses_and_trail_increments_are_sent(poinsot_app, probe):
     session = session_of(poinsot_app)
     assert wait_until(lambda: session.stats.frames > 30, 10)
     frames_before = session.stats.frames
-    batches = frame_traffic(probe, 1.5)
+    batches = frame_traffic(probe, session, 90)
     frames = session.stats.frames - frames_before
-    assert frames > 30
+    assert frames >= 90
     labels = 0  # the labels' layout: an anchor or a push, a few times a second at most
     for batch in batches:
         for kind, name in zip(batch.types, batch.names, strict=True):
@@ -162,7 +164,8 @@ def test_per_frame_only_poses_and_trail_increments_are_sent(poinsot_app, probe):
                 assert name == "/space/tip" or name.startswith(TRAIL_GROUPS), name
             elif kind == "SceneNodeUpdateMessage":
                 assert name == "/space/omega" or name.startswith(TRAIL_GROUPS), name
-    assert labels <= 2 * 7 * LABEL_HZ * 1.5 + 7, labels
+    # a layout at most every LABEL_MIN_FRAMES frames (and LABEL_HZ), two messages per label
+    assert labels <= 2 * 7 * (frames // LABEL_MIN_FRAMES + 1) + 7, labels
     # Bytes: poses plus at most a chunk of trail per trace per frame (the plot, at 10 Hz,
     # resends its 300-sample window; it is counted separately).
     scene_bytes = sum(b.nbytes for b in batches if "GuiUpdateMessage" not in b.types)
@@ -171,13 +174,17 @@ def test_per_frame_only_poses_and_trail_increments_are_sent(poinsot_app, probe):
 
 
 def test_the_loop_runs_at_most_60_hz(poinsot_app, probe):
+    """The frame thread draws a frame only once its interval (1/60 s at most, by the pacer)
+    has passed since the frame before, by its own clock: the gaps between the times it hands
+    to the frames it draws are never shorter (a loaded machine only makes them longer; the
+    rate itself is ``poinsot benchmark``'s "frames per second per client"). And it animates:
+    60 more frames arrive."""
     session = session_of(poinsot_app)
-    assert wait_until(lambda: session.stats.frames > 10, 10)
-    f0, t0 = session.stats.frames, time.monotonic()
-    time.sleep(2.0)
-    rate = (session.stats.frames - f0) / (time.monotonic() - t0)
-    assert rate <= MAX_FPS * 1.03, rate
-    assert rate > 20, rate  # and it does animate
+    drawn_at = record_frame_times(session)
+    assert wait_until(lambda: len(drawn_at) > 60, 30), len(drawn_at)
+    assert session.pacer.interval >= 1.0 / MAX_FPS
+    gaps = np.diff(drawn_at[:60])
+    assert gaps.min() >= (1.0 / MAX_FPS) * (1 - 1e-9), gaps.min()
 
 
 def test_the_loop_stops_when_the_client_leaves(poinsot_app, make_probe):
@@ -187,9 +194,9 @@ def test_the_loop_stops_when_the_client_leaves(poinsot_app, make_probe):
     probe.close()
     assert wait_until(lambda: not session.running, 5)
     assert poinsot_app.sessions() == {}
+    assert wait_until(lambda: not session._thread.is_alive(), 10)  # the frame thread ended
     frames = session.stats.frames
-    time.sleep(0.3)
-    assert session.stats.frames == frames
+    assert not session._thread.is_alive() and session.stats.frames == frames
 
 
 #: Frames (about a second's worth at 60 Hz) the stalled client's session draws before the
@@ -249,7 +256,8 @@ def test_two_clients_have_independent_sessions(poinsot_app, make_probe):
         ),
         10,
     )
-    time.sleep(0.3)
+    after_frames(sb)  # b's session has drained whatever reached it meanwhile
+    assert b.wait_for(lambda p: len(p.batches) > 0, 5)
     assert sb.params.inertia == DEFAULT_PRESET.inertia and sb.preset is DEFAULT_PRESET
     a_scale = a.snapshot()[0]["/space/body/ellipsoid"].props["scale"]
     b_scale = b.snapshot()[0]["/space/body/ellipsoid"].props["scale"]
@@ -269,7 +277,9 @@ def test_an_impossible_body_is_refused_and_the_last_scene_kept(poinsot_app, prob
     assert "I3 = 3.5 is larger than I1 + I2 = 3" in session.status
     assert probe.wait_for(lambda p: any("No real body" in t for t in markdown_texts(p)), 5)
     assert session.body is body_before
-    time.sleep(0.3)
+    received = len(probe.batches)
+    after_frames(session)  # frames after the refusal reached the probe, no new ellipsoid
+    assert probe.wait_for(lambda p: len(p.batches) >= received + 5, 10)
     assert np.allclose(probe.snapshot()[0]["/space/body/ellipsoid"].props["scale"], scale_before)
     assert session.stats.errors == 0
     check_finite(probe)
@@ -319,7 +329,10 @@ def test_random_input_never_raises_nor_sends_nan(poinsot_app, probe):
                 value = rng.choice(w.props["options"]) if "options" in w.props else True
                 probe.set_value(uuid, value)
         time.sleep(rng.choice([0.0, 0.0, 0.01, 0.05]))
-    time.sleep(1.0)
+    # One last change, then frames: the storm before it has been taken in.
+    probe.set_value(probe.widget("Speed")[0], 1.25)
+    assert wait_until(lambda: session.clock.speed == 1.25, 30)
+    after_frames(session)
     assert session.stats.errors == 0, session.stats.last_error
     assert session.status in ("",) or "No real body" in session.status
     check_finite(probe)
@@ -334,7 +347,7 @@ def test_visibility_trail_length_and_time_controls(poinsot_app, probe):
     uuid, _ = probe.widget("Trail length")
     probe.set_value(uuid, 100)
     assert wait_until(lambda: session.scene.trail_points == 100, 5)
-    time.sleep(2.0)
+    after_frames(session, 120)  # two seconds of trail at 60 Hz, more than 100 points
     for element in (Element.POLHODE, Element.HERPOLHODE):
         trail = session.scene.trail(element)
         assert trail.segment_count <= max(100, 2 * CHUNK_SEGMENTS) + CHUNK_SEGMENTS
@@ -345,7 +358,7 @@ def test_visibility_trail_length_and_time_controls(poinsot_app, probe):
     probe.set_value(probe.widget("Pause")[0], True)
     assert wait_until(lambda: session.clock.paused, 5)
     t = session.clock.now()
-    time.sleep(0.3)
+    after_frames(session)  # frames go on, time stands still
     assert session.clock.now() == t
     probe.set_value(probe.widget("Step")[0], True)
     assert wait_until(lambda: session.clock.now() > t, 5)
@@ -359,13 +372,13 @@ def test_visibility_trail_length_and_time_controls(poinsot_app, probe):
     assert session.stats.errors == 0, session.stats.last_error
 
 
-def test_slider_to_redraw_is_fast(poinsot_app, probe):
-    """A slider change is rebuilt and on the wire quickly (the benchmark measures it
-    precisely; this bound is loose for a loaded CI machine)."""
+def test_a_slider_move_is_one_rebuild_and_one_new_ellipsoid(poinsot_app, probe):
+    """Each slider value is rebuilt once and its ellipsoid reaches the client that moved it
+    (how fast is ``poinsot benchmark``'s "slider-to-redraw" and "server rebuild alone")."""
     session = session_of(poinsot_app)
     uuid, _ = probe.widget("I₂")
     for value in (1.7, 1.8, 1.9):  # valid bodies: I3 = 2.6 <= I1 + I2
-        start = time.perf_counter()
+        rebuilds = session.stats.rebuilds
         probe.set_value(uuid, value)
         assert probe.wait_for(
             lambda p, v=value: (
@@ -375,11 +388,12 @@ def test_slider_to_redraw_is_fast(poinsot_app, probe):
                     session.scene.geometry.semi_axes,
                 )
             ),
-            5,
+            15,
         )
-        assert time.perf_counter() - start < 0.5
-    slider_rebuilds = list(session.stats.rebuild_seconds)[-3:]  # not the first, full build
-    assert max(slider_rebuilds) < 0.1, slider_rebuilds
+        # (counted just after the flush that the probe may already have read)
+        assert wait_until(lambda r=rebuilds: session.stats.rebuilds > r, 15)
+        assert session.stats.rebuilds == rebuilds + 1
+    assert session.stats.errors == 0, session.stats.last_error
 
 
 def _session_threads() -> list[str]:

@@ -8,11 +8,10 @@ message in the folder and the scene as it was, with nothing non-finite sent."""
 from __future__ import annotations
 
 import threading
-import time
 
 import numpy as np
 import pytest
-from conftest import session_of, wait_until
+from conftest import after_frames, session_of, wait_until
 from test_scene_geometry import check_finite
 from test_server import markdown_texts
 from uploading import (
@@ -84,7 +83,9 @@ def scene_shown(session, probe):
 
 def assert_kept(session, probe, before) -> None:
     body, preset, scale = before
-    time.sleep(0.3)  # anything the refusal would have sent has arrived by now
+    received = len(probe.batches)
+    after_frames(session)  # anything the refusal would have sent went out before these frames
+    assert probe.wait_for(lambda p: len(p.batches) >= received + 5, 15)
     assert session.body is body and session.preset is preset
     assert np.allclose(ellipsoid_scale(probe), scale)
     assert session.stats.errors == 0, session.stats.last_error
@@ -238,7 +239,8 @@ def test_an_upload_that_finishes_after_its_folder_is_gone(toss_page, probe, monk
     assert wait_until(lambda: "Fitting toss.csv" in session.uploads.toss_lines.status, 10)
     choose(probe, session, preset_by_key("major").label)
     assert probe.wait_for(lambda p: RECORDING not in shown_labels(p), 10)
-    time.sleep(0.5)
+    assert wait_until(lambda: session.preset.key == "major", 10)
+    after_frames(session)  # the switch is drawn while the fit is still held
     release.set()
     finished(session, 1)
     assert wait_until(lambda: session.preset.key == "fitted_toss", 10)

@@ -189,6 +189,7 @@ WINDOW = 6.0  # seconds of frames counted, quiet and flooded (compared as a rati
 
 
 @pytest.mark.slow
+@pytest.mark.serial  # the flooder needs its 10k messages a second: no other test beside it
 def test_a_flooding_client_is_cut_off_and_the_others_keep_their_frames(make_app, make_probe):
     """A raw client (its own process) sends 10k camera messages a second: beyond its budget
     they are dropped unread by viser, then it is disconnected; another client's frames during

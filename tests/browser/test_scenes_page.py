@@ -6,6 +6,8 @@ takes the browser from a preset to a scene and back."""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 from conftest import session_of, wait_until
@@ -50,11 +52,21 @@ def changed(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def settle(page, session, spec: SceneSpec) -> None:
-    """Let the scene play a moment (its traces grow), then pause it."""
+    """Let the scene play a moment (its traces grow), then pause it (``render`` then waits
+    until two pictures in a row agree: the pause has reached the page)."""
     assert wait_until(lambda: session.showcase is not None and session.showcase.loaded, 20)
     assert wait_until(lambda: session.stats.frames > 60, 30), "the scene is not animating"
     session.clock.paused = True
-    page.page.wait_for_timeout(600)
+
+
+def render_until(session, done, timeout: float = 60.0) -> np.ndarray:
+    """The first settled render for which ``done(picture)`` holds (the page applies a change
+    on its next frames: the event waited for is the picture itself), or the last one."""
+    deadline = time.monotonic() + timeout
+    picture = render(session)
+    while not done(picture) and time.monotonic() < deadline:
+        picture = render(session)  # each a round trip to the page: no sleep needed
+    return picture
 
 
 def check_parts(page, session, spec: SceneSpec, shown: np.ndarray) -> None:
@@ -65,8 +77,7 @@ def check_parts(page, session, spec: SceneSpec, shown: np.ndarray) -> None:
     for part in spec.parts:
         page.set_checkbox(part.label, False)
         assert wait_until(lambda p=part: not drawing.parts.is_visible(p.key), 10), part.key
-        page.page.wait_for_timeout(400)
-        hidden = render(session)
+        hidden = render_until(session, lambda picture: changed(shown, picture) > 2e-4)
         assert changed(shown, hidden) > 2e-4, (spec.name, part.key)
         gone = np.abs(shown - hidden).sum(axis=2) > 40
         for color in part.colors:
@@ -74,7 +85,7 @@ def check_parts(page, session, spec: SceneSpec, shown: np.ndarray) -> None:
             assert int(np.sum(gone & near)) >= MIN_COLOUR_PIXELS, (spec.name, part.key, color)
         page.set_checkbox(part.label, True)
         assert wait_until(lambda p=part: drawing.parts.is_visible(p.key), 10), part.key
-    page.page.wait_for_timeout(400)
+        render_until(session, lambda picture, h=hidden: changed(h, picture) > 2e-4)  # again
 
 
 def test_every_scene_draws_its_parts_distinctly(make_app, open_page):

@@ -10,6 +10,7 @@ The study's building blocks are tested on their own below (cheap).
 from __future__ import annotations
 
 import csv
+import io
 import math
 import struct
 import subprocess
@@ -18,10 +19,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import STDERR_NAME
 from PIL import Image
+from rich.console import Console
 
 from poinsot.app.report.cases import CASES, StudyConfig
-from poinsot.app.report.progress import Progress
+from poinsot.app.report.progress import PLAIN_STEPS, Progress
 from poinsot.app.report.reference import TaylorReference
 from poinsot.app.report.runs import time_scale
 from poinsot.app.report.tables import ERROR_VS_TIME_COLUMNS, EXACT, WORK_PRECISION_COLUMNS
@@ -231,13 +234,61 @@ def test_taylor_reference_agrees_with_the_exact_solution():
         assert c.omega_error < 1e-12 and c.attitude_error < 1e-11
 
 
-def test_progress_bar_writes_to_stderr(capsys):
+@pytest.fixture
+def plain_env(monkeypatch) -> None:
+    """No variable that would make rich take a file for a terminal."""
+    for name in ("FORCE_COLOR", "TTY_COMPATIBLE", "TTY_INTERACTIVE"):
+        monkeypatch.delenv(name, raising=False)
+
+
+def test_progress_in_a_file_is_a_few_plain_lines(capsys, plain_env):
+    bar = Progress(1000)
+    for k in range(1000):
+        bar.advance(f"step {k}")
+    bar.close()
+    err = capsys.readouterr().err
+    lines = err.splitlines()
+    assert "\r" not in err and "\x1b" not in err
+    assert len(lines) == PLAIN_STEPS, lines  # one per tenth, the last one says 100 %
+    assert lines[0].startswith("report:  10%") and lines[-1].startswith("report: 100%")
+    assert err.endswith("\n")
+
+
+def test_progress_closed_early_still_says_done(capsys, plain_env):
     bar = Progress(4)
+    bar.advance("a")
+    bar.close()
+    assert capsys.readouterr().err.splitlines() == ["report:  25%  a", "report: 100%  done"]
+
+
+def test_progress_on_a_terminal_is_a_rich_bar():
+    out = io.StringIO()
+    console = Console(file=out, force_terminal=True, force_interactive=True, width=100)
+    bar = Progress(4, console=console)
     bar.advance("a")
     bar.advance("b", 2)
     bar.close()
-    err = capsys.readouterr().err
-    assert "[" in err and "100%" in err and err.endswith("\n")
+    text = out.getvalue()
+    assert "━" in text and "100%" in text and "done" in text  # rich's bar, filled
+    assert "report:" not in text  # not the plain lines
+
+
+def test_progress_disabled_writes_nothing(capsys):
+    bar = Progress(4, enabled=False)
+    bar.advance("a")
+    bar.close()
+    assert capsys.readouterr().err == ""
+
+
+@pytest.mark.slow
+def test_report_quick_into_a_file_writes_a_few_lines_of_progress(quick_report):
+    """``poinsot report --quick 2> file``: stderr as a file holds a few plain lines, not
+    hundreds of carriage-return frames of a bar."""
+    err = (quick_report / STDERR_NAME).read_text()
+    assert "\r" not in err and "\x1b" not in err
+    progress = [line for line in err.splitlines() if line.startswith("report:")]
+    assert 1 <= len(progress) <= PLAIN_STEPS, err
+    assert progress[-1].startswith("report: 100%")
 
 
 def test_python_dash_m_runs_the_report_command():
