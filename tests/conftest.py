@@ -23,6 +23,8 @@ import io
 import os
 import re
 import shutil
+import subprocess
+import sys
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -177,6 +179,17 @@ def probe(poinsot_app, make_probe) -> Probe:
         15,
     ), "scene never arrived"
     return p
+
+
+def run_command(argv: list[str], timeout: float = 900.0) -> subprocess.CompletedProcess[str]:
+    """``poinsot ARGV`` in a process of its own (its output as text), as a lecturer runs it."""
+    return subprocess.run(
+        [sys.executable, "-m", "poinsot.app.cli", *argv],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        check=False,
+    )
 
 
 def session_of(app: PoinsotApp, count: int = 1, timeout: float = 10.0) -> Session:

@@ -149,11 +149,19 @@ def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(
     assert poinsot_app.guard.malformed > 0
     assert not [r for r in caplog.records if r.levelname == "ERROR"], caplog.text[:2000]
     assert math.isfinite(session.clock.speed) and math.isfinite(session.clock.now())
-    for widget in _inputs(probe).values():
+
+    def in_range(widget: Any) -> bool:
         if "min" in widget.props and widget.value is not None:
-            assert widget.props["min"] <= widget.value <= widget.props["max"], widget.props
-        if "options" in widget.props:
-            assert widget.value in widget.props["options"], widget.props
+            return bool(widget.props["min"] <= widget.value <= widget.props["max"])
+        return "options" not in widget.props or widget.value in widget.props["options"]
+
+    # A widget's new range and its new value are two messages: wait for both to arrive.
+    def all_in_range(p: Probe) -> bool:
+        return all(in_range(w) for w in p.widgets.values() if w.type in INPUTS)
+
+    assert probe.wait_for(all_in_range, 15), [
+        w.props for w in _inputs(probe).values() if not in_range(w)
+    ]
 
 
 def test_a_number_beyond_the_range_is_clamped_and_shown_clamped(poinsot_app, probe):

@@ -17,6 +17,9 @@ from poinsot.app.scene import palette
 
 pytestmark = pytest.mark.browser
 
+#: What Chromium logs when a mouse press lands on a node that viser binds for dragging.
+DRAG_BINDING = "Unable to preventDefault inside passive event listener invocation."
+
 
 def amber_fraction(rgb: np.ndarray) -> float:
     """Fraction of pixels with the ellipsoid's hue (amber, 22-45 degrees), saturated and not
@@ -185,4 +188,7 @@ def test_a_real_browser_sends_only_what_the_wire_allows(poinsot_app, open_page):
     assert wait_until(lambda: session.stats.frames > frames + 10, 15)
     guard = poinsot_app.guard
     assert guard.closed_for_message == 0 and guard.malformed == 0 and guard.dropped == 0
-    assert len(poinsot_app.sessions()) == 1 and page.errors == []
+    # A mouse press on the energy ellipsoid (its drag binding: a start is pointed at by hand)
+    # makes Chromium note that viser's handler cannot cancel a passive event; nothing else may.
+    errors = [e for e in page.errors if e != DRAG_BINDING]
+    assert len(poinsot_app.sessions()) == 1 and errors == []

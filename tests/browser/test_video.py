@@ -9,10 +9,9 @@ import imageio.v2 as imageio
 import imageio.v3 as iio
 import numpy as np
 import pytest
-from conftest import chromium_or_fail
+from conftest import chromium_or_fail, run_command
 from PIL import Image
 
-from poinsot.app import cli
 from poinsot.app.exports.screenshot import THEME_BACKGROUND
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
@@ -27,11 +26,12 @@ def run_video(tmp_path, capsys, suffix: str):
     chromium_or_fail()
     out = tmp_path / f"v{suffix}"
     argv = ["video", "--preset", "t_handle", "--seconds", "4", "--fps", "25"]
-    code = cli.main([*argv, "--size", "640x360", "--out", str(out)])
-    captured = capsys.readouterr()
-    assert code == 0, captured.err
-    assert f"wrote {out} (640x360, 100 frames at 25 fps" in captured.out, captured.out
-    assert "100/100 frames" in captured.err  # the progress (plain lines: not a terminal)
+    # A process of its own, as a lecturer runs it (this one may already drive Chromium through
+    # playwright's sync API, which allows one per thread).
+    done = run_command([*argv, "--size", "640x360", "--out", str(out)])
+    assert done.returncode == 0, done.stderr
+    assert f"wrote {out} (640x360, 100 frames at 25 fps" in done.stdout, done.stdout
+    assert "100/100 frames" in done.stderr  # the progress (plain lines: not a terminal)
     return out
 
 
