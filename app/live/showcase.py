@@ -24,7 +24,16 @@ from poinsot.app.scene import palette
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scenes.runtime import Showcase
-from poinsot.app.scenes.spec import Choice, PlotSpec, SceneControl, SceneSpec, Slider, Value, table
+from poinsot.app.scenes.spec import (
+    START_KEY,
+    Choice,
+    PlotSpec,
+    SceneControl,
+    SceneSpec,
+    Slider,
+    Value,
+    table,
+)
 from poinsot.physics import FreeRigidBody
 
 #: Order of the scene's folder in the panel (after "Scene", before "Playback").
@@ -140,9 +149,12 @@ class LiveShowcase:
         return self.showcase.model is not None
 
     def configure(self, key: str, value: Value) -> bool:
-        """Ask for a new setting; True if the scene must be rebuilt."""
+        """Ask for a new setting; True if the scene must be rebuilt. A control moved drops a
+        start pointed at (the control chooses the motion again)."""
         if self.desired.get(key) == value:
             return False
+        if key != START_KEY:
+            self.desired.pop(START_KEY, None)
         self.desired[key] = value
         return True
 
