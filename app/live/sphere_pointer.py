@@ -33,6 +33,7 @@ from poinsot.app.live.showcase import LiveShowcase
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.geometry import POLHODE_INFLATE
+from poinsot.app.scenes import colors
 from poinsot.app.scenes.momentum import MomentumPicture
 from poinsot.app.scenes.spec import START_KEY, Value, start_setting
 from poinsot.physics import FreeRigidBody
@@ -187,8 +188,8 @@ class SpherePointer:
             s.client.scene.add_line_segments(
                 name,
                 segments,
-                colors=s.scene.look.polhode,
-                thickness=4.0,
+                colors=colors.POINTED,
+                thickness=5.0,
                 thickness_units="screen",
             )
             for name, segments in zip(names, lines, strict=True)
