@@ -88,9 +88,12 @@ class SpherePointer:
         picture = self.picture()
         if picture is self._bound:
             return
-        for handle in self.previews_drawn:  # the last scene's: gone with it, or stale
-            handle.remove()
+        if self.previews_drawn:  # the last scene's: the sphere's went with its group
+            self.previews_drawn[1].remove()
+        if self._paused_before is not None:  # a drag cut short by the change of scene
+            self.session.clock.paused = self._paused_before
         self.previews_drawn, self.last, self._bound = [], None, picture
+        self._paused_before = None
         if picture is not None:
             if self.dragging:
                 picture.sphere.on_drag(self._on_drag)

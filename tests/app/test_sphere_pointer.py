@@ -145,3 +145,25 @@ def test_a_ray_that_misses_the_sphere_does_nothing_and_the_slider_takes_over(
     session.configure_scene("D", 2.3)
     assert wait_until(lambda: session.showcase.showcase.model.D == 2.3, 15)
     assert "start" not in session.showcase.desired
+
+
+@pytest.mark.filterwarnings("error::UserWarning")
+def test_the_sphere_of_a_scene_shown_again_takes_a_start(make_app, make_probe) -> None:
+    session = _scene(make_app, make_probe)
+    pointer = session.sphere_pointer
+    target = [0.9, 0.4, -0.2]
+    _run(session, lambda: pointer.drag(_ray_at(session, _on_sphere(_G(session), target))))
+    assert pointer.previews == 1 and session.clock.paused
+    family = scene_by_name("polhode-family")
+    for spec in (scene_by_name("dzhanibekov"), family):  # a drag cut short by a change of scene
+        session.choose_scene(spec)
+        assert wait_until(
+            lambda s=spec: session.showcase is not None and session.showcase.spec is s, 15
+        )
+    assert wait_until(lambda: session.showcase.loaded, 15)
+    _run(session, lambda: None)
+    assert pointer.previews_drawn == [] and not session.clock.paused
+    body = session.body
+    _run(session, lambda: pointer.release(_ray_at(session, _on_sphere(_G(session), target))))
+    assert wait_until(lambda: session.body is not body, 15)
+    assert pointer.starts == 1 and session.stats.errors == 0 and session.status == ""
