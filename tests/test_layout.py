@@ -285,6 +285,8 @@ def test_tests_sleep_only_where_the_list_says_why():
             found += [f"{rel}:{line} in {function.name}" for line in lines]
     assert not found, f"sleeps in tests (wait for the event instead): {found}"
     assert seen == set(SLEEPS_ALLOWED), f"allowed but gone: {set(SLEEPS_ALLOWED) - seen}"
+
+
 #: Private attributes of viser's objects that Poinsot has reached for (viser 1.1.x). They are
 #: recognised by name, since a scan cannot know an object's type: each is a name viser keeps
 #: to itself on its server, its websocket server, a client's connection, a GUI, a scene API or
