@@ -30,6 +30,8 @@ __all__ = [
     "on_energy_ellipsoid",
     "ray_ellipsoid",
     "ray_sphere",
+    "momentum_from_ray",
+    "snap_momentum_to_separatrix",
     "snap_to_separatrix",
     "start_from_ray",
 ]
@@ -119,27 +121,63 @@ def snap_to_separatrix(
     """
     moments = check_inertia(inertia)
     w = np.asarray(omega, dtype=np.float64)
-    order = np.argsort(moments, kind="stable")
-    I1, I2, I3 = moments[order]
-    if not I1 < I2 < I3:
+    flat = _onto_separatrix_planes(moments, w, moments)
+    if flat is None:
         return w.copy(), np.zeros(w.shape[:-1], dtype=bool)
-    kappa = np.sqrt(I1 * (I2 - I1) / (I3 * (I3 - I2)))
-    w1, w3 = w[..., order[0]], w[..., order[2]]
-    sign = np.where(w1 * w3 < 0.0, -1.0, 1.0)
-    # The plane w3 - sign·κ·w1 = 0 of normal (-sign κ, 1)/√(1 + κ²) in the (w1, w3) plane.
-    n1, n3 = -sign * kappa / np.hypot(1.0, kappa), 1.0 / np.hypot(1.0, kappa)
-    along = w1 * n1 + w3 * n3
-    flat = w.copy()
-    flat[..., order[0]] = w1 - along * n1
-    flat[..., order[2]] = w3 - along * n3
     two_T = np.einsum("...i,i,...i->...", w, moments, w)
     with np.errstate(invalid="ignore", divide="ignore"):
         snapped = (
             flat * np.sqrt(two_T / np.einsum("...i,i,...i->...", flat, moments, flat))[..., None]
         )
-    near = np.linalg.norm(snapped - w, axis=-1) <= tolerance
+    return _where_near(w, snapped, tolerance)
+
+
+def snap_momentum_to_separatrix(
+    inertia: ArrayLike, momentum: ArrayLike, tolerance: float
+) -> tuple[Array, NDArray[np.bool_]]:
+    """Each body-frame L (..., 3) within ``tolerance`` (L's units) of the separatrix on its own
+    sphere ``|L| = G``, moved onto it at ``|L|`` kept: onto the nearer plane ``L₃ = ±μ L₁``
+    (sorted axes, ``μ = √(I₃(I₂ − I₁)/(I₁(I₃ − I₂)))``, the planes ``|L|² = I₂ Σ Lᵢ²/Iᵢ``
+    [LL76 §37]), then back onto the sphere along its direction.
+
+    Returns:
+        As :func:`snap_to_separatrix`, for L.
+    """
+    moments = check_inertia(inertia)
+    m = np.asarray(momentum, dtype=np.float64)
+    flat = _onto_separatrix_planes(moments, m, 1.0 / moments)
+    if flat is None:
+        return m.copy(), np.zeros(m.shape[:-1], dtype=bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        snapped = flat * (np.linalg.norm(m, axis=-1) / np.linalg.norm(flat, axis=-1))[..., None]
+    return _where_near(m, snapped, tolerance)
+
+
+def _onto_separatrix_planes(moments: Array, v: Array, weights: Array) -> Array | None:
+    """``v`` (..., 3) projected onto the nearer of the planes ``Σ wᵢ(Iᵢ − I₂) vᵢ² = 0``, in
+    sorted axes ``v₃ = ±κ v₁`` with ``κ² = w₁(I₂ − I₁) / (w₃(I₃ − I₂))``: the separatrix for ω
+    (``w = I``) and for L (``w = 1/I``); None without a separatrix (two equal moments)."""
+    order = np.argsort(moments, kind="stable")
+    I1, I2, I3 = moments[order]
+    if not I1 < I2 < I3:
+        return None
+    w1, w3 = weights[order[0]], weights[order[2]]
+    kappa = np.sqrt(w1 * (I2 - I1) / (w3 * (I3 - I2)))
+    v1, v3 = v[..., order[0]], v[..., order[2]]
+    sign = np.where(v1 * v3 < 0.0, -1.0, 1.0)
+    # The plane v3 - sign·κ·v1 = 0 of normal (-sign κ, 1)/√(1 + κ²) in the (v1, v3) plane.
+    n1, n3 = -sign * kappa / np.hypot(1.0, kappa), 1.0 / np.hypot(1.0, kappa)
+    along = v1 * n1 + v3 * n3
+    flat = v.copy()
+    flat[..., order[0]] = v1 - along * n1
+    flat[..., order[2]] = v3 - along * n3
+    return flat
+
+
+def _where_near(v: Array, snapped: Array, tolerance: float) -> tuple[Array, NDArray[np.bool_]]:
+    near = np.linalg.norm(snapped - v, axis=-1) <= tolerance
     near &= np.all(np.isfinite(snapped), axis=-1)
-    return np.where(near[..., None], snapped, w), near
+    return np.where(near[..., None], snapped, v), near
 
 
 def start_from_ray(
@@ -169,6 +207,27 @@ def start_from_ray(
     shape = np.broadcast_shapes(np.shape(origin), np.shape(direction))
     hit = ray_ellipsoid(o / scale, d / scale, np.sqrt(t2 / moments))
     return np.reshape(on_energy_ellipsoid(moments, t2, hit), shape)
+
+
+def momentum_from_ray(
+    G: float, origin: ArrayLike, direction: ArrayLike, scale: float = 1.0
+) -> Array:
+    """The body-frame L where each ray meets Landau's sphere ``|L| = G`` [LL76 §37].
+
+    Args:
+        G: ``|L|`` > 0, kept.
+        origin, direction: (..., 3) rays in the sphere's own axes (the body axes, centred on
+            the sphere), in drawn units: the sphere is drawn ``scale`` times its size in L's
+            units.
+
+    Returns:
+        (..., 3) L with ``|L| = G`` to rounding; NaN rows where a ray misses. Its ω is
+        :func:`omega_from_momentum`, and its energy ``T = ½ L·ω`` follows from the point.
+    """
+    g = check_positive(G, "|L|")
+    o = np.asarray(origin, dtype=np.float64) / scale
+    d = np.asarray(direction, dtype=np.float64) / scale
+    return ray_sphere(o, d, g)
 
 
 def body_from_start(

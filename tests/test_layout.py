@@ -285,3 +285,104 @@ def test_tests_sleep_only_where_the_list_says_why():
             found += [f"{rel}:{line} in {function.name}" for line in lines]
     assert not found, f"sleeps in tests (wait for the event instead): {found}"
     assert seen == set(SLEEPS_ALLOWED), f"allowed but gone: {set(SLEEPS_ALLOWED) - seen}"
+
+
+#: Private attributes of viser's objects that Poinsot has reached for (viser 1.1.x). They are
+#: recognised by name, since a scan cannot know an object's type: each is a name viser keeps
+#: to itself on its server, its websocket server, a client's connection, a GUI, a scene API or
+#: a handle, and each may move in any viser release. Their one home is app/viser_private/,
+#: where tests/app/test_viser_private.py pins them; the names here are the ones that adapter
+#: holds (a new private name goes there, and here). ``self._x``/``cls._x`` are our own.
+PRIVATE_VISER_ATTRIBUTES = frozenset(
+    {
+        "_assignable_props_api",
+        "_background_event_loop",
+        "_client_state_from_id",
+        "_connected_clients",
+        "_current_file_upload_states",
+        "_event_loop",
+        "_gui_input_handle_from_uuid",
+        "_impl",
+        "_incoming_handlers",
+        "_live_connections",
+        "_marks",
+        "_messages",
+        "_prop_hints",
+        "_queue_scene_message",
+        "_thread_executor",
+        "_viser_server",
+        "_websock_connection",
+        "_websock_server",
+        # public names on viser's private message buffer
+        "generator_cursors",
+        "message_from_id",
+        "message_counter",
+        "get_message_buffer",
+    }
+)
+VISER_ADAPTER = ROOT / "app" / "viser_private"
+
+
+def _private_viser_uses(source: str) -> list[str]:
+    """Where ``source`` names a private part of viser: an import of a private viser module or
+    name, ``viser._x``, ``x.<private attribute>`` (``self``/``cls`` excepted), or a
+    ``getattr``/``setattr``/``hasattr`` of one."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        line = getattr(node, "lineno", 0)
+        if isinstance(node, ast.Import):
+            modules = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            modules = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+        else:
+            modules = []
+        for module in modules:
+            parts = module.split(".")
+            if parts[0] == "viser" and any(p.startswith("_") for p in parts[1:]):
+                found.append(f"{line}: import {module}")
+        if isinstance(node, ast.Attribute):
+            owner = node.value.id if isinstance(node.value, ast.Name) else None
+            dunder = node.attr.startswith("__")
+            if owner == "viser" and node.attr.startswith("_") and not dunder:
+                found.append(f"{line}: viser.{node.attr}")
+            elif node.attr in PRIVATE_VISER_ATTRIBUTES and owner not in ("self", "cls"):
+                found.append(f"{line}: .{node.attr}")
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+            if node.func.id in ("getattr", "setattr", "hasattr") and len(node.args) >= 2:
+                name = node.args[1]
+                if isinstance(name, ast.Constant) and name.value in PRIVATE_VISER_ATTRIBUTES:
+                    found.append(f"{line}: {node.func.id}(..., {name.value!r})")
+    return found
+
+
+def test_viser_s_private_names_are_used_only_in_the_adapter():
+    """One door to viser's internals: app/viser_private/ (its docstring is the inventory)."""
+    used = {}
+    for f in sorted((ROOT / "app").rglob("*.py")):
+        if VISER_ADAPTER in f.parents:
+            continue
+        found = _private_viser_uses(f.read_text())
+        if found:
+            used[str(f.relative_to(ROOT))] = found
+    assert not used, f"private viser names outside app/viser_private/: {used}"
+
+
+def test_the_private_name_scan_sees_each_form():
+    source = "\n".join(
+        [
+            "from viser import _messages",
+            "from viser._messages import GuiSliderMark",
+            "import viser._viser",
+            "from viser.infra._infra import WebsockServer",
+            "x = viser._messages.Message",
+            "slider._marks = ()",
+            "loop = gui._event_loop",
+            "c = server._websock_server._live_connections",
+            "b = getattr(client, '_websock_connection', None)",
+            "n = buffer.generator_cursors",
+            "self._marks = []  # our own",
+            "v = viser.__version__",
+        ]
+    )
+    lines = {int(hit.split(":")[0]) for hit in _private_viser_uses(source)}
+    assert lines == set(range(1, 11))

@@ -28,7 +28,8 @@ from typing import Any, Protocol
 
 import viser
 
-from poinsot.app.live.pacing import Outbox, connection_of
+from poinsot.app.live.pacing import Outbox
+from poinsot.app.viser_private.transport import connection_of
 
 log = logging.getLogger(__name__)
 

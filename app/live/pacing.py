@@ -7,9 +7,10 @@ write buffer is full (websockets waits for the socket to drain), that is while t
 the network to it, does not keep up. Past the queue, the bytes wait in the websocket's write
 buffer and then in the kernel's socket buffer until the client's side acknowledges them (TCP);
 the kernel lets that buffer grow to megabytes, thousands of stale frames for a client that
-reads nothing. :class:`Outbox` reads, for one client, the id of the last message the frame
-put in the queue, how far the draining task has got, and the bytes written but not yet
-acknowledged by the client (the transport's buffer plus the socket's ``SIOCOUTQ``).
+reads nothing. :class:`Outbox` reads, for one client (through the adapter
+:mod:`poinsot.app.viser_private.transport`), the id of the last message the frame put in the
+queue, how far the draining task has got, and the bytes written but not yet acknowledged by the
+client (the transport's buffer plus the socket's ``SIOCOUTQ``).
 
 :class:`Pacer` is the session's frame-rate controller. After each frame it records the frame's
 last message id (:meth:`Pacer.sent`); before the next it asks how many frames are still
@@ -37,6 +38,8 @@ import termios
 from typing import Any
 
 import viser
+
+from poinsot.app.viser_private import transport as private
 
 #: Frames a client may have queued, not yet taken, before the next frame is skipped. 0: a
 #: frame is drawn only once the one before was taken; with 1, under a busy event loop, a
@@ -66,7 +69,7 @@ class Outbox:
     def __init__(self, client: viser.ClientHandle) -> None:
         self.client = client
         self.client_id = client.client_id
-        self._buffer: Any = _message_buffer(client)
+        self._buffer: Any = private.message_buffer(client)
         self._transport: Any = _transport(client)
 
     @property
@@ -75,17 +78,17 @@ class Outbox:
 
     def last_queued(self) -> int:
         """The id of the last message put in the client's queue (-1: none)."""
-        return int(self._buffer.message_counter) - 1 if self._buffer is not None else -1
+        return private.last_queued(self._buffer) if self._buffer is not None else -1
 
     def last_taken(self) -> int:
         """The id of the last message the client's sender has taken from the queue (every
         message after it is still queued)."""
-        taken = None if self._buffer is None else self._buffer.generator_cursors.get(self.client_id)
-        return self.last_queued() if taken is None else int(taken)  # no sender yet: nothing due
+        taken = None if self._buffer is None else private.last_taken(self._buffer, self.client_id)
+        return self.last_queued() if taken is None else taken  # no sender yet: nothing due
 
     def pending(self) -> int:
         """Messages in the client's queue now (after viser's coalescing of updates)."""
-        return len(self._buffer.message_from_id) if self._buffer is not None else 0
+        return private.pending(self._buffer) if self._buffer is not None else 0
 
     def unacknowledged(self) -> int:
         """Bytes written to the client and not yet acknowledged by it: the websocket
@@ -104,30 +107,9 @@ class Outbox:
             return 0
 
 
-def _message_buffer(client: viser.ClientHandle) -> Any:
-    """viser 1.1 keeps the queue on the client's connection; None if that ever changes (the
-    pacer then never skips: the behaviour before pacing)."""
-    connection = getattr(client, "_websock_connection", None)
-    getter = getattr(connection, "get_message_buffer", None)
-    if getter is None:
-        return None
-    buffer = getter()
-    needed = ("message_counter", "generator_cursors", "message_from_id")
-    return buffer if all(hasattr(buffer, name) for name in needed) else None
-
-
-def connection_of(client: viser.ClientHandle) -> tuple[Any, Any]:
-    """The client's websocket connection and the event loop it runs on (viser 1.1 keeps the
-    live connections and the loop on its websocket server), or Nones."""
-    server = getattr(getattr(client, "_viser_server", None), "_websock_server", None)
-    connections = getattr(server, "_live_connections", None)
-    connection = connections.get(client.client_id) if isinstance(connections, dict) else None
-    return connection, getattr(server, "_background_event_loop", None)
-
-
 def _transport(client: viser.ClientHandle) -> Any:
     """The asyncio transport of the client's websocket, or None."""
-    transport = getattr(connection_of(client)[0], "transport", None)
+    transport = getattr(private.connection_of(client)[0], "transport", None)
     return transport if hasattr(transport, "get_write_buffer_size") else None
 
 

@@ -15,7 +15,6 @@ time, readouts and the plot of ω are in the floating "Motion" window
 
 from __future__ import annotations
 
-import asyncio
 import dataclasses
 import math
 from collections.abc import Callable, Iterable
@@ -46,6 +45,7 @@ from poinsot.app.parameters import (
 from poinsot.app.presets import MENU, Preset
 from poinsot.app.scenes import SCENES, scene_by_label
 from poinsot.app.scenes.spec import SceneSpec
+from poinsot.app.viser_private import gui_event_loop
 
 ELEMENT_LABELS: dict[Element, str] = {
     Element.ELLIPSOID: "energy ellipsoid",
@@ -176,7 +176,7 @@ class ControlPanel:
         #: The browser's choices in the menu (a preset shown for an older one is not written
         #: over a newer one: :meth:`show_preset`).
         self.menu = Sent(preset.label)
-        self._loop: asyncio.AbstractEventLoop = gui._event_loop  # viser's; runs the menu's writes
+        self._loop = gui_event_loop(gui)  # viser's; runs the menu's writes
         on_user(self.preset, self._choose_preset, self.actions.report, self.menu, inline=True)
 
     def _on_user(self, handle: H, callback: Callable[[Sent], None]) -> H:

@@ -128,12 +128,7 @@ class Pointer:
 
     def snap_world(self, distance: float) -> float:
         """:data:`SNAP_PX` pixels as a length at ``distance`` from the camera (display units)."""
-        camera = self.session.client.camera
-        try:
-            height = float(camera.image_height) or DEFAULT_HEIGHT_PX
-        except AssertionError:  # the browser has not reported its canvas yet
-            height = DEFAULT_HEIGHT_PX
-        return SNAP_PX * distance * pixel_angle(float(camera.fov), height)
+        return snap_length(self.session.client.camera, distance)
 
     def drag(self, ray: Ray) -> None:
         """Draw the polhode through the start under the pointer; the motion stands still."""
@@ -192,6 +187,15 @@ class Pointer:
         else:
             self.preview.points = segments
             self.preview.visible = True
+
+
+def snap_length(camera: viser.CameraHandle, distance: float) -> float:
+    """:data:`SNAP_PX` pixels as a length at ``distance`` from ``camera`` (display units)."""
+    try:
+        height = float(camera.image_height) or DEFAULT_HEIGHT_PX
+    except AssertionError:  # the browser has not reported its canvas yet
+        height = DEFAULT_HEIGHT_PX
+    return SNAP_PX * distance * pixel_angle(float(camera.fov), height)
 
 
 def pixel_angle(fov: float, height_px: float) -> float:

@@ -21,7 +21,8 @@ import numpy as np
 import viser
 import websockets.sync.client
 import zstandard
-from viser import _messages
+
+from poinsot.app.viser_private import encode, wire_message
 
 
 @dataclasses.dataclass
@@ -139,7 +140,8 @@ class Probe:
 
     def _send_camera(self) -> None:
         self.send(
-            _messages.ViewerCameraMessage(
+            wire_message(
+                "ViewerCameraMessage",
                 wxyz=(1.0, 0.0, 0.0, 0.0),
                 position=(3.0, -3.0, 2.0),
                 fov=0.8,
@@ -176,8 +178,9 @@ class Probe:
             self._reading.set()
 
     # -- sending -------------------------------------------------------------------------
-    def send(self, message: _messages.Message) -> None:
-        self._ws.send(msgspec.msgpack.encode(message.as_serializable_dict()))
+    def send(self, message: Any) -> None:
+        """One of viser's messages (:func:`~poinsot.app.viser_private.wire_message`)."""
+        self._ws.send(encode(message))
 
     def send_raw(self, frame: bytes | str) -> None:
         """Any frame at all (binary for bytes, text for str): what a hostile script sends."""
@@ -186,15 +189,16 @@ class Probe:
     def set_value(self, uuid: str, value: Any) -> None:
         """What the browser sends when the user moves a slider, ticks a box, picks an option,
         or clicks a button (``value=True``)."""
-        self.send(_messages.GuiUpdateMessage(uuid, {"value": value}))
+        self.send(wire_message("GuiUpdateMessage", uuid, {"value": value}))
 
     def drag(self, name: str, phase: str, end: tuple[float, float, float]) -> None:
         """What the browser sends while the left button drags the node ``name`` (a drag on a
         node with a drag binding), the pointer at the world point ``end``."""
         node = self.nodes.get(name)
         self.send(
-            _messages.SceneNodeDragMessage(
-                phase=phase,  # type: ignore[arg-type]
+            wire_message(
+                "SceneNodeDragMessage",
+                phase=phase,
                 name=name,
                 instance_index=None,
                 start_position=end,
@@ -263,8 +267,11 @@ class Probe:
         localStorage holds nothing (the server then opens its default scene at once)."""
         if m["type"] == "LocalStorageGetItemRequestMessage":
             self.send(
-                _messages.LocalStorageGetItemResponseMessage(
-                    value=None, error=None, request_uuid=str(m["request_uuid"])
+                wire_message(
+                    "LocalStorageGetItemResponseMessage",
+                    value=None,
+                    error=None,
+                    request_uuid=str(m["request_uuid"]),
                 )
             )
 

@@ -29,6 +29,7 @@ from poinsot.app.live.pacing import Outbox, Pacer, SessionStats
 from poinsot.app.live.panel import ControlPanel
 from poinsot.app.live.pointer import Pointer
 from poinsot.app.live.showcase import LiveShowcase
+from poinsot.app.live.sphere_pointer import SpherePointer
 from poinsot.app.live.uploads import UploadControls
 from poinsot.app.live.widgets import Retirement
 from poinsot.app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters, drawn_solid
@@ -98,6 +99,7 @@ class Session:
         self._last_plot = self._last_time = 0.0  # monotonic times of the last refreshes
         #: The scene being shown, if one is chosen instead of a preset (frame thread).
         self.showcase: LiveShowcase | None = None
+        self.sphere_pointer: SpherePointer | None = None  # mounted with the pointer below
         self.speed_range = SPEED_RANGE
 
         apply_theme(client)
@@ -115,6 +117,8 @@ class Session:
         self.ghost = add_ghost_controls(self)  # its controls; the ghost when switched on
         self.layout = Layout(self, self.panel.motion, user_agent)  # a phone's, a tablet's page
         self.pointer = Pointer(self, drag=not self.layout.touch)  # a start pointed at
+        self.sphere_pointer = SpherePointer(self, drag=not self.layout.touch)
+        self.sphere_pointer.bind()  # on Landau's sphere, in a scene that draws one
         self._fit_ghost()
 
     # -- lifecycle -----------------------------------------------------------------------
@@ -370,6 +374,8 @@ class Session:
         self.panel.show_preset(self.preset, menu_count)
         self._show_playback()
         scene.view.apply(self.client.camera)
+        if self.sphere_pointer is not None:
+            self.sphere_pointer.bind()
         self._dirty = True
 
     def _declare(

@@ -11,6 +11,7 @@ spec's controls, part checkboxes and plots are created, in a folder of their own
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any, Protocol
 
@@ -19,12 +20,21 @@ import viser
 import viser.uplot
 
 from poinsot.app.live.motion_window import MotionWindow
-from poinsot.app.live.widgets import Removable, Retirement, Sent, on_user
+from poinsot.app.live.widgets import Removable, Retirement, Sent, on_user, set_value
 from poinsot.app.scene import palette
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scenes.runtime import Showcase
-from poinsot.app.scenes.spec import Choice, PlotSpec, SceneControl, SceneSpec, Slider, Value, table
+from poinsot.app.scenes.spec import (
+    START_KEY,
+    Choice,
+    PlotSpec,
+    SceneControl,
+    SceneSpec,
+    Slider,
+    Value,
+    table,
+)
 from poinsot.physics import FreeRigidBody
 
 #: Order of the scene's folder in the panel (after "Scene", before "Playback").
@@ -64,6 +74,7 @@ class LiveShowcase:
         self.desired: dict[str, Value] = spec.defaults()
         self.widgets: list[Removable] = []
         self.plots: dict[str, viser.GuiUplotHandle] = {}
+        self.sliders: dict[str, viser.GuiSliderHandle[float]] = {}
         self._shown: dict[str, int] = {}  # plot key -> samples last sent
         self._last_readout = self._last_plot = -1e9
         self._readout_text = ""
@@ -98,6 +109,7 @@ class LiveShowcase:
                 hint=control.hint or None,
                 order=order,
             )
+            self.sliders[control.key] = slider
             return self._on_user(slider, self._slider_callback(control))
         if control.buttons:
             group = gui.add_button_group(control.label, control.options, order=order)
@@ -140,19 +152,35 @@ class LiveShowcase:
         return self.showcase.model is not None
 
     def configure(self, key: str, value: Value) -> bool:
-        """Ask for a new setting; True if the scene must be rebuilt."""
+        """Ask for a new setting; True if the scene must be rebuilt. A control moved drops a
+        start pointed at (the control chooses the motion again)."""
         if self.desired.get(key) == value:
             return False
+        if key != START_KEY:
+            self.desired.pop(START_KEY, None)
         self.desired[key] = value
         return True
 
     def load(self, frame_time: float) -> Frame:
         """Build and show the desired settings at t = 0 (ValueError: the last scene is kept)."""
         frame = self.showcase.load(self.desired, t=0.0, frame_time=frame_time)
+        if START_KEY in self.desired:
+            self._show_model_values()
         self._shown.clear()
         self._last_readout = self._last_plot = -1e9
         self.refresh(0.0, frame.t)
         return frame
+
+    def _show_model_values(self) -> None:
+        """After a start pointed at, a slider whose key the model has (the D the point gave)
+        shows the model's value (a server-set value calls no scene callback)."""
+        model = self.showcase.model
+        for key, handle in self.sliders.items():
+            value = getattr(model, key, None)
+            if isinstance(value, float) and math.isfinite(value):
+                value = min(max(value, handle.min), handle.max)
+                self.desired[key] = value
+                set_value(handle, value)
 
     def advance(self, t: float) -> Frame:
         return self.showcase.advance(t)

@@ -15,10 +15,9 @@ a transfer whose parts add up to more than it announced is dropped. Parts held f
 that never completes are freed when the client leaves (viser drops its transfers then);
 :meth:`TransferGuard.pending_bytes` counts them.
 
-This reaches into two of viser 1.1's internals, both kept in this module: the client's message
-interface (``ClientHandle._websock_connection``), where the handlers are registered, and the
-GUI's tables of widgets and of transfers in progress (``GuiApi._gui_input_handle_from_uuid``,
-``GuiApi._current_file_upload_states``).
+This reaches into two of viser 1.1's internals, both through the adapter
+:mod:`poinsot.app.viser_private`: the client's message interface, where the handlers are
+registered, and the GUI's tables of widgets and of transfers in progress.
 """
 
 from __future__ import annotations
@@ -29,7 +28,8 @@ from collections.abc import Callable
 from typing import Any
 
 import viser
-from viser import _messages
+
+from poinsot.app import viser_private
 
 #: Transfers one client may have in progress at once.
 MAX_TRANSFERS = 2
@@ -43,9 +43,8 @@ MAX_DROPPED = 16
 Refusal = Callable[[str, str, int, int], None]
 
 
-def handle_id(handle: Any) -> str:
-    """The wire id of a GUI handle (viser 1.1 keeps it in ``handle._impl.uuid``)."""
-    return str(handle._impl.uuid)
+#: The wire id of a GUI handle.
+handle_id = viser_private.handle_id
 
 
 @dataclasses.dataclass
@@ -67,10 +66,9 @@ class TransferGuard:
         self._dropped: dict[str, _Dropped] = {}
         self._names: dict[str, str] = {}
         self._lock = threading.Lock()
-        connection = client._websock_connection
         # Registered after viser's own handlers, so each runs once viser has seen the message.
-        connection.register_handler(_messages.FileTransferStartUpload, self._on_start)
-        connection.register_handler(_messages.FileTransferPart, self._on_part)
+        viser_private.on_client_message(client, "FileTransferStartUpload", self._on_start)
+        viser_private.on_client_message(client, "FileTransferPart", self._on_part)
 
     def watch(self, handle: Any, cap: int) -> None:
         """Cap uploads to the button ``handle`` at ``cap`` bytes."""
@@ -101,13 +99,13 @@ class TransferGuard:
 
     # -- handlers (viser's event loop: short, never raising) -----------------------------
     def _states(self) -> dict[str, Any]:
-        return self._client.gui._current_file_upload_states
+        return viser_private.upload_states(self._client.gui)
 
-    def _on_start(self, client_id: int, message: _messages.FileTransferStartUpload) -> None:
+    def _on_start(self, client_id: int, message: Any) -> None:
         uuid, button = message.transfer_uuid, message.source_component_uuid
         if uuid not in self._states():
             return  # viser took nothing (no such widget)
-        handle = self._client.gui._gui_input_handle_from_uuid.get(button)
+        handle = viser_private.gui_widget(self._client.gui, button)
         if not isinstance(handle, viser.GuiUploadButtonHandle):
             self._states().pop(uuid, None)  # no browser uploads to a slider
             return
@@ -123,7 +121,7 @@ class TransferGuard:
         if button in self.caps:
             self._names[uuid] = message.filename
 
-    def _on_part(self, client_id: int, message: _messages.FileTransferPart) -> None:
+    def _on_part(self, client_id: int, message: Any) -> None:
         uuid = message.transfer_uuid
         with self._lock:
             dropped = self._dropped.get(uuid)
@@ -157,13 +155,13 @@ class TransferGuard:
     def _acknowledge(self, uuid: str, dropped: _Dropped, size: int) -> None:
         """Count a part of a refused transfer, and tell the browser it arrived."""
         dropped.received += size
-        self._client._websock_connection.queue_message(
-            _messages.FileTransferPartAck(
-                source_component_uuid=dropped.button,
-                transfer_uuid=uuid,
-                transferred_bytes=min(dropped.received, dropped.total),
-                total_bytes=dropped.total,
-            )
+        viser_private.send_to_client(
+            self._client,
+            "FileTransferPartAck",
+            source_component_uuid=dropped.button,
+            transfer_uuid=uuid,
+            transferred_bytes=min(dropped.received, dropped.total),
+            total_bytes=dropped.total,
         )
         if dropped.received >= dropped.total:
             with self._lock:

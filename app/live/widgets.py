@@ -26,7 +26,8 @@ from collections.abc import Callable, Hashable, Iterable
 from typing import Any, Protocol, TypeVar
 
 import viser
-from viser._messages import GuiSliderMark
+
+from poinsot.app import viser_private
 
 #: Delay between hiding a removed widget and deleting it [s]: a browser whose main thread
 #: stalls longer than this (1.5 s was seen to be too short for software WebGL switching
@@ -107,9 +108,8 @@ def set_value(handle: viser.GuiInputHandle[T], value: T) -> None:
 
 
 def set_marks(slider: viser.GuiSliderHandle[Any], marks: Iterable[tuple[float, str]]) -> None:
-    """Move a slider's labelled marks. viser 1.1 takes marks only as an argument of
-    ``add_slider``; a handle's ``marks`` attribute is not sent, the ``_marks`` property is."""
-    slider._marks = tuple(GuiSliderMark(value=float(v), label=label) for v, label in marks)
+    """Move a slider's labelled marks (viser 1.1 has no public way: the adapter's)."""
+    viser_private.set_slider_marks(slider, marks)
 
 
 class Sent:

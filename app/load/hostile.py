@@ -27,7 +27,6 @@ from multiprocessing.connection import Connection
 from typing import Any
 
 import websockets
-from viser import _messages
 
 from poinsot.app.live.probe import Probe
 from poinsot.app.load import crafted, procfs
@@ -35,6 +34,7 @@ from poinsot.app.load.children import Child
 from poinsot.app.load.config import Config, Report, Say
 from poinsot.app.load.figures import COMPLETES, Figure, at_least, at_most, info
 from poinsot.app.load.server_process import ServerProcess
+from poinsot.app.viser_private import wire_message
 
 PHASE = "hostile"
 #: Each crafted message is sent this many times, each HTTP/1.0 request too.
@@ -105,10 +105,10 @@ def _crafted_gui(port: int, innocent: Probe) -> Counter[str]:
             for uuid in innocent.snapshot()[1]:  # another client's widgets
                 hostile.set_value(uuid, 0.0)
                 outcomes["sent"] += 1
-            start = _messages.FileTransferStartUpload(slider, "t", "a.stl", "x", 3, 3_000_000)
+            start = wire_message("FileTransferStartUpload", slider, "t", "a.stl", "x", 3, 3_000_000)
             hostile.send(start)
             for k in range(3):
-                hostile.send(_messages.FileTransferPart(slider, "t", k, b"\0" * 1_000_000))
+                hostile.send(wire_message("FileTransferPart", slider, "t", k, b"\0" * 1_000_000))
             hostile.set_value(slider, "x" * 1_000_000)
             outcomes["sent"] += 5
         except websockets.ConnectionClosed:

@@ -18,9 +18,9 @@ import struct
 import threading
 import time
 
-import msgspec
 import viser
-from viser import _messages
+
+from poinsot.app.viser_private import encode, wire_message
 
 _OP_CLOSE, _OP_PING, _OP_PONG, _OP_BINARY = 0x8, 0x9, 0xA, 0x2
 
@@ -53,7 +53,8 @@ def client_frame(payload: bytes, opcode: int = _OP_BINARY) -> bytes:
 def camera_message(step: int = 0) -> bytes:
     """A viewer-camera message as the browser sends it while the user orbits (msgpack)."""
     angle = 0.01 * step
-    message = _messages.ViewerCameraMessage(
+    message = wire_message(
+        "ViewerCameraMessage",
         wxyz=(1.0, 0.0, 0.0, 0.0),
         position=(3.0 * math.cos(angle), -3.0 + 3.0 * math.sin(angle), 2.0),
         fov=0.8,
@@ -64,7 +65,7 @@ def camera_message(step: int = 0) -> bytes:
         look_at=(0.0, 0.0, 0.0),
         up_direction=(0.0, 0.0, 1.0),
     )
-    return msgspec.msgpack.encode(message.as_serializable_dict())
+    return encode(message)
 
 
 class RawClient:

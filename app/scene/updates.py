@@ -19,7 +19,8 @@ on the class alone: :func:`cache_property_hints` (run when this module is import
 per class, and a trail's new chunk or a label costs a third.
 
 They use viser 1.1's handle internals (the handle's ``_impl`` and its scene API's
-``_queue_scene_message``), kept in this one module. ``tests/app/test_updates.py`` checks that
+``_queue_scene_message``), reached through the adapter :mod:`poinsot.app.viser_private.scene`
+(where ``tests/app/test_viser_private.py`` pins them). ``tests/app/test_updates.py`` checks that
 each one leaves the handle and the queued message exactly as the public setter does, so a viser
 upgrade that changes those internals fails a test instead of a frame. A write to a removed
 node raises as the setter does. Values that only a setter should see (the first pose, a
@@ -28,17 +29,16 @@ colour, a style) keep using the setters.
 
 from __future__ import annotations
 
-import functools
-import typing
 from typing import Any
 
 import numpy as np
 import viser
-from viser import _assignable_props_api, _messages
+
+from poinsot.app.viser_private import scene as private
 
 
 def _impl(handle: viser.SceneNodeHandle) -> Any:
-    impl = handle._impl
+    impl = private.node_state(handle)
     if impl.removed:
         raise RuntimeError(f"Cannot update the removed scene node {impl.name!r}.")
     return impl
@@ -49,7 +49,7 @@ def set_wxyz(handle: viser.SceneNodeHandle, wxyz: np.ndarray) -> None:
     impl = _impl(handle)
     value = (float(wxyz[0]), float(wxyz[1]), float(wxyz[2]), float(wxyz[3]))
     impl.wxyz[:] = value
-    impl.api._queue_scene_message(_messages.SetOrientationMessage(impl.name, value))
+    private.queue_orientation(impl, value)
 
 
 def set_position(handle: viser.SceneNodeHandle, position: np.ndarray) -> None:
@@ -57,7 +57,7 @@ def set_position(handle: viser.SceneNodeHandle, position: np.ndarray) -> None:
     impl = _impl(handle)
     value = (float(position[0]), float(position[1]), float(position[2]))
     impl.position[:] = value
-    impl.api._queue_scene_message(_messages.SetPositionMessage(impl.name, value))
+    private.queue_position(impl, value)
 
 
 def set_points(handle: viser.LineSegmentsHandle | viser.ArrowsHandle, points: np.ndarray) -> None:
@@ -69,24 +69,10 @@ def set_points(handle: viser.LineSegmentsHandle | viser.ArrowsHandle, points: np
         stored[...] = value
     else:
         impl.props.points = value.copy()
-    impl.api._queue_scene_message(_messages.SceneNodeUpdateMessage(impl.name, {"points": value}))
+    private.queue_props(impl, {"points": value})
 
 
-@functools.cache
-def _hints(props_class: Any) -> dict[str, Any]:
-    return typing.get_type_hints(props_class)
-
-
-def cache_property_hints() -> None:
-    """Make viser look a handle's property type hints up once per properties class, not once
-    per handle (viser only reads them). Idempotent."""
-    base: Any = _assignable_props_api.AssignablePropsBase
-    base._prop_hints = property(_prop_hints)  # a plain property: no per-instance lock either
-
-
-def _prop_hints(handle: Any) -> dict[str, Any]:
-    props_class: Any = type(handle._impl.props)
-    return _hints(props_class)
-
+#: Kept here for the callers that name it; the patch itself is the adapter's.
+cache_property_hints = private.cache_property_hints
 
 cache_property_hints()

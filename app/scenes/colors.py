@@ -24,6 +24,9 @@ ELLIPSOID_OPACITY = 0.3
 #: The moving point m = I ω on Landau's picture, and its trace (a polhode: the polhode pink).
 MOMENTUM: RGB = (255, 255, 255)
 MOMENTUM_TRACE: RGB = palette.POLHODE
+#: The polhode through a start pointed at on Landau's sphere, drawn while dragging (bright,
+#: to stand out of the family and the current D's pink curves).
+POINTED: RGB = (255, 225, 60)
 #: Cones of the symmetric top: the body cone (rides with the body), the space cone (fixed).
 BODY_CONE: RGB = (255, 120, 200)
 SPACE_CONE: RGB = (90, 230, 160)

@@ -118,7 +118,10 @@ class MomentumPicture:
         self.root = root
         self.radius = float(radius)
         half = 0.5 * float(turn)
-        parts.frame(part, root, offset, (math.cos(half), 0.0, 0.0, math.sin(half)))
+        #: The group's pose in space (display units): the sphere's centre and its turn.
+        self.offset = tuple(float(v) for v in np.asarray(offset, dtype=float))
+        self.wxyz = (math.cos(half), 0.0, 0.0, math.sin(half))
+        parts.frame(part, root, self.offset, self.wxyz)
         sphere = unit_sphere()
         self.sphere = parts.surface(
             part, f"{root}/sphere", sphere, colors.SPHERE, colors.SPHERE_OPACITY

@@ -10,7 +10,8 @@ of them (Poinsot's construction: ellipsoid, plane, herpolhode). A D slider sweep
 
 Beside it, Landau's view [LL76 §37]: in momentum space the sphere |m| = G cut by the ellipsoid
 Σ mᵢ²/Iᵢ = 2T; their intersection is the polhode (mapped by m = I ω), and the point m(t) of the
-moving body runs along it.
+moving body runs along it. A point of the sphere (pointed at by hand) is a start at |L| kept:
+ω = I⁻¹L, and D follows from it (the setting :data:`START_KEY`, until the slider moves).
 
 Physics: :func:`poinsot.physics.family.polhode_family` and :func:`~.polhode_curves` (the
 curves, at the body's energy), :func:`~.momentum_view` (Landau's picture at the body's |L|),
@@ -43,6 +44,7 @@ from poinsot.app.scenes.momentum import (
     momentum_nodes,
 )
 from poinsot.app.scenes.spec import (
+    START_KEY,
     Canvas,
     Model,
     Part,
@@ -51,6 +53,7 @@ from poinsot.app.scenes.spec import (
     Settings,
     Slider,
     number,
+    parse_start,
 )
 from poinsot.physics import FreeRigidBody, Regime
 from poinsot.physics.axis_angles import measure_wobble, wobble_theory
@@ -63,6 +66,7 @@ from poinsot.physics.family import (
     polhode_family,
 )
 from poinsot.physics.flip import measure_flips
+from poinsot.physics.pointing import body_from_start, omega_from_momentum
 
 #: The body: the presets' homogeneous 3 × 2 × 1 box (its moments are checked against trimesh's
 #: mass properties of the drawn mesh by tests/app/test_parts.py), sorted I₁ < I₂ < I₃.
@@ -202,9 +206,21 @@ def snapped_D(value: float) -> float:
     return I2 if abs(D - I2) <= 0.5 * D_STEP else D
 
 
+def pointed_body(text: str) -> FreeRigidBody:
+    """The body started from a point of Landau's sphere (:data:`START_KEY`'s setting): body-frame
+    L, ω = I⁻¹L, the exact separatrix if it was snapped onto it (ValueError if it is no start)."""
+    momentum, separatrix = parse_start(text)
+    return body_from_start(INERTIA, omega_from_momentum(INERTIA, momentum), separatrix=separatrix)
+
+
 def build(settings: Settings) -> FamilyModel:
-    D = snapped_D(float(settings["D"]))
-    body = FreeRigidBody.from_energy(INERTIA, D, omega_norm=OMEGA_NORM)
+    start = settings.get(START_KEY)
+    if isinstance(start, str):  # pointed at on Landau's sphere: D follows from the point
+        body = pointed_body(start)
+        D = body.D
+    else:
+        D = snapped_D(float(settings["D"]))
+        body = FreeRigidBody.from_energy(INERTIA, D, omega_norm=OMEGA_NORM)
     T = body.energy
     G = math.sqrt(2.0 * T * body.D)
     family = polhode_family(INERTIA, family_D_values(INERTIA, PER_FAMILY), energy=T)
@@ -235,6 +251,8 @@ class FamilyDrawing(PartsDrawing):
             current=True,
             radius=LANDAU_RADIUS,
         )
+        #: Landau's sphere takes a start pointed at (app/live/sphere_pointer.py).
+        self.pointable = self.landau
         self.model: FamilyModel | None = None
 
     def fit(self, model: Model, geometry: Geometry | None) -> None:

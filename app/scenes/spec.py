@@ -39,6 +39,29 @@ RGB = tuple[int, int, int]
 Value = float | str
 Settings = Mapping[str, Value]
 
+#: The setting of a start pointed at by hand, in a scene that takes one (its text is
+#: :func:`start_setting`'s); any control moved drops it.
+START_KEY = "start"
+
+
+def start_setting(momentum: tuple[float, float, float], separatrix: bool) -> str:
+    """The setting of a start pointed at: body-frame L (exact to the last bit) and whether it
+    was snapped onto the separatrix."""
+    return ",".join([*(format(float(v), ".17g") for v in momentum), "1" if separatrix else "0"])
+
+
+def parse_start(text: str) -> tuple[np.ndarray, bool]:
+    """The body-frame L and the separatrix flag of :func:`start_setting`'s text (ValueError
+    if it is not one)."""
+    parts = text.split(",")
+    if len(parts) != 4 or parts[3] not in ("0", "1"):
+        raise ValueError(f"a pointed start is three numbers and a flag, not {text!r}")
+    momentum = np.array([float(v) for v in parts[:3]])
+    if not np.all(np.isfinite(momentum)) or not np.any(momentum):
+        raise ValueError(f"a pointed start needs a finite, nonzero L, not {text!r}")
+    return momentum, parts[3] == "1"
+
+
 #: The panel's groups a scene may share (the others edit a preset's parameters).
 SHAREABLE: frozenset[Control] = frozenset(
     {Control.SPEED, Control.PLAYBACK, Control.TRAIL, Control.VISIBILITY}

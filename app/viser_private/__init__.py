@@ -7,7 +7,10 @@ there is done here, on names that viser may move in any release. Each is pinned 
 :func:`check` runs the same checks at start.
 
 Written for viser **1.1.x** (:data:`VISER_SERIES`), websockets 13 or later (its public
-``serve(process_request=..., create_connection=...)``).
+``serve(process_request=..., create_connection=...)``). It imports no other Poinsot folder
+(an import-linter contract), so that ``app.scene``, ``app.live``, ``app.load`` and
+``app.exports`` may all import it; ``tests/test_layout.py`` refuses a private viser name
+anywhere else in ``app/``.
 
 Inventory (section, private name, what it is used for):
 
@@ -30,12 +33,45 @@ Inventory (section, private name, what it is used for):
     only while a ``get_render`` handler is registered).
 
 *GUI*
-  - ``GuiApi._gui_input_handle_from_uuid`` (uuid -> handle): the widget a value is meant for.
+  - ``GuiApi._gui_input_handle_from_uuid`` (uuid -> handle): the widget a value is meant for
+    (:func:`gui_input_handle`, :func:`gui_widget`).
+  - ``handle._impl.uuid``: a widget's wire id (:func:`handle_id`).
+  - ``GuiApi._current_file_upload_states`` (transfer id -> state dict): the uploads in
+    progress, which the upload cap drops early (:func:`upload_states`).
+  - ``GuiApi._event_loop``: the loop a client's GUI runs its callbacks on, for a caller that
+    holds the GUI and not the server (:func:`gui_event_loop`; it is the loop of the public
+    :meth:`viser.ViserServer.get_event_loop`).
+  - ``GuiSliderHandle._marks`` (the ``GuiSliderProps._marks`` prop, tuples of
+    ``viser._messages.GuiSliderMark``): viser 1.1 takes marks only in ``add_slider``; setting
+    the private prop sends them (:func:`set_slider_marks`).
+  - ``ClientHandle._websock_connection``'s ``register_handler``/``queue_message`` with a class
+    of ``viser._messages``: a handler of a client's messages after viser's own, and a message
+    to that client (:func:`on_client_message`, :func:`send_to_client`).
+
+*Scene* (:mod:`poinsot.app.viser_private.scene`)
+  - ``SceneNodeHandle._impl`` (``name``, ``wxyz``, ``position``, ``props``, ``removed``,
+    ``api``) and ``SceneApi._queue_scene_message`` with ``SetOrientationMessage``,
+    ``SetPositionMessage`` and ``SceneNodeUpdateMessage``: the frame path's setters without
+    viser's comparison.
+  - ``viser._assignable_props_api.AssignablePropsBase._prop_hints``: replaced, class-wide, by a
+    property cached per properties class
+    (:func:`~poinsot.app.viser_private.scene.cache_property_hints`).
+
+*Transport* (:mod:`poinsot.app.viser_private.transport`)
+  - ``ClientHandle._websock_connection.get_message_buffer()`` with its ``message_counter``,
+    ``generator_cursors`` and ``message_from_id``: how far a client's send queue was taken (the
+    pacer).
+  - ``ClientHandle._viser_server._websock_server`` with ``_live_connections`` and
+    ``_background_event_loop``: a client's socket and its loop (the pacer's unacknowledged
+    bytes, the backlog watch).
 
 *Messages*
   - ``viser._messages``: the client-to-server message classes whose fields
     :data:`ALLOWED` mirrors (names and order checked by :func:`check`), and ``ShareUrlRequest``
     / ``ShareUrlDisconnect``, whose server handlers :func:`disable_share` removes.
+  - ``viser._messages.<name>`` built by hand, and ``Message.as_serializable_dict`` encoded as
+    viser's client encodes it (:func:`wire_message`, :func:`wire_class`, :func:`encode`): what
+    the headless probe and the load test send as a browser would.
 
 *Page* (a page's own address, and the clipboard)
   - ``ViserServer._websock_server._live_connections[client_id].request``: the websocket
@@ -65,9 +101,10 @@ import dataclasses
 import json
 import threading
 import uuid
-from collections.abc import Awaitable, Callable, Iterator
+from collections.abc import Awaitable, Callable, Iterable, Iterator
 from typing import Any
 
+import msgspec
 import viser
 import websockets.asyncio.server
 from viser import _messages
@@ -209,10 +246,75 @@ def gui_input_handle(server: viser.ViserServer, client_id: int, uuid: str) -> An
     """The input widget ``uuid`` of the client's own GUI or the shared one, or None."""
     client = server._connected_clients.get(client_id)
     for gui in (client.gui if client is not None else None, server.gui):
-        handle = gui._gui_input_handle_from_uuid.get(uuid) if gui is not None else None
+        handle = gui_widget(gui, uuid) if gui is not None else None
         if handle is not None:
             return handle
     return None
+
+
+def gui_widget(gui: viser.GuiApi, uuid: str) -> Any:
+    """The input widget ``uuid`` of ``gui`` (a client's own, or the shared one), or None."""
+    return gui._gui_input_handle_from_uuid.get(uuid)
+
+
+def handle_id(handle: Any) -> str:
+    """The wire id of a GUI handle (viser 1.1 keeps it in ``handle._impl.uuid``)."""
+    return str(handle._impl.uuid)
+
+
+def upload_states(gui: viser.GuiApi) -> dict[str, Any]:
+    """The GUI's transfers in progress (transfer id -> viser's state of it, a dict with
+    ``client_id``, ``total_bytes``, ``transferred_bytes`` and ``parts``)."""
+    states: dict[str, Any] = gui._current_file_upload_states
+    return states
+
+
+def gui_event_loop(gui: viser.GuiApi) -> asyncio.AbstractEventLoop:
+    """The event loop viser runs ``gui``'s callbacks on (the server's
+    :meth:`viser.ViserServer.get_event_loop`, for a GUI whose server is out of reach)."""
+    loop: asyncio.AbstractEventLoop = gui._event_loop
+    return loop
+
+
+def set_slider_marks(
+    slider: viser.GuiSliderHandle[Any], marks: Iterable[tuple[float, str]]
+) -> None:
+    """Move a slider's labelled marks. viser 1.1 takes marks only as an argument of
+    ``add_slider``; a handle's ``marks`` attribute is not sent, the ``_marks`` property is."""
+    slider._marks = tuple(
+        _messages.GuiSliderMark(value=float(v), label=label) for v, label in marks
+    )
+
+
+# -- messages ----------------------------------------------------------------------------------
+def wire_class(name: str) -> type:
+    """viser's message class ``name`` (``viser._messages.<name>``)."""
+    found = getattr(_messages, name, None)
+    if not isinstance(found, type):
+        raise ViserChanged(f"no message class {name} in viser._messages")
+    return found
+
+
+def wire_message(name: str, /, *args: Any, **fields: Any) -> Any:
+    """A message of viser's class ``name``, as viser's client or server would build it."""
+    return wire_class(name)(*args, **fields)
+
+
+def encode(message: Any) -> bytes:
+    """``message`` (:func:`wire_message`) as a websocket frame's payload, as the browser sends
+    it (msgpack of viser's serializable dict)."""
+    return msgspec.msgpack.encode(message.as_serializable_dict())
+
+
+def on_client_message(client: viser.ClientHandle, name: str, handler: Callable[..., None]) -> None:
+    """Run ``handler(client_id, message)`` on viser's event loop for each message ``name`` from
+    ``client``, after viser's own handlers (``ClientHandle._websock_connection``)."""
+    client._websock_connection.register_handler(wire_class(name), handler)
+
+
+def send_to_client(client: viser.ClientHandle, name: str, /, **fields: Any) -> None:
+    """Queue viser's message ``name`` for ``client``."""
+    client._websock_connection.queue_message(wire_message(name, **fields))
 
 
 # -- share -------------------------------------------------------------------------------------

@@ -6,6 +6,7 @@ which one the adapter was written for (:class:`~poinsot.app.viser_private.ViserC
 
 from __future__ import annotations
 
+import asyncio
 import dataclasses
 import inspect
 import threading
@@ -19,6 +20,8 @@ from viser import _messages
 from poinsot.app import viser_private
 from poinsot.app.live.guard import WireGuard
 from poinsot.app.live.transfers import handle_id
+from poinsot.app.viser_private import scene as private_scene
+from poinsot.app.viser_private import transport as private_transport
 
 WRITTEN_FOR = f"written for viser {viser_private.VISER_SERIES}.x, found viser {viser.__version__}"
 
@@ -114,3 +117,96 @@ def test_the_share_handlers_are_where_viser_put_them(make_app):
         assert not viser_private.share_enabled(plain)
     finally:
         plain.stop()
+
+
+# -- scene (poinsot.app.viser_private.scene) ---------------------------------------------------
+def test_a_node_s_state_and_its_scene_queue_are_where_viser_put_them(make_app):
+    server = make_app().server
+    frame = server.scene.add_frame("/pinned", show_axes=False)
+    node = private_scene.node_state(frame)
+    missing = [name for name in private_scene.NODE_FIELDS if not hasattr(node, name)]
+    assert not missing, f"{missing}: {WRITTEN_FOR}"
+    assert callable(getattr(node.api, "_queue_scene_message", None)), WRITTEN_FOR
+    for name, fields in _SCENE_MESSAGES.items():
+        theirs = viser_private.wire_class(name)
+        assert [f.name for f in dataclasses.fields(theirs)] == fields, f"{name}: {WRITTEN_FOR}"
+
+
+#: The fields of the messages the fast setters build (name and value; the scene queue stamps
+#: ``owner``).
+_SCENE_MESSAGES = {
+    "SetOrientationMessage": ["name", "wxyz", "owner"],
+    "SetPositionMessage": ["name", "position", "owner"],
+    "SceneNodeUpdateMessage": ["name", "updates", "owner"],
+}
+
+
+def test_the_property_hints_patch_replaces_viser_s_per_handle_lookup():
+    """viser 1.1 looks the hints up in ``AssignablePropsBase._prop_hints``, once per handle."""
+    base = viser._assignable_props_api.AssignablePropsBase
+    assert base.__dict__.get("_prop_hints") is private_scene.CACHED_HINTS, WRITTEN_FOR
+    source = inspect.getsource(viser._assignable_props_api)
+    assert "self._prop_hints" in source, WRITTEN_FOR
+
+
+# -- transport (poinsot.app.viser_private.transport) -------------------------------------------
+def test_a_client_s_queue_and_socket_are_where_viser_put_them(poinsot_app, probe):
+    session = session_of(poinsot_app)
+    client = session.client
+    buffer = private_transport.message_buffer(client)
+    assert buffer is not None, WRITTEN_FOR
+    assert private_transport.last_queued(buffer) >= 0, WRITTEN_FOR  # the scene was sent
+    taken = private_transport.last_taken(buffer, client.client_id)
+    assert taken is not None and taken <= private_transport.last_queued(buffer), WRITTEN_FOR
+    assert private_transport.pending(buffer) >= 0
+    connection, loop = private_transport.connection_of(client)
+    assert isinstance(connection, websockets.asyncio.server.ServerConnection), WRITTEN_FOR
+    assert isinstance(loop, asyncio.AbstractEventLoop) and loop.is_running(), WRITTEN_FOR
+    assert connection is viser_private.live_connection(poinsot_app.server, client.client_id)
+
+
+# -- GUI -----------------------------------------------------------------------------------------
+def test_a_widget_s_id_loop_and_uploads_are_where_viser_put_them(poinsot_app, probe):
+    session = session_of(poinsot_app)
+    gui = session.client.gui
+    speed = session.panel.widgets.speed
+    assert viser_private.gui_widget(gui, viser_private.handle_id(speed)) is speed, WRITTEN_FOR
+    assert viser_private.gui_event_loop(gui) is poinsot_app.server.get_event_loop(), WRITTEN_FOR
+    assert isinstance(viser_private.upload_states(gui), dict), WRITTEN_FOR
+    connection = session.client._websock_connection
+    for name in ("register_handler", "unregister_handler", "queue_message"):
+        assert callable(getattr(connection, name, None)), f"{name}: {WRITTEN_FOR}"
+
+
+def test_slider_marks_are_a_sent_property_of_the_handle(make_app):
+    """viser 1.1 sends a slider's ``_marks`` prop (``GuiSliderProps._marks``) when it is set."""
+    server = make_app().server
+    slider = server.gui.add_slider("pinned", 0.0, 1.0, 0.1, 0.5)
+    viser_private.set_slider_marks(slider, [(0.25, "a"), (0.75, "b")])
+    props = [f.name for f in dataclasses.fields(_messages.GuiSliderProps)]
+    assert "_marks" in props, WRITTEN_FOR
+    assert [(m.value, m.label) for m in slider._marks] == [(0.25, "a"), (0.75, "b")], WRITTEN_FOR
+
+
+# -- messages ------------------------------------------------------------------------------------
+def test_a_hand_built_message_is_what_the_wire_check_reads():
+    """The probe's and the load test's messages decode under the allow-list, field for field."""
+    sent = viser_private.wire_message("GuiUpdateMessage", "abc", {"value": 1.5})
+    decoded = viser_private.client_message(viser_private.encode(sent))
+    assert decoded == viser_private.GuiUpdate(uuid="abc", updates={"value": 1.5}), WRITTEN_FOR
+    for name in _HAND_BUILT:
+        assert dataclasses.is_dataclass(viser_private.wire_class(name)), f"{name}: {WRITTEN_FOR}"
+    with pytest.raises(viser_private.ViserChanged, match=rf"viser {viser.__version__} .* 1\.1"):
+        viser_private.wire_class("NoSuchMessage")
+
+
+_HAND_BUILT = (
+    "ViewerCameraMessage",
+    "GuiUpdateMessage",
+    "SceneNodeDragMessage",
+    "LocalStorageGetItemResponseMessage",
+    "FileTransferStartUpload",
+    "FileTransferPart",
+    "FileTransferPartAck",
+    "GuiSliderMark",
+)

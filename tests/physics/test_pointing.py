@@ -5,16 +5,19 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics import FreeRigidBody, Regime
 from poinsot.physics.pointing import (
     body_from_start,
     energy_parameter,
+    momentum_from_ray,
     omega_from_momentum,
     on_energy_ellipsoid,
     ray_ellipsoid,
     ray_sphere,
+    snap_momentum_to_separatrix,
     snap_to_separatrix,
     start_from_ray,
 )
@@ -129,3 +132,54 @@ def test_a_point_of_the_momentum_sphere_is_omega_of_that_momentum() -> None:
     L = ray_sphere([0.0, 0.0, 4.0], [0.1, 0.2, -1.0], 1.5)
     omega = omega_from_momentum(INERTIA, L)
     np.testing.assert_allclose(np.linalg.norm(omega * INERTIA), 1.5, rtol=1e-14)
+
+
+def test_a_ray_at_landaus_sphere_gives_a_start_of_its_own_energy_at_g_kept() -> None:
+    G, scale = 2.3, 0.62 / 2.3
+    target, eye = _visible_targets(np.full(3, G), 300)  # L on the sphere, eyes outside it
+    L = momentum_from_ray(G, eye * scale, 1.7 * (target - eye) * scale, scale=scale)
+    np.testing.assert_allclose(L, target, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(L, axis=1), G, rtol=1e-12)
+    omega = omega_from_momentum(INERTIA, L)
+    for w in omega[:20]:
+        body = body_from_start(INERTIA, w)
+        two_T = float(w @ (INERTIA * w))  # the energy follows from the point
+        assert 2.0 * body.energy == pytest.approx(two_T, rel=1e-12)
+        assert float(np.linalg.norm(body.angular_momentum)) == pytest.approx(G, rel=1e-12)
+        # The point lies on the energy ellipsoid of its own T, and ω(t) keeps |L| (DOP853).
+        curve = body.polhode(400)
+        assert np.min(np.linalg.norm(curve - w, axis=1)) <= np.max(
+            np.linalg.norm(np.diff(curve, axis=0), axis=1)
+        )
+        reference = solve_ivp(_euler, (0.0, 3.0), w, method="DOP853", rtol=1e-12, atol=1e-13)
+        np.testing.assert_allclose(body.omega(3.0), reference.y[:, -1], rtol=1e-8, atol=1e-9)
+    assert np.all(np.isnan(momentum_from_ray(G, [0.0, 0.0, 5.0], [1.0, 0.0, 0.0])))
+
+
+def _euler(_t: float, w: np.ndarray) -> np.ndarray:
+    """Euler's equations, torque-free, body frame [LL76 §36]."""
+    I1, I2, I3 = INERTIA
+    return np.array(
+        [(I2 - I3) * w[1] * w[2] / I1, (I3 - I1) * w[2] * w[0] / I2, (I1 - I2) * w[0] * w[1] / I3]
+    )
+
+
+def test_a_momentum_near_the_separatrix_snaps_onto_it_at_g_kept() -> None:
+    I1, I2, I3 = INERTIA
+    G = 1.9
+    mu = np.sqrt(I3 * (I2 - I1) / (I1 * (I3 - I2)))
+    on = np.array([1.0, 0.8, mu])  # L3 = mu L1: on the separatrix (independent form)
+    on *= G / np.linalg.norm(on)
+    near = on + np.array([0.0, 0.0, 2e-3])
+    near *= G / np.linalg.norm(near)
+    far = on + np.array([0.0, 0.0, 0.2])
+    far *= G / np.linalg.norm(far)
+    L, snapped = snap_momentum_to_separatrix(INERTIA, np.stack([near, far, -near]), 1e-2)
+    assert snapped.tolist() == [True, False, True]
+    np.testing.assert_allclose(np.linalg.norm(L, axis=1), G, rtol=1e-14)
+    np.testing.assert_allclose(L[0], on, rtol=1e-3)
+    np.testing.assert_array_equal(L[1], far)  # not near: untouched
+    w = omega_from_momentum(INERTIA, L[0])
+    assert energy_parameter(INERTIA, w) == pytest.approx(I2, rel=1e-14)
+    body = body_from_start(INERTIA, w, separatrix=True)
+    assert body.regime is Regime.SEPARATRIX and body.D == I2
