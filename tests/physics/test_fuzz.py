@@ -122,9 +122,9 @@ def test_the_benchmark_counts_a_short_run(capsys: pytest.CaptureFixture[str]) ->
 
 
 def test_from_energy_with_the_default_omega_norm_passed_as_none_is_checked_cleanly() -> None:
-    # The fuzz's case 67051 (seed 0) of from_energy: from_energy(..., omega_norm=None) builds a
-    # body with the default |ω0|; the check read float(None) and called the valid body unclean.
-    # A case's arguments depend on its index and seed alone, so naming the one target keeps the
+    # The fuzz's case 67051 of from_energy: from_energy(..., omega_norm=None) builds a body with
+    # the default |ω0|; the check read float(None) and called the valid body unclean. A case's
+    # arguments depend on its index and the run's seed alone, so naming the one target keeps the
     # case as the registry grows.
     o = case(67051, 0, ["FreeRigidBody.from_energy"])
     assert o.target == "FreeRigidBody.from_energy" and "omega_norm=None" in o.call
