@@ -492,6 +492,9 @@ def test_sphere_and_custom_alternate_without_console_errors(poinsot_app, open_pa
 
 
 # -- projector mode and the two views ---------------------------------------------------------
+# Runs alone after the parallel stage: beside three busy workers its ratio came out at 1.57
+# (the threshold is 1.6) in two of three full runs; alone it passes.
+@pytest.mark.serial
 def test_projector_mode_folds_the_panels_and_thickens_the_picture(poinsot_app, open_page):
     page = open_page(poinsot_app.url, width=1280, height=800)
     session = started(poinsot_app, frames=40)
