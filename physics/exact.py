@@ -148,11 +148,12 @@ class ExactState:
     @classmethod
     def on_separatrix(cls, J: Iterable[float], w: Iterable[float], w_exp: int = 0) -> ExactState:
         """The state on the separatrix nearest ``ω = w / 2^w_exp``, for sorted ``J1 < J2 < J3``
-        and ``ω = (ω1, 0, ω3)``, both nonzero.
+        and ``ω = (ω1, ω2, ω3)`` with ω1, ω3 nonzero.
 
-        Δ2 = 0 reads ``J1 (J2 - J1) ω1² = J3 (J3 - J2) ω3²``: the larger of ``|ω1|, |ω3|`` is kept
-        and the other square set by this ratio (a rational, in general not the square of a
-        double: no float ω lies exactly on the separatrix). The signs are those of ``w``.
+        Δ2 = 0 reads ``J1 (J2 - J1) ω1² = J3 (J3 - J2) ω3²`` (ω2 does not enter it): ω2 and the
+        larger of ``|ω1|, |ω3|`` are kept and the other square set by this ratio (a rational,
+        in general not the square of a double: no float ω lies exactly on the separatrix).
+        The signs are those of ``w``.
         """
         Jn, S = dyadic(J)
         wn, T = dyadic(w, w_exp)
@@ -160,8 +161,9 @@ class ExactState:
         a3 = Jn[2] * (Jn[2] - Jn[1])
         keep = 0 if abs(wn[0]) >= abs(wn[2]) else 2
         square = wn[keep] * wn[keep]
-        den = (a3 if keep == 0 else a1) << (2 * T)
-        return cls(Jn, S, (square * a3, 0, square * a1), den, (_sgn(wn[0]), 0, _sgn(wn[2])))
+        a_kept = a3 if keep == 0 else a1
+        w2 = (square * a3, wn[1] * wn[1] * a_kept, square * a1)
+        return cls(Jn, S, w2, a_kept << (2 * T), tuple(map(_sgn, wn)))
 
     def reversed(self) -> ExactState:
         """The same data in the minor family's pole frame ``x'' = (x3, x2, -x1)``."""

@@ -123,6 +123,31 @@ def test_a_point_near_the_separatrix_snaps_onto_the_exact_separatrix() -> None:
         assert body_from_start(INERTIA, far).regime is not Regime.SEPARATRIX
 
 
+def test_a_snapped_start_off_the_middle_plane_moves_along_its_own_separatrix() -> None:
+    """A start snapped onto the separatrix where ω₂ ≠ 0 (most points a hand reaches): the exact
+    separatrix through that very point, its energy kept, Euler's equations obeyed."""
+    two_T = 2.0
+    kappa = np.sqrt(
+        INERTIA[0] * (INERTIA[1] - INERTIA[0]) / (INERTIA[2] * (INERTIA[2] - INERTIA[1]))
+    )
+    for w2 in (0.4, -0.7):
+        start = on_energy_ellipsoid(INERTIA, two_T, np.array([1.0, w2, kappa]))
+        body = body_from_start(INERTIA, start, separatrix=True)
+        assert body.regime is Regime.SEPARATRIX and body.D == INERTIA[1]
+        assert body.energy == pytest.approx(two_T / 2.0, rel=1e-12)
+        np.testing.assert_allclose(body.omega(0.0), start, rtol=1e-12)
+        curve = body.polhode(4096)
+        gaps = np.linalg.norm(np.diff(curve, axis=0), axis=1)
+        assert np.min(np.linalg.norm(curve - start, axis=1)) <= np.max(gaps)
+        t = np.linspace(-3.0, 3.0, 7)
+        w = body.omega(t)
+        np.testing.assert_allclose(np.einsum("ij,j,ij->i", w, INERTIA, w), two_T, rtol=1e-12)
+        eps = 1e-6  # the rate of ω against Euler's equations, by a central difference
+        rate = (body.omega(t + eps) - body.omega(t - eps)) / (2.0 * eps)
+        euler = np.array([_euler(0.0, x) for x in w])
+        np.testing.assert_allclose(rate, euler, atol=1e-7)
+
+
 def test_a_symmetric_body_has_nothing_to_snap_to() -> None:
     omega, moved = snap_to_separatrix([1.0, 2.0, 2.0], [[0.3, 0.4, 0.5]], tolerance=10.0)
     assert not moved.any() and np.array_equal(omega, [[0.3, 0.4, 0.5]])
