@@ -103,11 +103,21 @@ class FreeRigidBody:
     """
 
     def __init__(
-        self, inertia: ArrayLike, omega0: ArrayLike, attitude0: Rotation | None = None
+        self,
+        inertia: ArrayLike,
+        omega0: ArrayLike,
+        attitude0: Rotation | None = None,
+        *,
+        on_separatrix: bool = False,
     ) -> None:
+        """``on_separatrix``: ``omega0`` was put on the separatrix ``D = I2`` to rounding (no
+        float ω lies on it exactly, e.g. by :func:`~poinsot.physics.pointing.snap_to_separatrix`):
+        the motion is the separatrix itself through it, with ``D == I2``, as
+        :meth:`from_energy` builds it for ``D = I2``. Ignored for a body with two equal moments,
+        or an ``omega0`` with no component on the axis of the smallest or the largest moment."""
         checked = check_inertia(inertia)
         omega = check_vector(omega0, "the initial angular velocity omega0")
-        self._build(checked, omega, check_attitude(attitude0))
+        self._build(checked, omega, check_attitude(attitude0), on_separatrix)
 
     @classmethod
     def from_energy(
@@ -196,7 +206,10 @@ class FreeRigidBody:
             omega_user=omega0,
             w_exp=self._w_exp,
         )
-        on_separatrix = on_separatrix and state.w_exact[0] != 0.0 and state.w_exact[2] != 0.0
+        J1, J2, J3 = state.J  # ascending
+        on_separatrix = (
+            on_separatrix and J1 < J2 < J3 and state.w_exact[0] != 0.0 and state.w_exact[2] != 0.0
+        )
         motion = classify(state, on_separatrix)
         self.regime, self._form = motion.regime, motion.form
         self.parameter = motion.form.parameter

@@ -238,6 +238,4 @@ def body_from_start(
     it, ``D == I₂``, as :meth:`FreeRigidBody.from_energy` builds it for ``D = I₂``."""
     moments = check_inertia(inertia)
     w = check_vector(omega0, "the initial angular velocity omega0")
-    body = FreeRigidBody.__new__(FreeRigidBody)
-    body._build(moments, w, attitude_checked(moments, w), on_separatrix=separatrix)
-    return body
+    return FreeRigidBody(moments, w, attitude_checked(moments, w), on_separatrix=separatrix)
