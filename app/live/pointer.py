@@ -15,15 +15,22 @@ drawn and plays (unless it was paused before). A click is a drag's release at on
 misses the ellipsoid does nothing and says nothing; so does one while a scene of its own (which
 draws no construction of a free body) is shown.
 
+:class:`StartPointer` is the drag and the release of any pointable surface (this ellipsoid, and
+Landau's sphere: :mod:`.sphere_pointer`): a drag update only meets the ray, evaluates the one
+polhode and updates its line nodes (no rebuild: the body and its sampler are rebuilt once, on
+release); updates queued behind a busy session thread are coalesced to the newest.
+
 viser's callbacks are ``async``: they run in order on its event loop and only post to the
 session's queue; the work is the session thread's.
 """
 
 from __future__ import annotations
 
+import collections
 import math
+import time
 from collections.abc import Callable, Hashable
-from typing import Protocol
+from typing import Generic, Protocol, TypeVar
 
 import numpy as np
 import viser
@@ -44,68 +51,170 @@ SNAP_PX = 6.0
 PREVIEW_POINTS = 240
 #: The canvas height assumed before the browser has reported its own [px].
 DEFAULT_HEIGHT_PX = 800.0
+#: Drag updates whose server time is kept (:attr:`StartPointer.server_seconds`).
+KEPT_TIMES = 2000
 
 Ray = tuple[tuple[float, float, float], tuple[float, float, float]]
-Start = tuple[Vector, bool]  # (ω0, snapped onto the separatrix)
+Start = tuple[Vector, bool]  # (a point: ω0 or L, snapped onto the separatrix)
+Look = tuple[str, tuple[int, int, int], float]  # a line's node, colour, thickness [px]
+S = TypeVar("S", bound="BaseSession")
 
 
-class PointerSession(Protocol):
-    """What the pointer uses of a session."""
+class BaseSession(Protocol):
+    """What every pointer uses of a session."""
 
     client: viser.ClientHandle
     scene: PoinsotScene
     body: FreeRigidBody | None
-    frame: Frame | None
     clock: SimClock
+
+    def post(self, action: Callable[[], None], key: Hashable | None = None) -> None: ...
+
+
+class PointerSession(BaseSession, Protocol):
+    """What the ellipsoid's pointer uses of a session."""
+
+    frame: Frame | None
 
     @property
     def showcase(self) -> object | None: ...
 
-    def post(self, action: Callable[[], None], key: Hashable | None = None) -> None: ...
     def edit(self, change: Callable[[Parameters], Parameters]) -> None: ...
 
 
-class Pointer:
-    """The pointer of one session (see the module's docstring)."""
+class StartPointer(Generic[S]):
+    """A drag and a release on one pointable surface of a session (the module's docstring).
 
-    def __init__(self, session: PointerSession, drag: bool = True) -> None:
-        """``drag``: a drag on the ellipsoid draws the start's polhode (else a drag on it turns
+    A surface says where a ray meets it (:meth:`start_of`), which polhode lines a start draws
+    (:meth:`lines`), where and how they are drawn (:meth:`looks`), and what a release sets
+    (:meth:`commit`)."""
+
+    def __init__(self, session: S, drag: bool = True) -> None:
+        """``drag``: a drag on the surface draws the start's polhode (else a drag on it turns
         the camera, as on a touch screen, where viser's drag binding on a node costs the
         browser a console error and one finger turns the camera everywhere)."""
         self.session = session
         self.dragging = drag
-        self.preview: viser.LineSegmentsHandle | None = None
+        self.previews_drawn: list[viser.LineSegmentsHandle] = []
         self.last: Start | None = None  # the start drawn last while dragging
         self._paused_before: bool | None = None  # the clock's state when a drag began
         #: Starts set, and polhodes drawn while dragging (tests, benchmark).
         self.starts = self.previews = 0
-        session.scene.on_create = self._bind
-        drawing = session.scene.drawing(Element.ELLIPSOID)
-        if drawing is not None:
-            self._bind(Element.ELLIPSOID, drawing)
+        #: Per polhode drawn: seconds from the drag update's arrival (viser's event loop) to
+        #: its line sent (the benchmark's server share).
+        self.server_seconds: collections.deque[float] = collections.deque(maxlen=KEPT_TIMES)
+
+    # -- to be given by a surface ----------------------------------------------------------
+    def start_of(self, ray: Ray) -> Start | None:
+        raise NotImplementedError
+
+    def lines(self, start: Start) -> list[np.ndarray] | None:
+        raise NotImplementedError
+
+    def looks(self) -> list[Look]:
+        """(node name, colour, thickness in screen pixels) of each line of :meth:`lines`."""
+        raise NotImplementedError
+
+    def commit(self, start: Start) -> None:
+        raise NotImplementedError
 
     # -- viser's event loop: post only ------------------------------------------------------
-    def _bind(self, element: Element, drawing: Drawing) -> None:
-        if element is Element.ELLIPSOID and isinstance(drawing, Ellipsoid):
-            if self.dragging:
-                drawing.mesh.on_drag(self._on_drag)
-            drawing.mesh.on_click(self._on_click)
+    def listen(self, node: viser.MeshHandle) -> None:
+        """Take the clicks (and drags, if :attr:`dragging`) on ``node``."""
+        if self.dragging:
+            node.on_drag(self._on_drag)
+        node.on_click(self._on_click)
 
     async def _on_click(self, event: viser.SceneNodePointerEvent) -> None:
         ray: Ray = (event.ray_origin, event.ray_direction)
         self.session.post(lambda: self.release(ray))
 
     async def _on_drag(self, event: viser.SceneNodeDragEvent) -> None:
-        eye = tuple(float(v) for v in event.client.camera.position)
+        arrived = time.perf_counter()
+        x, y, z = (float(v) for v in event.client.camera.position)
         end = event.end_position
-        x, y, z = eye
         ray: Ray = ((x, y, z), (end[0] - x, end[1] - y, end[2] - z))
         if event.phase == "end":
             self.session.post(lambda: self.release(ray))
-        else:
-            self.session.post(lambda: self.drag(ray), "pointer-drag")
+        else:  # keyed: only the newest update waits in the queue
+            self.session.post(lambda: self.drag(ray, arrived), (type(self), "drag"))
 
     # -- the session's thread ------------------------------------------------------------------
+    def drag(self, ray: Ray, arrived: float | None = None) -> None:
+        """Draw the polhode through the start under the pointer; the motion stands still."""
+        start = self.start_of(ray)
+        if start is None:
+            return
+        clock = self.session.clock
+        if self._paused_before is None:
+            self._paused_before = clock.paused
+            clock.paused = True
+        self.last = start
+        lines = self.lines(start)
+        if lines is None or not all(np.all(np.isfinite(line)) for line in lines):
+            return
+        self._send(lines)
+        self.previews += 1
+        if arrived is not None:
+            self.server_seconds.append(time.perf_counter() - arrived)
+
+    def release(self, ray: Ray) -> None:
+        """Start the motion from the start under the pointer (or, off the surface, the one
+        drawn last while dragging)."""
+        start = self.start_of(ray) or self.last
+        for handle in self.previews_drawn:
+            handle.visible = False
+        self.cancel()
+        if start is None:
+            return
+        self.starts += 1
+        self.commit(start)
+
+    def cancel(self) -> None:
+        """End a drag without a start: the clock as it was before it."""
+        if self._paused_before is not None:
+            self.session.clock.paused = self._paused_before
+        self._paused_before, self.last = None, None
+
+    def _send(self, lines: list[np.ndarray]) -> None:
+        """The lines out at once: an update sets the points alone (one message a line)."""
+        client = self.session.client
+        if not self.previews_drawn:
+            with client.atomic():
+                self.previews_drawn = [
+                    client.scene.add_line_segments(
+                        name, line, colors=color, thickness=thickness, thickness_units="screen"
+                    )
+                    for line, (name, color, thickness) in zip(lines, self.looks(), strict=True)
+                ]
+        else:
+            with client.atomic():
+                for handle, line in zip(self.previews_drawn, lines, strict=True):
+                    handle.points = line
+                    if not handle.visible:
+                        handle.visible = True
+        client.flush()  # out now, not at viser's next 1/60 s window
+
+
+class Pointer(StartPointer[PointerSession]):
+    """The ellipsoid's pointer of one session (see the module's docstring)."""
+
+    def __init__(self, session: PointerSession, drag: bool = True) -> None:
+        super().__init__(session, drag)
+        session.scene.on_create = self._bind
+        drawing = session.scene.drawing(Element.ELLIPSOID)
+        if drawing is not None:
+            self._bind(Element.ELLIPSOID, drawing)
+
+    @property
+    def preview(self) -> viser.LineSegmentsHandle | None:
+        """The polhode drawn while dragging, once there is one."""
+        return self.previews_drawn[0] if self.previews_drawn else None
+
+    def _bind(self, element: Element, drawing: Drawing) -> None:
+        if element is Element.ELLIPSOID and isinstance(drawing, Ellipsoid):
+            self.listen(drawing.mesh)
+
     def start_of(self, ray: Ray) -> Start | None:
         """The start where ``ray`` (space frame, display units) meets the ellipsoid as drawn
         now, snapped onto a separatrix within :data:`SNAP_PX`; None if it misses."""
@@ -130,63 +239,31 @@ class Pointer:
         """:data:`SNAP_PX` pixels as a length at ``distance`` from the camera (display units)."""
         return snap_length(self.session.client.camera, distance)
 
-    def drag(self, ray: Ray) -> None:
-        """Draw the polhode through the start under the pointer; the motion stands still."""
-        start = self.start_of(ray)
-        if start is None:
-            return
-        clock = self.session.clock
-        if self._paused_before is None:
-            self._paused_before = clock.paused
-            clock.paused = True
-        self.last = start
-        self._draw_polhode(start)
-
-    def release(self, ray: Ray) -> None:
-        """Start the motion from the start under the pointer (or, off the ellipsoid, the one
-        drawn last while dragging)."""
-        start = self.start_of(ray) or self.last
-        if self.preview is not None:
-            self.preview.visible = False
-        if self._paused_before is not None:
-            self.session.clock.paused = self._paused_before
-        self._paused_before, self.last = None, None
-        if start is None:
-            return
-        omega0, separatrix = start
-        self.starts += 1
-        self.session.edit(lambda p: p.with_start(omega0, separatrix))
-
-    def _draw_polhode(self, start: Start) -> None:
-        s = self.session
-        geometry, body = s.scene.geometry, s.body
-        assert geometry is not None and body is not None  # start_of() checked
+    def lines(self, start: Start) -> list[np.ndarray] | None:
+        """The polhode through ``start`` on the ellipsoid as drawn (body frame)."""
+        geometry, body = self.session.scene.geometry, self.session.body
+        if geometry is None or body is None:
+            return None
         omega0, separatrix = start
         curve = body_from_start(body.inertia, omega0, separatrix=separatrix).polhode(PREVIEW_POINTS)
-        points = (curve * geometry.scale).astype(np.float32)
-        if not separatrix:
-            points = np.concatenate([points, points[:1]])
-        segments = np.stack([points[:-1], points[1:]], axis=1)
-        if not np.all(np.isfinite(segments)):
-            return
-        with s.client.atomic():
-            self._send_polhode(segments)
-        s.client.flush()  # out now, not at viser's next 1/60 s window
-        self.previews += 1
+        return [segments(curve * geometry.scale, separatrix)]
 
-    def _send_polhode(self, segments: np.ndarray) -> None:
-        s = self.session
-        if self.preview is None:
-            self.preview = s.client.scene.add_line_segments(
-                f"{s.scene.root}/body/pointed_polhode",
-                segments,
-                colors=s.scene.look.polhode,
-                thickness=4.0,
-                thickness_units="screen",
-            )
-        else:
-            self.preview.points = segments
-            self.preview.visible = True
+    def looks(self) -> list[Look]:
+        scene = self.session.scene
+        return [(f"{scene.root}/body/pointed_polhode", scene.look.polhode, 4.0)]
+
+    def commit(self, start: Start) -> None:
+        omega0, separatrix = start
+        self.session.edit(lambda p: p.with_start(omega0, separatrix))
+
+
+def segments(points: np.ndarray, separatrix: bool) -> np.ndarray:
+    """(n, 2, 3) float32 segments along ``points`` (n, 3), closed unless it is a separatrix
+    arc (from pole to pole)."""
+    p = points.astype(np.float32)
+    if not separatrix:
+        p = np.concatenate([p, p[:1]])
+    return np.stack([p[:-1], p[1:]], axis=1)
 
 
 def snap_length(camera: viser.CameraHandle, distance: float) -> float:
