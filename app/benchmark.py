@@ -25,7 +25,8 @@ prints:
 
 Targets: <= 1 ms per client-frame, <= 30 ms per redraw, twins <= 1.6 x a single body. Then the
 drag rows (:mod:`poinsot.app.drag_benchmark`): a drag update on the ellipsoid to its polhode
-drawn, p95 <= 50 ms with one client, <= 100 ms with ten on two workers.
+drawn, p95 <= 50 ms with one client, <= 100 ms with ten on two workers; ``poinsot benchmark
+--drag`` runs them alone.
 
 ``poinsot benchmark --video`` instead films the video row (:func:`video_row`): 10 s of the
 T-handle at 1280x720 and 25 frames per second as MP4 (``poinsot video``'s pipeline: headless
@@ -356,10 +357,15 @@ def video_row() -> str:
 
 
 def main(
-    clients: Sequence[int] = (1, 20), seconds: float = 5.0, redraws: int = 30, video: bool = False
+    clients: Sequence[int] = (1, 20),
+    seconds: float = 5.0,
+    redraws: int = 30,
+    video: bool = False,
+    drag: bool = False,
 ) -> int:
     """Run the benchmark for each number of ``clients`` and print the results, then the drag
-    rows and the twins' row (with ``video``: the video row alone)."""
+    rows and the twins' row (with ``video``: the video row alone; with ``drag``: the drag rows
+    alone)."""
     from poinsot.app.drag_benchmark import main as drag_main
 
     print(
@@ -368,6 +374,9 @@ def main(
     )
     if video:
         print(video_row(), flush=True)
+        return 0
+    if drag:
+        drag_main()
         return 0
     for n in clients:
         print(format_result(run(n, seconds, redraws)), flush=True)

@@ -198,11 +198,12 @@ def fit(
     )
 
 
-def benchmark(clients: list[int], seconds: float, redraws: int, video: bool) -> int:
-    """Measure the live server, or the video export (see :mod:`poinsot.app.benchmark`)."""
+def benchmark(clients: list[int], seconds: float, redraws: int, video: bool, drag: bool) -> int:
+    """Measure the live server, or the video export, or the drag alone (see
+    :mod:`poinsot.app.benchmark`)."""
     from poinsot.app.benchmark import main as benchmark_main
 
-    return benchmark_main(clients, seconds, redraws, video)
+    return benchmark_main(clients, seconds, redraws, video, drag)
 
 
 # -- the parser -----------------------------------------------------------------------------
@@ -374,6 +375,11 @@ def _add_benchmark_arguments(parser: argparse.ArgumentParser) -> None:
         "--video",
         action="store_true",
         help="instead, film 10 s at 1280x720 (poinsot video): seconds per frame and MB",
+    )
+    parser.add_argument(
+        "--drag",
+        action="store_true",
+        help="only the drag rows: a drag update to its polhode drawn, 1 and 10 clients",
     )
     parser.set_defaults(func=benchmark)
 

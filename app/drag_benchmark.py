@@ -8,6 +8,15 @@ one thread each, that all drag at once, each update sent when the last one's pol
 round trip is timed by the client, from sending the update to receiving the drawn polhode:
 the ray met with the ellipsoid, the body of the start built, its polhode evaluated, sent and
 decoded. Goals: p95 <= 50 ms with one client, <= 100 ms with ten on two workers.
+
+Each row also gives the server's share, as the workers measured it
+(:attr:`~poinsot.app.live.pointer.StartPointer.server_seconds`): from the update's arrival on
+viser's event loop to its polhode handed to the socket. The rest of a round trip is the
+network, the probe's decoding and, on a busy machine, waiting for a core. An update answered by
+nothing is counted apart: a start whose polhode is the one drawn already (two starts snapped
+onto the same separatrix arc) changes nothing, and viser sends nothing.
+
+``poinsot benchmark --drag`` runs these rows alone.
 """
 
 from __future__ import annotations
@@ -17,10 +26,14 @@ import math
 import statistics
 import threading
 import time
+from typing import TYPE_CHECKING
 
 from poinsot.app.live.probe import Probe
 from poinsot.app.live.workers import start_workers, stop_workers
 from poinsot.app.presets import DEFAULT_PRESET
+
+if TYPE_CHECKING:
+    from poinsot.app.live.server import PoinsotApp
 
 #: The drag rows: (clients, workers, goal for the p95 [ms]).
 ROWS: tuple[tuple[int, int, float], ...] = ((1, 1, 50.0), (10, 2, 100.0))
@@ -38,8 +51,9 @@ class DragResult:
     clients: int
     workers: int
     goal_ms: float
-    latencies: tuple[float, ...]  # seconds
-    lost: int
+    latencies: tuple[float, ...]  # seconds, client round trips
+    unanswered: int
+    server: tuple[float, ...] = ()  # seconds, arrival to sent, as the workers measured
 
     @property
     def median_ms(self) -> float:
@@ -47,10 +61,24 @@ class DragResult:
 
     @property
     def p95_ms(self) -> float:
-        if not self.latencies:
-            return math.nan
-        ordered = sorted(self.latencies)
-        return 1e3 * ordered[min(len(ordered) - 1, round(0.95 * (len(ordered) - 1)))]
+        return p95_ms(self.latencies)
+
+    @property
+    def server_p95_ms(self) -> float:
+        return p95_ms(self.server)
+
+
+def p95_ms(seconds: tuple[float, ...]) -> float:
+    """The 95th percentile of ``seconds``, in ms (NaN for none)."""
+    if not seconds:
+        return math.nan
+    ordered = sorted(seconds)
+    return 1e3 * ordered[min(len(ordered) - 1, round(0.95 * (len(ordered) - 1)))]
+
+
+def server_times(app: PoinsotApp) -> list[float]:
+    """In a worker: the server's time of every drag update its sessions answered [s]."""
+    return [x for session in app.sessions.values() for x in session.pointer.server_seconds]
 
 
 def pointer_at(k: int) -> tuple[float, float, float]:
@@ -61,11 +89,12 @@ def pointer_at(k: int) -> tuple[float, float, float]:
 
 
 def drag_round_trips(probe: Probe, updates: int) -> tuple[list[float], int]:
-    """One drag of ``updates`` updates by ``probe``; the round trips [s] and those lost."""
+    """One drag of ``updates`` updates by ``probe``; the round trips [s] and the updates
+    answered by nothing within :data:`TIMEOUT`."""
     arrived = threading.Event()
     probe.add_listener(lambda m, _t: arrived.set() if m.get("name") == PREVIEW else None)
     latencies: list[float] = []
-    lost = 0
+    unanswered = 0
     for k in range(updates + 1):
         arrived.clear()
         sent = time.perf_counter()
@@ -74,10 +103,10 @@ def drag_round_trips(probe: Probe, updates: int) -> tuple[list[float], int]:
             if k > 0:  # the start's polhode also creates the node: not timed
                 latencies.append(time.perf_counter() - sent)
         else:
-            lost += 1
+            unanswered += 1
         time.sleep(PAUSE)
     probe.drag(ELLIPSOID, "end", pointer_at(updates))
-    return latencies, lost
+    return latencies, unanswered
 
 
 def run_drag(clients: int, workers: int, goal_ms: float, updates: int = 40) -> DragResult:
@@ -103,12 +132,13 @@ def run_drag(clients: int, workers: int, goal_ms: float, updates: int = 40) -> D
             thread.start()
         for thread in threads:
             thread.join()
+        server = tuple(x for worker in servers for x in worker.inspect(server_times))
     finally:
         for probe in probes:
             probe.close()
         stop_workers(servers)
     latencies = tuple(x for r in results for x in r[0])
-    return DragResult(clients, workers, goal_ms, latencies, sum(r[1] for r in results))
+    return DragResult(clients, workers, goal_ms, latencies, sum(r[1] for r in results), server)
 
 
 def format_drag(r: DragResult) -> str:
@@ -116,7 +146,7 @@ def format_drag(r: DragResult) -> str:
         f"drag update, {r.clients} client{'s' if r.clients > 1 else ''} on {r.workers} "
         f"worker{'s' if r.workers > 1 else ''}: ray to polhode drawn median {r.median_ms:.1f} ms, "
         f"p95 {r.p95_ms:.1f} ms   (goal <= {r.goal_ms:.0f} ms; {len(r.latencies)} updates, "
-        f"{r.lost} lost)"
+        f"{r.unanswered} unanswered; server's share p95 {r.server_p95_ms:.1f} ms)"
     )
 
 
