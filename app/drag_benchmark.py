@@ -78,7 +78,7 @@ def p95_ms(seconds: tuple[float, ...]) -> float:
 
 def server_times(app: PoinsotApp) -> list[float]:
     """In a worker: the server's time of every drag update its sessions answered [s]."""
-    return [x for session in app.sessions.values() for x in session.pointer.server_seconds]
+    return [x for session in app.sessions().values() for x in session.pointer.server_seconds]
 
 
 def pointer_at(k: int) -> tuple[float, float, float]:

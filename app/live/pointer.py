@@ -43,7 +43,7 @@ from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.nodes import Drawing, Ellipsoid
 from poinsot.physics import FreeRigidBody
-from poinsot.physics.pointing import body_from_start, snap_to_separatrix, start_from_ray
+from poinsot.physics.pointing import snap_to_separatrix, start_from_ray
 
 #: The pointer snaps onto the separatrix within this many pixels of it (on screen).
 SNAP_PX = 6.0
@@ -187,12 +187,11 @@ class StartPointer(Generic[S]):
                     )
                     for line, (name, color, thickness) in zip(lines, self.looks(), strict=True)
                 ]
-        else:
-            with client.atomic():
-                for handle, line in zip(self.previews_drawn, lines, strict=True):
-                    handle.points = line
-                    if not handle.visible:
-                        handle.visible = True
+        else:  # no atomic window: its end would wake viser's loop once more than the flush
+            for handle, line in zip(self.previews_drawn, lines, strict=True):
+                handle.points = line
+                if not handle.visible:
+                    handle.visible = True
         client.flush()  # out now, not at viser's next 1/60 s window
 
 
@@ -245,7 +244,7 @@ class Pointer(StartPointer[PointerSession]):
         if geometry is None or body is None:
             return None
         omega0, separatrix = start
-        curve = body_from_start(body.inertia, omega0, separatrix=separatrix).polhode(PREVIEW_POINTS)
+        curve = polhode_through(body.inertia, omega0, separatrix)
         return [segments(curve * geometry.scale, separatrix)]
 
     def looks(self) -> list[Look]:
@@ -255,6 +254,13 @@ class Pointer(StartPointer[PointerSession]):
     def commit(self, start: Start) -> None:
         omega0, separatrix = start
         self.session.edit(lambda p: p.with_start(omega0, separatrix))
+
+
+def polhode_through(inertia: Vector, omega0: Vector, separatrix: bool) -> np.ndarray:
+    """(PREVIEW_POINTS, 3) the polhode through ``omega0`` (body frame): the body's attitude
+    does not enter it, so none is computed (a drag update's time is the class's)."""
+    body = FreeRigidBody(inertia, omega0, on_separatrix=separatrix)
+    return body.polhode(PREVIEW_POINTS)
 
 
 def segments(points: np.ndarray, separatrix: bool) -> np.ndarray:

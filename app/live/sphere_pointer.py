@@ -25,12 +25,12 @@ from typing import Protocol
 import numpy as np
 
 from poinsot.app.live.pointer import (
-    PREVIEW_POINTS,
     BaseSession,
     Look,
     Ray,
     Start,
     StartPointer,
+    polhode_through,
     segments,
     snap_length,
 )
@@ -41,7 +41,6 @@ from poinsot.app.scenes import colors
 from poinsot.app.scenes.momentum import MomentumPicture
 from poinsot.app.scenes.spec import START_KEY, Value, start_setting
 from poinsot.physics.pointing import (
-    body_from_start,
     momentum_from_ray,
     omega_from_momentum,
     snap_momentum_to_separatrix,
@@ -112,9 +111,9 @@ class SpherePointer(StartPointer[SphereSession]):
             return None
         momentum, separatrix = start
         omega0 = omega_from_momentum(body.inertia, momentum)
-        new = body_from_start(body.inertia, omega0, separatrix=separatrix)
-        curve = new.polhode(PREVIEW_POINTS)  # ω(t) over a period, body frame
-        on_drawn = np.sqrt(body.energy / new.energy)  # onto the ellipsoid on screen
+        curve = polhode_through(body.inertia, omega0, separatrix)  # ω over a period, body frame
+        two_T = float(omega0 @ (np.asarray(body.inertia) * omega0))
+        on_drawn = np.sqrt(2.0 * body.energy / two_T)  # onto the ellipsoid on screen
         ellipsoid = curve * (on_drawn * geometry.scale * POLHODE_INFLATE)
         sphere = curve * np.asarray(body.inertia) * picture.scale  # L = Iω, as drawn
         return [segments(sphere, separatrix), segments(ellipsoid, separatrix)]
