@@ -10,11 +10,12 @@ Compact, the page differs in three ways (once, for that browser only):
 
 - **One sheet.** viser shows a narrow screen (under 36 em: a phone held upright) as one bottom
   sheet that holds the controls and, as sections, the panels; one tap on its bar closes it and
-  the next opens it. It is open when the page opens (that state is the browser's own, and a
-  sheet shown closed against it would be inert to taps), so it is held low here. A wider
-  screen (a tablet, a phone on its side) gets viser's docked columns: the "What you see" panel
-  is docked above the controls in their column, and the column is folded to a slim rail that
-  one tap opens.
+  the next opens it. viser mounts it open, and that state is the page's own (no message folds
+  it; a sheet hidden by style against it would be inert to taps), so a line of the page's
+  JavaScript taps its bar once (:func:`~poinsot.app.viser_private.fold_bottom_sheet`): the page
+  opens on the scene and the sheet's bar. Opened, it is held low. A wider screen (a tablet, a
+  phone on its side) gets viser's docked columns: the "What you see" panel is docked above the
+  controls in their column, and the column is folded to a slim rail that one tap opens.
 - **The legend in one tap.** The legend is mirrored at the top of the controls (shown on the
   bottom sheet only, where the "What you see" section comes last, folded), in larger text; on
   the rail, "What you see" comes first.
@@ -42,6 +43,7 @@ from poinsot.app.scene.cameras import construction_points, framed
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.geometry import L_OVERSHOOT, PLANE_RADIUS
 from poinsot.app.scene.view import DEFAULT_VIEW
+from poinsot.app.viser_private import fold_bottom_sheet
 
 #: A phone's or a tablet's browser says so in its User-Agent.
 TOUCH_AGENT = re.compile(r"Mobi|Android|iPhone|iPad|iPod|Silk|Kindle|Tablet", re.IGNORECASE)
@@ -153,6 +155,7 @@ class Layout:
         motion.legend.mirror(self.mirror, mirrored)
         motion.window.dock_above(gui.main_panel)
         gui.main_panel.minimize()
+        fold_bottom_sheet(self.session.client)
 
     def frame(self, aspect: float) -> None:
         """Frame the whole construction for a picture ``aspect`` wide."""

@@ -91,6 +91,11 @@ Inventory (section, private name, what it is used for):
     awaits on the event loop (a page that never answers holds no thread).
   - ``"viser-user:"``: the prefix viser's client puts before the keys of its localStorage API
     (``LOCAL_STORAGE_PREFIX`` in the client's ``MessageHandler.tsx``).
+  - The bottom sheet of a narrow page (the client's ``ControlPanel/BottomPanel.tsx``): a
+    ``position: fixed; bottom: 0`` Mantine ``Paper`` whose bar (``cursor: pointer``,
+    ``height: 3.5em``) toggles it; it is open when it mounts (its state is the page's own,
+    ``useDisclosure(true)``: no message and no GUI handle folds it). :func:`fold_bottom_sheet`
+    taps that bar once, from the page, as a finger would.
 """
 
 from __future__ import annotations
@@ -406,6 +411,35 @@ if (navigator.clipboard && window.isSecureContext) {
   fallback();
 }
 """
+
+
+_FOLD_SHEET_JS = """
+(() => {
+  if (window.poinsotSheetFolded) return;
+  const until = Date.now() + %d;
+  const fold = () => {
+    const sheet = [...document.querySelectorAll(".mantine-Paper-root")].find(
+      (e) => e.style.position === "fixed" && e.style.bottom === "0px");
+    const bar = sheet && [...sheet.querySelectorAll("div")].find(
+      (e) => e.style.cursor === "pointer" && e.style.height === "3.5em");
+    if (bar && sheet.getBoundingClientRect().height > 1.5 * bar.getBoundingClientRect().height) {
+      window.poinsotSheetFolded = true;
+      bar.click();
+    } else if (Date.now() < until) {
+      setTimeout(fold, 100);
+    }
+  };
+  fold();
+})();
+"""
+
+
+def fold_bottom_sheet(client: viser.ClientHandle, wait_ms: int = 10000) -> None:
+    """Fold the page's bottom sheet (a narrow page's) once, as one tap on its bar does, as soon
+    as it is there and open (looked for during ``wait_ms``; a wide page has none). Its bar then
+    opens and closes it with one tap each, as ever."""
+    _run_javascript(client, _FOLD_SHEET_JS % int(wait_ms))
+    client.flush()
 
 
 def copy_to_clipboard(client: viser.ClientHandle, text: str) -> None:
