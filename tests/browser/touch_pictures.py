@@ -3,7 +3,7 @@
 ``assets/phone_390x844.png`` and ``assets/drag_1280x800.png``).
 
 - The phone: an iPhone's 390 x 844 page with touch, as it opens (the scene framed for it, the
-  sheet held low with the legend at its top).
+  sheet folded to its bar).
 - The drag: a desktop page at 1280 x 800, the mouse pressed on the ellipsoid and moved, held
   while the polhode through the pointed start is drawn (the motion stands still).
 """
@@ -20,7 +20,12 @@ from playwright.sync_api import sync_playwright
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from conftest import CHROMIUM, BrowserPage, _dismiss_software_webgl_notice, wait_until  # noqa: E402
+from conftest import (  # noqa: E402
+    CHROMIUM,
+    HIDE_SOFTWARE_WEBGL_NOTICE_JS,
+    BrowserPage,
+    wait_until,
+)
 from test_touch_page import IPHONE, screen_point  # noqa: E402
 
 from poinsot.app.exports.screenshot import CHROMIUM_ARGS  # noqa: E402
@@ -31,10 +36,10 @@ ASSETS = Path(__file__).resolve().parents[2] / "assets"
 
 def _open(browser, app: PoinsotApp, width: int, height: int, **options) -> BrowserPage:
     context = browser.new_context(viewport={"width": width, "height": height}, **options)
+    context.add_init_script(HIDE_SOFTWARE_WEBGL_NOTICE_JS)
     page = context.new_page()
     page.goto(app.url)
     page.locator("canvas").first.wait_for(state="visible", timeout=30000)
-    _dismiss_software_webgl_notice(page)
     return BrowserPage(page, [])
 
 
