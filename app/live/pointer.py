@@ -34,6 +34,7 @@ from typing import Generic, Protocol, TypeVar
 
 import numpy as np
 import viser
+from numpy.typing import ArrayLike
 
 from poinsot.app.elements import Element
 from poinsot.app.live.clock import SimClock
@@ -256,7 +257,7 @@ class Pointer(StartPointer[PointerSession]):
         self.session.edit(lambda p: p.with_start(omega0, separatrix))
 
 
-def polhode_through(inertia: Vector, omega0: Vector, separatrix: bool) -> np.ndarray:
+def polhode_through(inertia: ArrayLike, omega0: ArrayLike, separatrix: bool) -> np.ndarray:
     """(PREVIEW_POINTS, 3) the polhode through ``omega0`` (body frame): the body's attitude
     does not enter it, so none is computed (a drag update's time is the class's)."""
     body = FreeRigidBody(inertia, omega0, on_separatrix=separatrix)
