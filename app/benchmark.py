@@ -276,7 +276,7 @@ def twins_cost(frames: int = 600, rounds: int = 5) -> tuple[float, float]:
     per-client-frame figure above.
     """
     from poinsot.app.scenes import scene_by_name
-    from poinsot.app.scenes.stage import SceneStage
+    from poinsot.app.stage.scene_stage import SceneStage
 
     spec = scene_by_name("dzhanibekov")
     dt = spec.speed / 60.0

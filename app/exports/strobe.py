@@ -22,7 +22,7 @@ import math
 import numpy as np
 import viser
 
-from poinsot.app.exports.stage import Stage
+from poinsot.app.stage.served import Stage
 from poinsot.app.scene.geometry import (
     DISPLAY_RADIUS,
     L_OVERSHOOT,
@@ -32,7 +32,7 @@ from poinsot.app.scene.geometry import (
 )
 from poinsot.app.scene.meshes import ellipsoid_unit_mesh
 from poinsot.app.scene.view import View
-from poinsot.app.scenes.stage import SceneStage
+from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.flip import measure_flips
 
