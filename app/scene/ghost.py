@@ -41,8 +41,9 @@ import numpy as np
 import viser
 import viser.uplot
 
-from poinsot.app.scene import meshes, palette, updates
+from poinsot.app.scene import palette, updates
 from poinsot.app.scene.batch import Frame
+from poinsot.app.scene.ellipsoid import add_ellipsoid, fit_ellipsoid
 from poinsot.app.scene.frames import rotation_from_wxyz, wxyz_from_xyzw, xyzw_from_wxyz
 from poinsot.app.scene.geometry import Geometry, triple
 from poinsot.physics import FreeRigidBody, errors, rotations
@@ -251,18 +252,9 @@ class GhostCage:
     """The ghost's scene nodes: its shell, principal sections and axes, and the tip of its ω."""
 
     def __init__(self, scene: viser.SceneApi, root: str) -> None:
-        sphere = meshes.ellipsoid_unit_mesh()
         self.node = scene.add_frame(f"{root}/ghost", show_axes=False)
-        self.shell = scene.add_mesh_simple(
-            f"{root}/ghost/ellipsoid",
-            sphere.vertices,
-            sphere.faces,
-            color=palette.GHOST,
-            opacity=palette.GHOST_OPACITY,
-            material="standard",
-            side="front",
-            cast_shadow=False,
-            receive_shadow=False,
+        self.shell = add_ellipsoid(
+            scene, f"{root}/ghost/ellipsoid", palette.GHOST, palette.GHOST_OPACITY
         )
         self.axes, self.rings = (
             scene.add_line_segments(
@@ -281,7 +273,7 @@ class GhostCage:
     def fit(self, geometry: Geometry) -> None:
         """Size the cage as the body's ellipsoid (a new body)."""
         semi = geometry.semi_axes
-        self.shell.scale = triple(semi * GHOST_INFLATE)
+        fit_ellipsoid(self.shell, semi * GHOST_INFLATE)
         ends = geometry.axis_ends()
         self.axes.points = np.stack([-ends, ends], axis=1).astype(np.float32)
         self.rings.points = principal_sections(semi * GHOST_INFLATE, GHOST_RING_SEGMENTS)
