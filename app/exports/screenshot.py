@@ -35,7 +35,6 @@ import numpy as np
 import viser
 from scipy.spatial.transform import Rotation
 
-from poinsot.app.stage.served import ClientOf, Stage
 from poinsot.app.exports.strobe import Strobe, StrobeError, add_strobe, body_of
 from poinsot.app.presets import PRESETS, Preset, preset_by_key
 from poinsot.app.scene.cameras import space_view
@@ -44,6 +43,7 @@ from poinsot.app.scene.view import View
 from poinsot.app.scenes import scene_by_name
 from poinsot.app.scenes.spec import SceneSpec
 from poinsot.app.stage.scene_stage import SceneStage
+from poinsot.app.stage.served import ClientOf, Stage
 
 if TYPE_CHECKING:
     from playwright.sync_api import Browser, ViewportSize

@@ -23,7 +23,6 @@ from typing import TYPE_CHECKING
 import viser
 
 from poinsot.app.exports.screenshot import THEME_BACKGROUND, filename, find_chromium
-from poinsot.app.stage.served import ClientOf, Stage
 from poinsot.app.exports.video import (
     BROWSER_MAX_SECONDS,
     BROWSER_MAX_SIZE,
@@ -40,6 +39,7 @@ from poinsot.app.scene.cameras import RIDE_ALONG
 from poinsot.app.scene.geometry import triple
 from poinsot.app.scene.view import View
 from poinsot.app.stage.scene_stage import SceneStage
+from poinsot.app.stage.served import ClientOf, Stage
 
 if TYPE_CHECKING:
     from poinsot.app.live.lecture import LectureControls

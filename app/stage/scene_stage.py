@@ -8,6 +8,9 @@ T or a clip of S seconds is reproducible.
 
 from __future__ import annotations
 
+from poinsot.app.scene.batch import Frame
+from poinsot.app.scenes.runtime import Showcase
+from poinsot.app.scenes.spec import SceneSpec, Settings
 from poinsot.app.stage.served import (
     ClientOf,
     ServedStage,
@@ -15,9 +18,6 @@ from poinsot.app.stage.served import (
     scene_target,
     themed_construction,
 )
-from poinsot.app.scene.batch import Frame
-from poinsot.app.scenes.runtime import Showcase
-from poinsot.app.scenes.spec import SceneSpec, Settings
 
 
 class SceneStage(ServedStage):

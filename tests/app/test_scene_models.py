@@ -16,7 +16,6 @@ from poinsot.app.cli import build_parser
 from poinsot.app.elements import Control
 from poinsot.app.exports.html import scene_html
 from poinsot.app.exports.screenshot import resolve_scene
-from poinsot.app.stage.served import ServedStage, Stage
 from poinsot.app.live.probe import Probe
 from poinsot.app.presets import MENU, preset_by_key
 from poinsot.app.scene import palette
@@ -32,8 +31,9 @@ from poinsot.app.scenes import (
     scene_names,
 )
 from poinsot.app.scenes.spec import Choice, Readout, SceneSpec, table
-from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.app.scenes.tabulated import Player, Table
+from poinsot.app.stage.scene_stage import SceneStage
+from poinsot.app.stage.served import ServedStage, Stage
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 NAMES = (

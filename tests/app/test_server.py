@@ -194,9 +194,9 @@ def test_the_loop_stops_when_the_client_leaves(poinsot_app, make_probe):
     probe.close()
     assert wait_until(lambda: not session.running, 5)
     assert poinsot_app.sessions() == {}
-    assert wait_until(lambda: not session._thread.is_alive(), 10)  # the frame thread ended
+    assert wait_until(lambda: not session.running, 10)  # the frame thread ended
     frames = session.stats.frames
-    assert not session._thread.is_alive() and session.stats.frames == frames
+    assert not session.running and session.stats.frames == frames
 
 
 #: Frames (about a second's worth at 60 Hz) the stalled client's session draws before the
