@@ -74,7 +74,7 @@ def serve(
     else with ``preset``. With ``workers`` > 1 the sessions run in that many processes behind
     a landing port (:mod:`poinsot.app.live.workers`). A port that cannot be served is one
     line and exit status 2."""
-    from poinsot.app.live.network import PortError, board, check_port, port_problem
+    from poinsot.app.live.hardening.network import PortError, board, check_port, port_problem
 
     try:
         check_port(host, port)

@@ -22,7 +22,7 @@ from viser.infra import StateSerializer
 
 from poinsot.app.elements import ALL_ELEMENTS
 from poinsot.app.exports.html import HTML_FPS, record
-from poinsot.app.live.legend import caption, entries, legend_html
+from poinsot.app.live.ui.legend import caption, entries, legend_html
 from poinsot.app.parameters import Parameters, drawn_solid
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, PRESETS, Preset
 from poinsot.app.scene import palette

@@ -10,7 +10,7 @@ error (the geodesic angle between the two rotations) and of the energy error aga
 simulated time.
 
 A :class:`Ghost` exists only while the ghost is switched on (its controls, which create and
-remove it, are :mod:`poinsot.app.live.ghost_controls`). It owns the scene nodes
+remove it, are :mod:`poinsot.app.live.ui.ghost_controls`). It owns the scene nodes
 ``/space/ghost`` (a faint shell, the three principal sections and the principal axes, posed
 by the ghost's attitude) and ``/space/ghost_tip`` (the tip of the ghost's ω, which leaves the
 invariable plane when the energy drifts), and the readout and the plot in the panel folder it
@@ -289,7 +289,8 @@ class GhostCage:
 
 def add_error_plot(gui: viser.GuiApi, t0: float) -> viser.GuiUplotHandle:
     """The plot of log₁₀ of the errors, created with two samples at the floor (see
-    :meth:`poinsot.app.live.panel.ControlPanel`: an empty first data set breaks uPlot's range)."""
+    :meth:`poinsot.app.live.ui.panel.ControlPanel`: an empty first data set breaks uPlot's
+    range)."""
     return gui.add_uplot(
         data=(t0 + np.array([0.0, 1.0]), *(np.full(2, _LOG_FLOOR) for _ in range(3))),
         series=(
@@ -466,7 +467,7 @@ class Ghost:
     # -- removal -------------------------------------------------------------------------
     def remove(self) -> list[viser.GuiMarkdownHandle | viser.GuiUplotHandle]:
         """Remove the scene nodes now; return the widgets, for the caller to retire (hide now,
-        delete later: :mod:`poinsot.app.live.widgets`)."""
+        delete later: :mod:`poinsot.app.live.ui.widgets`)."""
         self.cage.remove()
         return [self.readout, self.plot]
 

@@ -16,7 +16,7 @@ from poinsot.app.cli import build_parser
 from poinsot.app.elements import Control
 from poinsot.app.exports.html import scene_html
 from poinsot.app.exports.screenshot import resolve_scene
-from poinsot.app.live.probe import Probe
+from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.presets import MENU, preset_by_key
 from poinsot.app.scene import palette
 from poinsot.app.scene.geometry import SceneDataError

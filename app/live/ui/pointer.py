@@ -29,7 +29,7 @@ import numpy as np
 import viser
 
 from poinsot.app.elements import Element
-from poinsot.app.live.clock import SimClock
+from poinsot.app.live.ui.clock import SimClock
 from poinsot.app.parameters import Parameters, Vector
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene

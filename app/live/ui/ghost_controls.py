@@ -25,8 +25,8 @@ from typing import Any
 
 import viser
 
-from poinsot.app.live.engine_upload import EngineLogUpload
-from poinsot.app.live.widgets import Retirement, Sent, on_user, set_value
+from poinsot.app.live.ui.engine_upload import EngineLogUpload
+from poinsot.app.live.ui.widgets import Retirement, Sent, on_user, set_value
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.ghost import (

@@ -4,8 +4,8 @@ Threads: viser runs GUI callbacks on its thread pool; they only post small actio
 session's queue and wake its frame thread, which alone touches the scene and the body. So a
 callback never blocks or raises into viser, a slider drag is coalesced into one rebuild per
 wake-up, and a slow or departed browser never stalls another (each session has its own thread;
-viser gives each client its own send buffer, and :mod:`.pacing` sends a client a new frame only
-once it has taken the ones before, so that buffer never grows).
+viser gives each client its own send buffer, and :mod:`..hardening.pacing` sends a client a new
+frame only once it has taken the ones before, so that buffer never grows).
 """
 
 from __future__ import annotations
@@ -19,21 +19,21 @@ from collections.abc import Callable
 import viser
 
 from poinsot.app.elements import ALL_ELEMENTS, Control, Element, Plot
-from poinsot.app.live.actions import MAX_ACTIONS, ActionQueue
-from poinsot.app.live.budget import RebuildGate
-from poinsot.app.live.clock import SimClock
-from poinsot.app.live.frame_loop import HOLD_SECONDS, FrameLoop
-from poinsot.app.live.ghost_controls import add_ghost_controls
-from poinsot.app.live.layout import Layout
-from poinsot.app.live.lecture import add_lecture_controls
-from poinsot.app.live.pacing import Outbox, Pacer, SessionStats
-from poinsot.app.live.panel import ControlPanel
-from poinsot.app.live.pointer import Pointer
-from poinsot.app.live.refresh import PLOT_HZ, PLOT_MIN_FRAMES, TIME_HZ, Refresh
-from poinsot.app.live.showcase import LiveShowcase
-from poinsot.app.live.sphere_pointer import SpherePointer
-from poinsot.app.live.uploads import UploadControls
-from poinsot.app.live.widgets import Retirement
+from poinsot.app.live.hardening.budget import RebuildGate
+from poinsot.app.live.hardening.pacing import Outbox, Pacer, SessionStats
+from poinsot.app.live.ui.actions import MAX_ACTIONS, ActionQueue
+from poinsot.app.live.ui.clock import SimClock
+from poinsot.app.live.ui.frame_loop import HOLD_SECONDS, FrameLoop
+from poinsot.app.live.ui.ghost_controls import add_ghost_controls
+from poinsot.app.live.ui.layout import Layout
+from poinsot.app.live.ui.lecture import add_lecture_controls
+from poinsot.app.live.ui.panel import ControlPanel
+from poinsot.app.live.ui.pointer import Pointer
+from poinsot.app.live.ui.refresh import PLOT_HZ, PLOT_MIN_FRAMES, TIME_HZ, Refresh
+from poinsot.app.live.ui.showcase import LiveShowcase
+from poinsot.app.live.ui.sphere_pointer import SpherePointer
+from poinsot.app.live.ui.uploads import UploadControls
+from poinsot.app.live.ui.widgets import Retirement
 from poinsot.app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters, drawn_solid
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, Preset
 from poinsot.app.scene.batch import Frame

@@ -42,7 +42,7 @@ from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.app.stage.served import ClientOf, Stage
 
 if TYPE_CHECKING:
-    from poinsot.app.live.lecture import LectureControls
+    from poinsot.app.live.ui.lecture import LectureControls
 
 #: Formats offered: label -> file suffix.
 FORMAT_CHOICES = {"MP4 (slides, web)": ".mp4", "GIF (loops)": ".gif"}

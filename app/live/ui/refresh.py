@@ -9,8 +9,8 @@ of them (12 Hz at 60 fps: a window that waits a frame still keeps up).
 
 from __future__ import annotations
 
-from poinsot.app.live.motion_window import MotionWindow
-from poinsot.app.live.widgets import Retirement
+from poinsot.app.live.ui.motion_window import MotionWindow
+from poinsot.app.live.ui.widgets import Retirement
 from poinsot.app.scene.batch import Frame
 
 #: Plot and time-readout refresh rates [Hz].

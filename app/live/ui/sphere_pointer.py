@@ -2,11 +2,11 @@
 a click, a tap or a drag on the sphere chooses the body-frame L where the motion starts, at
 |L| kept.
 
-As on the energy ellipsoid (:mod:`poinsot.app.live.pointer`): the sphere mesh's ``on_click``
+As on the energy ellipsoid (:mod:`poinsot.app.live.ui.pointer`): the sphere mesh's ``on_click``
 gives the ray, its ``on_drag`` the pointer on a plane facing the camera (the ray runs from the
 camera through it). The physics (:mod:`poinsot.physics.pointing`) meets the ray with the sphere
 ``|L| = G`` of the body on screen; ω = I⁻¹L and D follow from the point. Within
-:data:`~poinsot.app.live.pointer.SNAP_PX` pixels of the separatrix the point is snapped onto it
+:data:`~poinsot.app.live.ui.pointer.SNAP_PX` pixels of the separatrix the point is snapped onto it
 at |L| kept, and the body built from it is the exact separatrix.
 
 While a drag lasts the motion stands still and the polhode through the point is drawn twice:
@@ -27,9 +27,9 @@ from typing import Protocol
 import numpy as np
 import viser
 
-from poinsot.app.live.clock import SimClock
-from poinsot.app.live.pointer import PREVIEW_POINTS, Ray, snap_length
-from poinsot.app.live.showcase import LiveShowcase
+from poinsot.app.live.ui.clock import SimClock
+from poinsot.app.live.ui.pointer import PREVIEW_POINTS, Ray, snap_length
+from poinsot.app.live.ui.showcase import LiveShowcase
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.geometry import POLHODE_INFLATE
@@ -65,7 +65,7 @@ class SpherePointer:
     """The sphere's pointer of one session (see the module's docstring)."""
 
     def __init__(self, session: SphereSession, drag: bool = True) -> None:
-        """``drag``: as :class:`~poinsot.app.live.pointer.Pointer`'s (off on a touch screen)."""
+        """``drag``: as :class:`~poinsot.app.live.ui.pointer.Pointer`'s (off on a touch screen)."""
         self.session = session
         self.dragging = drag
         self.previews_drawn: list[viser.LineSegmentsHandle] = []  # sphere, ellipsoid

@@ -1,10 +1,10 @@
 """One session's frame thread: it wakes at its client's frame time (or when an action is
 posted), runs the session's queued work, and draws a frame if the browser has taken the one
-before (:class:`~.pacing.Pacer`).
+before (:class:`~..hardening.pacing.Pacer`).
 
 While another session rebuilds, a due frame waits for that rebuild to end
-(:meth:`~.budget.RebuildGate.hold` wakes it) for at most :data:`HOLD_SECONDS`, so that a slider
-move elsewhere runs alone and many students dragging sliders never freeze the others.
+(:meth:`~..hardening.budget.RebuildGate.hold` wakes it) for at most :data:`HOLD_SECONDS`, so that a
+slider move elsewhere runs alone and many students dragging sliders never freeze the others.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ import threading
 import time
 from collections.abc import Callable
 
-from poinsot.app.live.budget import RebuildGate
-from poinsot.app.live.pacing import Pacer, SessionStats
+from poinsot.app.live.hardening.budget import RebuildGate
+from poinsot.app.live.hardening.pacing import Pacer, SessionStats
 
 #: While another session rebuilds, a due frame is held until the rebuild ends, for at most
 #: HOLD_SECONDS [s].

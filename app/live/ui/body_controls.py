@@ -17,11 +17,11 @@ from typing import TYPE_CHECKING, Any
 import viser
 
 from poinsot.app.elements import Control
-from poinsot.app.live.widgets import Removable, Sent, set_marks, set_value
+from poinsot.app.live.ui.widgets import Removable, Sent, set_marks, set_value
 from poinsot.app.parameters import INERTIA_RANGE, OMEGA_NORM_RANGE, Parameters
 
 if TYPE_CHECKING:
-    from poinsot.app.live.panel import Widgets
+    from poinsot.app.live.ui.panel import Widgets
 
 SIDE_OPTIONS = ("minor axis", "major axis")
 POLE_OPTIONS = ("+ pole", "− pole")

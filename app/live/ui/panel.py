@@ -3,14 +3,14 @@
 Only the controls the current preset declares are shown (:meth:`ControlPanel.declare` creates
 whole groups, or shows them again; ``order`` keeps the layout stable whatever the creation
 order). A group the preset does not declare is put away: the panel's own groups are hidden and
-kept for when a preset declares them again (:class:`~poinsot.app.live.widgets.Shelf`: no
+kept for when a preset declares them again (:class:`~poinsot.app.live.ui.widgets.Shelf`: no
 widget of theirs is ever deleted, so no update can reach a deleted one), the groups other
 modules add are retired (hidden at once, deleted later).
 Callbacks never touch the scene or block: they hand a small action to the session's frame
 thread via :class:`Actions`. Programmatic value changes (``event.client is None``) are
 ignored, so the session can mirror its state into the widgets without feedback loops. The
 time, readouts and the plot of ω are in the floating "Motion" window
-(:mod:`poinsot.app.live.motion_window`).
+(:mod:`poinsot.app.live.ui.motion_window`).
 """
 
 from __future__ import annotations
@@ -22,10 +22,10 @@ from typing import Any, Protocol, TypeVar
 import viser
 
 from poinsot.app.elements import Control, Element, Plot
-from poinsot.app.live.body_controls import D_STEP, BodyControls
-from poinsot.app.live.legend import caption
-from poinsot.app.live.motion_window import MotionWindow
-from poinsot.app.live.widgets import (
+from poinsot.app.live.ui.body_controls import D_STEP, BodyControls
+from poinsot.app.live.ui.legend import caption
+from poinsot.app.live.ui.motion_window import MotionWindow
+from poinsot.app.live.ui.widgets import (
     Removable,
     Retirement,
     Sent,

@@ -26,7 +26,7 @@ from typing import Protocol
 import numpy as np
 import viser
 
-from poinsot.app.live.motion_window import MotionWindow
+from poinsot.app.live.ui.motion_window import MotionWindow
 from poinsot.app.scene import palette
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.body_view import OFFSET, BodyView
