@@ -105,7 +105,7 @@ class LectureControls:
         self.page = self.last_link = ""
         with self.client.gui.add_folder("Lecture: views and export", order=order):
             self._add_widgets(self.client.gui)
-        self.display = Display(session, session.panel.motion, self.style)
+        self.display = Display(session.client, session.scene, session.panel.motion, self.style)
         # Browser changes only, each value checked against its widget first (:func:`on_user`).
         for handle, callback in (
             (self.views, self._on_view),
