@@ -28,13 +28,14 @@ from poinsot.app.live.ui.ghost_controls import add_ghost_controls
 from poinsot.app.live.ui.layout import Layout
 from poinsot.app.live.ui.lecture import add_lecture_controls
 from poinsot.app.live.ui.panel import ControlPanel
+from poinsot.app.live.ui.playback import STEP_SECONDS, Playback, clamp_trail
 from poinsot.app.live.ui.pointer import Pointer
 from poinsot.app.live.ui.refresh import PLOT_HZ, PLOT_MIN_FRAMES, TIME_HZ, Refresh
 from poinsot.app.live.ui.showcase import LiveShowcase
 from poinsot.app.live.ui.sphere_pointer import SpherePointer
 from poinsot.app.live.ui.uploads import UploadControls
 from poinsot.app.live.ui.widgets import Retirement
-from poinsot.app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters, drawn_solid
+from poinsot.app.parameters import SPEED_RANGE, Parameters, drawn_solid
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, Preset
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
@@ -57,8 +58,6 @@ __all__ = [
 
 #: The animation rate cap per client [frames per second].
 MAX_FPS = 60.0
-#: "Step" advances this many wall seconds' worth of simulation time.
-STEP_SECONDS = 0.1
 
 
 class Session:
@@ -103,7 +102,6 @@ class Session:
         #: The scene being shown, if one is chosen instead of a preset (frame thread).
         self.showcase: LiveShowcase | None = None
         self.sphere_pointer: SpherePointer | None = None  # mounted with the pointer below
-        self.speed_range = SPEED_RANGE
 
         apply_theme(client)
         view.apply(client.camera)
@@ -115,6 +113,7 @@ class Session:
             client.gui, self, preset if scene is None else scene.identity(), self.retirement
         )
         self.refresh = Refresh(self.panel.motion, self.retirement)
+        self.playback = Playback(self.clock, self.scene, self.panel.show_playback, self.max_fps)
         # The ghost's controls; the ghost itself when switched on (fitted after each rebuild).
         self.ghost = add_ghost_controls(client, self.scene, self.retirement)
         self._apply_preset(preset) if scene is None else self._apply_scene(scene)
@@ -196,35 +195,26 @@ class Session:
         self.post(lambda: self._edit(change, count))
 
     def set_speed(self, speed: float) -> None:
-        speed = min(max(float(speed), self.speed_range[0]), self.speed_range[1])
-
-        def action() -> None:
-            self.clock.speed = speed
-            self.scene.set_frame_time(self.frame_time)
-
-        self.post(action, "speed")
+        speed = self.playback.clamp_speed(speed)
+        self.post(lambda: self.playback.set_speed(speed), "speed")
 
     @property
     def frame_time(self) -> float:
         """Simulation time one frame advances at full frame rate."""
-        return self.clock.speed / self.max_fps
+        return self.playback.frame_time
 
     def toggle_pause(self) -> None:
-        self.post(self._toggle_pause)
+        self.post(self.playback.toggle_pause)
 
     def step(self) -> None:
-        self.post(self._step)
+        self.post(self.playback.step)
 
     def reset(self) -> None:
         self.post(self._reset)
 
     def set_trail(self, points: int) -> None:
-        points = min(max(int(points), TRAIL_RANGE[0]), TRAIL_RANGE[1])
-
-        def action() -> None:
-            self.scene.trail_points = points
-
-        self.post(action, "trail")
+        points = clamp_trail(points)
+        self.post(lambda: self.playback.set_trail(points), "trail")
 
     def set_visible(self, element: Element, visible: bool) -> None:
         self.post(lambda: self.scene.set_visible(element, visible), ("element", element))
@@ -322,28 +312,25 @@ class Session:
             self._base = preset
             self._base_inertia = Parameters.from_preset(preset).inertia
             self._desired = Parameters.from_preset(preset)
-            self.clock.speed = preset.speed
-            self.scene.trail_points = preset.trail_points
+            self.playback.take(preset.speed, preset.trail_points)
             self._dirty = True
         self.scene.declare(preset.elements)
         self._declare(preset.controls, preset.plots, preset.elements, self._desired)
         self.panel.show_preset(preset, menu_count)
-        self._show_playback()
+        self.playback.show()
 
     def _apply_scene(self, scene: SceneSpec, menu_count: int | None = None) -> None:
         """Show ``scene``: the construction's elements it declares, the panel's groups it shares
         (speed, playback, trail, show/hide), and its own controls, parts, readouts and plots."""
         self._leave_scene()
         self.preset = scene.identity()
-        self.speed_range = scene.speed_range
-        self.clock.speed = scene.initial_speed()
-        self.scene.trail_points = scene.trail_points
+        self.playback.take(scene.initial_speed(), scene.trail_points, scene.speed_range)
         self.showcase = LiveShowcase(
             scene, self.client, self.scene, self.panel.motion, self, self.retirement
         )
         self._declare(scene.shared, frozenset(), scene.elements, self._desired)
         self.panel.show_preset(self.preset, menu_count)
-        self._show_playback()
+        self.playback.show()
         scene.view.apply(self.client.camera)
         if self.sphere_pointer is not None:
             self.sphere_pointer.bind()
@@ -365,7 +352,7 @@ class Session:
         if self.showcase is not None:
             self.showcase.remove()
             self.showcase = None
-            self.speed_range = SPEED_RANGE
+            self.playback.speed_range = SPEED_RANGE
             self.body = None
             self._dirty = True
             DEFAULT_VIEW.apply(self.client.camera)
@@ -435,18 +422,6 @@ class Session:
         motion.record_plot(0.0, frame.omega, frame.wxyz)
         self._set_status("")
 
-    def _toggle_pause(self) -> None:
-        self.clock.paused = not self.clock.paused
-        self._show_playback()
-
-    def _step(self) -> None:
-        self.clock.paused = True
-        self.clock.step(STEP_SECONDS * self.clock.speed)
-        self._show_playback()
-
     def _reset(self) -> None:
         self.clock.reset(0.0)
         self.panel.motion.clear_plot()
-
-    def _show_playback(self) -> None:
-        self.panel.show_playback(self.clock.speed, self.clock.paused, self.scene.trail_points)
