@@ -3,8 +3,8 @@
 
 For each number of connected clients it starts a real Poinsot server in this process and the clients
 in a *separate* process (so that their decoding does not count as server time). The clients are
-:class:`poinsot.app.live.probe.Probe` websockets speaking viser's protocol like a browser. It
-prints:
+:class:`poinsot.app.live.hardening.probe.Probe` websockets speaking viser's protocol like a browser.
+It prints:
 
 - server time per client-frame, two ways: the CPU time of the session's frame thread per
   frame (everything Poinsot does for a client-frame: physics, scene updates, plot and time
@@ -16,7 +16,7 @@ prints:
   (poses, trace increments, labels, the plot at 10 Hz and the time readout: one frame is one
   websocket message), and its viser messages, all and the scene's alone; and the frames the
   session skipped because the client had not yet taken the ones before
-  (:mod:`poinsot.app.live.pacing`);
+  (:mod:`poinsot.app.live.hardening.pacing`);
 - slider-to-redraw time: from a client sending a slider value to that client receiving the new
   ellipsoid (the scale of ``/space/body/ellipsoid``), median and p95, and the server's
   rebuild time alone;
@@ -48,7 +48,7 @@ from multiprocessing.connection import Connection
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from poinsot.app.live.probe import Probe
+    from poinsot.app.live.hardening.probe import Probe
 
 #: Values the benchmark's slider alternates between (I2 of the default preset: valid bodies).
 SLIDER_LABEL = "I₂"
@@ -66,7 +66,7 @@ def _percentile(values: list[float], q: float) -> float:
 # -- the client process ----------------------------------------------------------------------
 def _clients_main(port: int, count: int, seconds: float, redraws: int, conn: Connection) -> None:
     """Runs in a child process: connect, measure traffic, then measure slider round trips."""
-    from poinsot.app.live.probe import Probe
+    from poinsot.app.live.hardening.probe import Probe
 
     probes = [Probe(port, keep_batches=True) for _ in range(count)]
     for probe in probes:
@@ -218,7 +218,7 @@ def run(clients: int, seconds: float = 5.0, redraws: int = 30) -> Result:
 
 def _probe_main(port: int, seconds: float) -> None:
     """Child process of :func:`viser_floor`: one headless client that just listens."""
-    from poinsot.app.live.probe import Probe
+    from poinsot.app.live.hardening.probe import Probe
 
     Probe(port)
     time.sleep(seconds)
@@ -277,7 +277,7 @@ def twins_cost(frames: int = 600, rounds: int = 5) -> tuple[float, float]:
     per-client-frame figure above.
     """
     from poinsot.app.scenes import scene_by_name
-    from poinsot.app.scenes.stage import SceneStage
+    from poinsot.app.stage.scene_stage import SceneStage
 
     spec = scene_by_name("dzhanibekov")
     dt = spec.speed / 60.0

@@ -3,7 +3,10 @@
 ``poinsot`` serves the live app; ``report``, ``screenshot``, ``export-html``, ``benchmark`` and
 ``fit`` (the exact free motion fitted to a gyroscope recording) are the offline commands.
 
-Every option of every command is declared here (:func:`build_parser`), with the converters of
+:func:`build_parser` makes the one parser of ``poinsot``: the serve, report and benchmark options
+are declared here, the other commands' next to their implementation (:mod:`.cli_pictures`:
+screenshot and export-html; :mod:`.cli_motion`: video and the strobe; :mod:`.cli_fit`: fit;
+:mod:`.check_engine`: check-engine), all with the converters of
 :mod:`poinsot.app.cli_types`. Each subcommand sets
 ``func``, its implementation, which takes its options as plain typed keyword arguments named
 as its parameters (the parser's ``type=`` converters turn the text into values) and returns
@@ -16,38 +19,27 @@ from __future__ import annotations
 import argparse
 import inspect
 import os
-import pathlib
 import sys
 import time
 from collections.abc import Callable, Sequence
 
 from poinsot.app.arguments import (
     OneLineParser,
-    bounded_float,
-    input_path,
-    non_negative_float,
     output_dir,
-    output_file,
     port_number,
     positive_float,
     positive_int,
     run_guarded,
 )
 from poinsot.app.check_engine import add_check_engine_arguments
-from poinsot.app.cli_motion import add_strobe_arguments, add_video_arguments
+from poinsot.app.cli_fit import add_fit_arguments
+from poinsot.app.cli_motion import add_video_arguments
+from poinsot.app.cli_pictures import add_export_html_arguments, add_screenshot_arguments
 from poinsot.app.cli_types import (
-    fixed_view_type,
     link_type,
-    preset_type,
     scene_only_type,
-    scene_type,
-    seconds_type,
-    size_type,
-    view_type,
 )
-from poinsot.app.exports.html import HTML_FPS, HTML_MAX_SECONDS
-from poinsot.app.presets import PRESETS, Preset, preset_by_key
-from poinsot.app.scene.cameras import CAMERA_NAMES, RIDE_ALONG
+from poinsot.app.presets import PRESETS, preset_by_key
 from poinsot.app.scenes import scene_names
 from poinsot.app.scenes.spec import SceneSpec
 
@@ -82,7 +74,7 @@ def serve(
     else with ``preset``. With ``workers`` > 1 the sessions run in that many processes behind
     a landing port (:mod:`poinsot.app.live.workers`). A port that cannot be served is one
     line and exit status 2."""
-    from poinsot.app.live.network import PortError, board, check_port, port_problem
+    from poinsot.app.live.hardening.network import PortError, board, check_port, port_problem
 
     try:
         check_port(host, port)
@@ -124,78 +116,6 @@ def report(args: argparse.Namespace) -> int:
     from poinsot.app.report import run_report
 
     return run_report(Path(args.out), quick=args.quick)
-
-
-def screenshot(
-    out: pathlib.Path,
-    scene: Preset | SceneSpec,
-    t: float | None,
-    size: tuple[int, int],
-    view: str,
-    background: str,
-    fit: bool,
-    strobe: int | None,
-    t_from: float | None,
-    t_to: float | None,
-) -> int:
-    """Write a PNG of a scene through headless Chromium (see
-    :mod:`poinsot.app.exports.screenshot`), with a strobe of the body if asked."""
-    from poinsot.app.cli_motion import strobe_of
-    from poinsot.app.exports.screenshot import screenshot_command
-
-    try:
-        copies = strobe_of(strobe, t_from, t_to, t, view)
-    except ValueError as exc:
-        print(f"poinsot screenshot: error: {exc}", file=sys.stderr)
-        return 2
-    return screenshot_command(
-        out, scene, t=t, size=size, view=view, background=background, fit=fit, strobe=copies
-    )
-
-
-def export_html(
-    out: pathlib.Path,
-    preset: Preset | SceneSpec,
-    seconds: float,
-    fps: float,
-    view: str,
-    light: bool,
-) -> int:
-    """Write a standalone animated HTML page (see :mod:`poinsot.app.exports.html`)."""
-    from poinsot.app.exports.html import export_html_command
-
-    return export_html_command(out, preset, seconds=seconds, fps=fps, view=view, light=light)
-
-
-def fit(
-    path: pathlib.Path,
-    start: float | None,
-    end: float | None,
-    json_out: pathlib.Path | None,
-    plot_out: pathlib.Path | None,
-    degrees: bool,
-    fit_rotation: bool,
-    fit_bias: bool,
-) -> int:
-    """Fit the exact free motion to each toss of a recording (see :mod:`poinsot.app.fitting`)."""
-    from poinsot.app.fitting import run_fit
-
-    if start is not None and end is not None and not start < end:
-        print(
-            f"poinsot fit: error: the start ({start:g} s) must come before the end ({end:g} s)",
-            file=sys.stderr,
-        )
-        return 2
-    return run_fit(
-        path,
-        start=start,
-        end=end,
-        json_out=json_out,
-        plot_out=plot_out,
-        degrees=degrees,
-        fit_rotation=fit_rotation,
-        fit_bias=fit_bias,
-    )
 
 
 def benchmark(clients: list[int], seconds: float, redraws: int, video: bool, drag: bool) -> int:
@@ -272,95 +192,6 @@ def _add_report_arguments(parser: argparse.ArgumentParser) -> None:
     parser.set_defaults(func=report)
 
 
-def _add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
-    keys = "{" + ",".join(p.key for p in PRESETS) + "}"
-    which = parser.add_mutually_exclusive_group()
-    which.add_argument(
-        "--preset",
-        dest="scene",
-        type=preset_type,
-        default=PRESETS[0].key,
-        metavar=keys,
-        help="preset to draw",
-    )
-    which.add_argument(
-        "--scene",
-        type=scene_type,
-        metavar="NAME",
-        help="a scene by name ("
-        + ", ".join(scene_names())
-        + "), or a preset by key or label, e.g. 'Sphere (a cube)'",
-    )
-    parser.add_argument(
-        "--time",
-        dest="t",
-        metavar="TIME",
-        type=non_negative_float,
-        default=None,
-        help="simulation time of the picture (default: one period of omega)",
-    )
-    parser.add_argument(
-        "--size", type=size_type, default="1920x1080", help="WIDTHxHEIGHT in pixels"
-    )
-    parser.add_argument(
-        "--view",
-        type=view_type,
-        default="default",
-        metavar="{" + ",".join(CAMERA_NAMES) + "}",
-        help="camera, as the browser's buttons name it: the scene's default view, along L "
-        "(from above), the side, or riding on the body",
-    )
-    parser.add_argument(
-        "--background",
-        choices=("dark", "light", "transparent"),
-        default="dark",
-        help="opaque dark or light theme background, or a transparent PNG",
-    )
-    parser.add_argument(
-        "--no-fit",
-        dest="fit",
-        action="store_false",
-        help="keep the view's field of view instead of framing the construction",
-    )
-    add_strobe_arguments(parser)
-    parser.add_argument("--out", type=output_file, required=True, help="output .png file")
-    parser.set_defaults(func=screenshot)
-
-
-def _add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
-    keys = "{" + ",".join(p.key for p in PRESETS) + "}"
-    which = parser.add_mutually_exclusive_group()
-    which.add_argument(
-        "--preset", type=preset_type, default=PRESETS[0].key, metavar=keys, help="preset to record"
-    )
-    which.add_argument(
-        "--scene",
-        dest="preset",
-        type=scene_type,
-        metavar="NAME",
-        help="or a scene to record: " + ", ".join(scene_names()),
-    )
-    parser.add_argument(
-        "--seconds",
-        type=bounded_float(0.0, HTML_MAX_SECONDS, open_low=True),
-        default=20.0,
-        help="clip length (wall seconds)",
-    )
-    parser.add_argument(
-        "--fps", type=bounded_float(1.0, 60.0), default=HTML_FPS, help="recorded frames per second"
-    )
-    parser.add_argument(
-        "--view",
-        type=fixed_view_type,
-        default="default",
-        metavar="{" + ",".join(v for v in CAMERA_NAMES if v != RIDE_ALONG) + "}",
-        help="initial camera, as the browser's buttons name it (the viewer can still orbit)",
-    )
-    parser.add_argument("--light", action="store_true", help="light theme (default: dark)")
-    parser.add_argument("--out", type=output_file, required=True, help="output .html file")
-    parser.set_defaults(func=export_html)
-
-
 def _add_benchmark_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--clients",
@@ -384,44 +215,6 @@ def _add_benchmark_arguments(parser: argparse.ArgumentParser) -> None:
     parser.set_defaults(func=benchmark)
 
 
-def _add_fit_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "path",
-        type=input_path,
-        metavar="PATH",
-        help="a phyphox export (folder or .zip) or a CSV of t, ωx, ωy, ωz",
-    )
-    parser.add_argument(
-        "--start", type=seconds_type, metavar="S", help="fit only from this time [s] (one stretch)"
-    )
-    parser.add_argument(
-        "--end", type=seconds_type, metavar="E", help="fit only up to this time [s] (one stretch)"
-    )
-    parser.add_argument(
-        "--json", dest="json_out", type=output_file, metavar="OUT", help="write the fits as JSON"
-    )
-    parser.add_argument(
-        "--plot",
-        dest="plot_out",
-        type=output_file,
-        metavar="OUT.png",
-        help="plot the measured ω against the fits (needs matplotlib)",
-    )
-    parser.add_argument(
-        "--deg", dest="degrees", action="store_true", help="the plain CSV is in deg/s"
-    )
-    parser.add_argument(
-        "--rotation",
-        dest="fit_rotation",
-        action="store_true",
-        help="also fit a small rotation between the sensor's and the principal axes",
-    )
-    parser.add_argument(
-        "--bias", dest="fit_bias", action="store_true", help="also fit a constant gyroscope bias"
-    )
-    parser.set_defaults(func=fit)
-
-
 #: Subcommand -> (help, how its options are declared).
 _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] = {
     "serve": ("serve the interactive scene (the default)", _add_serve_arguments),
@@ -429,10 +222,10 @@ _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] =
         "work-precision report: the exact solution beside numerical integrators",
         _add_report_arguments,
     ),
-    "screenshot": ("a PNG of a scene, rendered by headless Chromium", _add_screenshot_arguments),
+    "screenshot": ("a PNG of a scene, rendered by headless Chromium", add_screenshot_arguments),
     "export-html": (
         "a standalone animated HTML page that plays from a file",
-        _add_export_html_arguments,
+        add_export_html_arguments,
     ),
     "video": ("an MP4 or GIF of a scene, rendered by headless Chromium", add_video_arguments),
     "benchmark": (
@@ -441,7 +234,7 @@ _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] =
     ),
     "fit": (
         "fit the exact free motion to the tosses of a gyroscope recording (phyphox or CSV)",
-        _add_fit_arguments,
+        add_fit_arguments,
     ),
     "check-engine": (
         "does a physics engine's log (t, wx, wy, wz[, qw, qx, qy, qz]) move as a free body?",

@@ -12,7 +12,7 @@ from poinsot.app.arguments import output_file
 from poinsot.app.exports.screenshot import parse_size, resolve_scene
 from poinsot.app.exports.video import FORMATS as VIDEO_FORMATS
 from poinsot.app.exports.video import MAX_SIZE as VIDEO_MAX_SIZE
-from poinsot.app.live.links import LinkError, parse
+from poinsot.app.live.ui.links import LinkError, parse
 from poinsot.app.presets import Preset, preset_by_key
 from poinsot.app.scene.cameras import RIDE_ALONG, canonical
 from poinsot.app.scenes import scene_by_name
@@ -76,7 +76,7 @@ def size_type(text: str) -> tuple[int, int]:
 
 
 def link_type(text: str) -> str:
-    """A link to a state (:mod:`poinsot.app.live.links`): its query, or a whole URL; the
+    """A link to a state (:mod:`poinsot.app.live.ui.links`): its query, or a whole URL; the
     query is returned, checked."""
     query = text.partition("?")[2] if "?" in text else text
     try:

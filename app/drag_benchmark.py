@@ -1,16 +1,16 @@
 """The drag rows of ``poinsot benchmark``: from a browser's drag update on the ellipsoid to the
-polhode through the pointed start arriving at that browser (:mod:`poinsot.app.live.pointer`).
+polhode through the pointed start arriving at that browser (:mod:`poinsot.app.live.ui.pointer`).
 
 The server runs as ``poinsot serve --workers N`` does (:mod:`poinsot.app.live.workers`), on
-loopback; the clients are :class:`~poinsot.app.live.probe.Probe` websockets in this process,
-one thread each, that all drag at once, each update sent when the last one's polhode has come
-(viser sends a dragging browser's updates at about 20 Hz: :data:`PAUSE` between them). Each
+loopback; the clients are :class:`~poinsot.app.live.hardening.probe.Probe` websockets in this
+process, one thread each, that all drag at once, each update sent when the last one's polhode has
+come (viser sends a dragging browser's updates at about 20 Hz: :data:`PAUSE` between them). Each
 round trip is timed by the client, from sending the update to receiving the drawn polhode:
 the ray met with the ellipsoid, the body of the start built, its polhode evaluated, sent and
 decoded. Goals: p95 <= 50 ms with one client, <= 100 ms with ten on two workers.
 
 Each row also gives the server's share, as the workers measured it
-(:attr:`~poinsot.app.live.pointer.StartPointer.server_seconds`): from the update's arrival on
+(:attr:`~poinsot.app.live.ui.pointer.StartPointer.server_seconds`): from the update's arrival on
 viser's event loop to its polhode handed to the socket. The rest of a round trip is the
 network, the probe's decoding and, on a busy machine, waiting for a core. An update answered by
 nothing is counted apart: a start whose polhode is the one drawn already (two starts snapped
@@ -28,7 +28,7 @@ import threading
 import time
 from typing import TYPE_CHECKING
 
-from poinsot.app.live.probe import Probe
+from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.live.workers import start_workers, stop_workers
 from poinsot.app.presets import DEFAULT_PRESET
 

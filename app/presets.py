@@ -47,7 +47,7 @@ class Preset:
     controls: frozenset[Control] = STANDARD_CONTROLS
     plots: frozenset[Plot] = STANDARD_PLOTS
     #: One or two sentences saying what the picture shows, over the legend (a scene sets its
-    #: own here; empty: :mod:`poinsot.app.live.legend` has the presets' captions).
+    #: own here; empty: :mod:`poinsot.app.live.ui.legend` has the presets' captions).
     caption: str = ""
 
     def __post_init__(self) -> None:

@@ -8,7 +8,7 @@ Reusable pieces (also for the screenshot and export tests):
 - ``poinsot_app`` (factory ``make_app``): a :class:`poinsot.app.live.server.PoinsotApp` on a
   free port;
 - ``probe`` (factory ``make_probe``): a headless websocket client
-  (:mod:`poinsot.app.live.probe`);
+  (:mod:`poinsot.app.live.hardening.probe`);
 - ``chromium`` (session scope): a launched playwright Browser;
 - ``open_page``: ``open_page(url, width=..., height=...) -> BrowserPage`` with the console
   errors collected, the canvas ready and the software-WebGL notice hidden;
@@ -35,10 +35,10 @@ import pytest
 
 from poinsot.app.cli import main as cli_main
 from poinsot.app.exports.screenshot import CHROMIUM_ARGS, CHROMIUM_ENV, DEFAULT_CHROMIUM
-from poinsot.app.live.lecture import LectureControls
-from poinsot.app.live.probe import Probe
+from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.live.server import PoinsotApp
-from poinsot.app.live.session import Session
+from poinsot.app.live.ui.lecture import LectureControls
+from poinsot.app.live.ui.session import Session
 from poinsot.app.presets import DEFAULT_PRESET, Preset
 from poinsot.app.report.cases import CASES, StudyConfig
 from poinsot.app.report.exact import load_reference

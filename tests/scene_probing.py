@@ -13,9 +13,9 @@ import numpy as np
 from conftest import session_of, wait_until
 from scipy.spatial.transform import Rotation
 
-from poinsot.app.live.probe import Node, Probe
+from poinsot.app.live.hardening.probe import Node, Probe
 from poinsot.app.live.server import PoinsotApp
-from poinsot.app.live.session import Session
+from poinsot.app.live.ui.session import Session
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.frames import xyzw_from_wxyz
 

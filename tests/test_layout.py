@@ -2,6 +2,7 @@
 
 import ast
 import pathlib
+import re
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 ALLOWED = {
@@ -58,6 +59,35 @@ def test_physics_imports_nothing_of_the_app():
         ours = {m for m in _imported_modules(f) if m.split(".")[0] == "poinsot"}
         bad = {m for m in ours if not (m + ".").startswith("poinsot.physics.")}
         assert not bad, f"{f.name} imports {sorted(bad)}"
+
+
+def _floors_of_contract(name_start: str) -> list[list[str]]:
+    """The layers of the import contract whose name starts with ``name_start``, each a list of
+    its rooms, top first."""
+    import tomllib
+
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    for contract in config["tool"]["importlinter"]["contracts"]:
+        if contract["name"].startswith(name_start):
+            return [re.split(r"\s*[|:]\s*", layer.strip()) for layer in contract["layers"]]
+    raise AssertionError(f"no import contract named {name_start!r}...")
+
+
+def _floors_of_page(heading: str) -> list[list[str]]:
+    """The rooms column of the floors table whose header row starts with ``heading`` in
+    docs/ARCHITECTURE.md, each floor a list of its rooms, top first."""
+    text = (ROOT / "docs" / "ARCHITECTURE.md").read_text()
+    table = text[text.index(heading) :].split("\n\n")[0].splitlines()[2:]  # past the header
+    cells = [re.split(r"(?<!\\)\|", row) for row in table]
+    return [re.findall(r"`([\w.]+)`", row[2]) for row in cells]
+
+
+def test_the_architecture_tables_are_the_layered_contracts():
+    """docs/ARCHITECTURE.md's floors are the layers of pyproject.toml's contracts, in order."""
+    app = _floors_of_page("| floor | rooms (`poinsot.app.…`)")
+    live = _floors_of_page("| floor | rooms (`poinsot.app.live.…`)")
+    assert app == _floors_of_contract("the app's floors")
+    assert live == _floors_of_contract("the live server")
 
 
 def test_code_imports_through_the_one_namespace():

@@ -9,7 +9,7 @@ import numpy as np
 import trimesh
 from viser import _messages
 
-from poinsot.app.live.probe import Probe
+from poinsot.app.live.hardening.probe import Probe
 from poinsot.physics.fit import synthetic_toss
 
 #: The T-handle of the presets, tossed spinning about its intermediate axis (it flips).

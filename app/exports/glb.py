@@ -17,6 +17,7 @@ import trimesh.visual.material
 from poinsot.app.elements import Solid
 from poinsot.app.exports.run_csv import DEFAULT_SPAN, period_or
 from poinsot.app.scene import meshes, palette
+from poinsot.app.scene.ellipsoid import ellipsoid_mesh
 from poinsot.app.scene.geometry import (
     CONTACT_RADIUS,
     HERPOLHODE_LIFT,
@@ -128,8 +129,7 @@ def _arrow(tip: np.ndarray, shape: ArrowShape) -> trimesh.Trimesh:
 
 def _body_parts(g: Geometry) -> dict[str, trimesh.Trimesh]:
     """What the body node carries, in body coordinates: the ellipsoid, the polhode, the solid."""
-    ellipsoid = meshes.ellipsoid_unit_mesh()
-    ellipsoid.apply_transform(np.diag([*g.semi_axes, 1.0]))
+    ellipsoid = ellipsoid_mesh(g.semi_axes)
     polhode = g.polhode * POLHODE_INFLATE
     if g.polhode_closed:
         polhode = np.concatenate([polhode, polhode[:1]])

@@ -1,6 +1,6 @@
 """The animation as one standalone HTML page that plays from a file.
 
-A :class:`~poinsot.app.exports.stage.Stage` is recorded frame by frame with viser's scene
+A :class:`~poinsot.app.stage.served.Stage` is recorded frame by frame with viser's scene
 serializer (``insert_sleep`` between frames, ``as_html``): the viser client and the recording
 in one file that plays from ``file://`` with no server.
 """
@@ -16,13 +16,13 @@ from typing import Any
 from viser.infra import StateSerializer
 
 from poinsot.app.elements import Element, Solid
-from poinsot.app.exports.stage import Stage
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import Preset
 from poinsot.app.scene.cameras import space_view
 from poinsot.app.scene.view import DEFAULT_VIEW, View
 from poinsot.app.scenes.spec import SceneSpec
-from poinsot.app.scenes.stage import SceneStage
+from poinsot.app.stage.scene_stage import SceneStage
+from poinsot.app.stage.served import Stage
 
 #: Frames per second of the recorded animation: smooth, and half the bytes of 60.
 HTML_FPS = 30.0

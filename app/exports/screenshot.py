@@ -4,7 +4,7 @@ A picture is rendered by a browser (viser's ``get_render``: WebGL, at any size, 
 control panel or notices), comes back RGBA with a transparent background, and is laid on the
 theme's background colour unless a transparent PNG is asked for (:func:`png_bytes`).
 
-``poinsot screenshot`` starts a :class:`~poinsot.app.exports.stage.Stage` (the app's own scene
+``poinsot screenshot`` starts a :class:`~poinsot.app.stage.served.Stage` (the app's own scene
 construction on a viser server at a free port), seeks it to the requested time, opens it in headless
 Chromium through playwright, renders, and writes the PNG. The camera is a named view
 (:mod:`poinsot.app.scene.cameras`); unless ``--no-fit`` is given, its field of view is then narrowed
@@ -35,7 +35,6 @@ import numpy as np
 import viser
 from scipy.spatial.transform import Rotation
 
-from poinsot.app.exports.stage import ClientOf, Stage
 from poinsot.app.exports.strobe import Strobe, StrobeError, add_strobe, body_of
 from poinsot.app.presets import PRESETS, Preset, preset_by_key
 from poinsot.app.scene.cameras import space_view
@@ -43,7 +42,8 @@ from poinsot.app.scene.frames import wxyz as to_wxyz
 from poinsot.app.scene.view import View
 from poinsot.app.scenes import scene_by_name
 from poinsot.app.scenes.spec import SceneSpec
-from poinsot.app.scenes.stage import SceneStage
+from poinsot.app.stage.scene_stage import SceneStage
+from poinsot.app.stage.served import ClientOf, Stage
 
 if TYPE_CHECKING:
     from playwright.sync_api import Browser, ViewportSize
@@ -372,7 +372,7 @@ def open_stage(
     scene: Preset | SceneSpec, dark_mode: bool, client_of: ClientOf | None = None
 ) -> Stage | SceneStage:
     """The stage that draws a preset or a scene (stop it when done); ``client_of``: on one
-    browser's own scene (:data:`~poinsot.app.exports.stage.ClientOf`)."""
+    browser's own scene (:data:`~poinsot.app.stage.served.ClientOf`)."""
     if isinstance(scene, SceneSpec):
         return SceneStage(scene, dark_mode=dark_mode, client_of=client_of)
     return Stage.from_preset(scene, dark_mode=dark_mode, client_of=client_of)

@@ -22,7 +22,7 @@ import math
 import numpy as np
 import viser
 
-from poinsot.app.exports.stage import Stage
+from poinsot.app.scene.ellipsoid import ellipsoid_mesh
 from poinsot.app.scene.geometry import (
     DISPLAY_RADIUS,
     L_OVERSHOOT,
@@ -30,9 +30,9 @@ from poinsot.app.scene.geometry import (
     Geometry,
     triple,
 )
-from poinsot.app.scene.meshes import ellipsoid_unit_mesh
 from poinsot.app.scene.view import View
-from poinsot.app.scenes.stage import SceneStage
+from poinsot.app.stage.scene_stage import SceneStage
+from poinsot.app.stage.served import Stage
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.flip import measure_flips
 
@@ -115,8 +115,8 @@ def body_mesh(geometry: Geometry) -> tuple[np.ndarray, np.ndarray]:
     mesh = geometry.solid_mesh
     if mesh is not None:
         return np.asarray(mesh.vertices, float), np.asarray(mesh.faces)
-    unit = ellipsoid_unit_mesh()
-    return np.asarray(unit.vertices, float) * geometry.semi_axes, np.asarray(unit.faces)
+    mesh = ellipsoid_mesh(geometry.semi_axes)
+    return np.asarray(mesh.vertices, float), np.asarray(mesh.faces)
 
 
 def _basis(view: View) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:

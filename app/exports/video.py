@@ -34,10 +34,10 @@ from poinsot.app.exports.screenshot import (
     headless_chromium,
     open_window,
 )
-from poinsot.app.exports.stage import ClientOf, Stage
 from poinsot.app.scene.cameras import BODY_VIEW, ride_along
 from poinsot.app.scene.view import View
-from poinsot.app.scenes.stage import SceneStage
+from poinsot.app.stage.scene_stage import SceneStage
+from poinsot.app.stage.served import ClientOf, Stage
 
 #: The formats, by the output file's suffix.
 FORMATS = (".mp4", ".gif")

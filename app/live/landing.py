@@ -24,7 +24,7 @@ import urllib.parse
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
-from poinsot.app.live.network import PortError, bind_errno, port_problem
+from poinsot.app.live.hardening.network import PortError, bind_errno, port_problem
 
 #: A browser sent to a worker that has not connected within this many seconds is forgotten
 #: (it closed the tab, reloaded straight on the worker's port, or was a tool that only follows

@@ -1,4 +1,5 @@
-"""The viser server and its sessions: one :class:`~poinsot.app.live.session.Session` per browser."""
+"""The viser server and its sessions: one :class:`~poinsot.app.live.ui.session.Session` per
+browser."""
 
 from __future__ import annotations
 
@@ -11,13 +12,13 @@ from concurrent.futures import Future
 
 import viser
 
-from poinsot.app.live import links
-from poinsot.app.live.backlog import BacklogLimit, BacklogWatch
-from poinsot.app.live.budget import RebuildGate
-from poinsot.app.live.guard import WireGuard, guarded_viser
-from poinsot.app.live.pacing import frame_share
-from poinsot.app.live.session import MAX_FPS, Session
-from poinsot.app.live.upkeep import MemoryTrim, fixed_pool
+from poinsot.app.live.hardening.backlog import BacklogLimit, BacklogWatch
+from poinsot.app.live.hardening.budget import RebuildGate
+from poinsot.app.live.hardening.guard import WireGuard, guarded_viser
+from poinsot.app.live.hardening.pacing import frame_share
+from poinsot.app.live.hardening.upkeep import MemoryTrim, fixed_pool
+from poinsot.app.live.ui import links
+from poinsot.app.live.ui.session import MAX_FPS, Session
 from poinsot.app.presets import DEFAULT_PRESET, Preset
 from poinsot.app.scenes.spec import SceneSpec
 from poinsot.app.viser_private import handshake_origin, page_address
@@ -52,10 +53,10 @@ class PoinsotApp:
     ) -> None:
         """Each new browser starts with ``preset``, or with ``scene`` if one is given. A
         browser's websocket is refused unless it comes from a page this server served, or from
-        one of ``allow_origins`` (``scheme://host[:port]``); see :mod:`.guard`. A browser that
-        leaves more than ``backlog`` untaken for longer than its grace is disconnected
-        (:mod:`.backlog`; its defaults if None). ``landing_port``: a landing in front of this
-        server (:mod:`.landing`), named by the links copied from the pages served here."""
+        one of ``allow_origins`` (``scheme://host[:port]``); see :mod:`.hardening.guard`. A browser
+        that leaves more than ``backlog`` untaken for longer than its grace is disconnected
+        (:mod:`.hardening.backlog`; its defaults if None). ``landing_port``: a landing in front of
+        this server (:mod:`.landing`), named by the links copied from the pages served here."""
         self.preset = preset
         self.scene = scene
         self.landing_port = landing_port
@@ -71,7 +72,7 @@ class PoinsotApp:
         self.discarded = 0
         self._connected = threading.Condition(self._lock)
         self.budget = RebuildGate()
-        # Handshakes checked before viser sees them, the share tunnel off (:mod:`.guard`).
+        # Handshakes checked before viser sees them, the share tunnel off (:mod:`.hardening.guard`).
         self.server, gate = guarded_viser(host, port, verbose=verbose, allow_origins=allow_origins)
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
         self.server.scene.world_axes.visible = False
@@ -81,15 +82,16 @@ class PoinsotApp:
         # disconnect callback stopping it; viser then warns once that the message is dropped.
         # That is expected here, not a leak: the thread stops right after.
         warnings.filterwarnings("ignore", message=r"Queued a \w+ on a closed connection")
-        # Sessions are built on a fixed pool (:mod:`.upkeep`), which also runs the widgets'
-        # worker-thread callbacks; a departure is handled on viser's event loop (it only
+        # Sessions are built on a fixed pool (:mod:`.hardening.upkeep`), which also runs the
+        # widgets' worker-thread callbacks; a departure is handled on viser's event loop (it only
         # stops a thread) and, once quiet, memory is handed back.
         self.pool = fixed_pool()
         self.server.get_event_loop().set_default_executor(self.pool)
         self.memory = MemoryTrim()
         self.server.on_client_connect(self._on_connect)
         self.server.on_client_disconnect(self._on_disconnect)
-        #: Closes the connection of a client that leaves too much untaken (:mod:`.backlog`).
+        #: Closes the connection of a client that leaves too much untaken
+        #: (:mod:`.hardening.backlog`).
         self.backlog = BacklogWatch(self.sessions, backlog).start()
 
     @property
@@ -136,7 +138,7 @@ class PoinsotApp:
     def _connect(self, client: viser.ClientHandle, address: str | None = None) -> None:
         """Build the session outside the lock (30-300 ms), then register and start it under
         the lock, unless the client left meanwhile: then it is closed and never started. The
-        page's ``address`` may carry a link to a state (:mod:`.links`)."""
+        page's ``address`` may carry a link to a state (:mod:`.ui.links`)."""
         with self._lock:
             if client.client_id in self._departed:
                 self._departed.discard(client.client_id)

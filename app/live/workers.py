@@ -24,7 +24,7 @@ from collections.abc import Callable, Sequence
 from multiprocessing.connection import Connection
 from typing import TYPE_CHECKING, Any
 
-from poinsot.app.live.network import PortError, check_port, port_problem
+from poinsot.app.live.hardening.network import PortError, check_port, port_problem
 
 if TYPE_CHECKING:
     from poinsot.app.live.server import PoinsotApp
@@ -266,9 +266,9 @@ def serve_classroom(
     """Run ``count`` workers behind a landing on ``host:port`` until Ctrl-C (exit status 0),
     or until every worker has ended (1). A port that cannot be served raises
     :class:`PortError` before anything runs. ``link``: a link's query printed with the board
-    (:func:`~poinsot.app.live.network.board`)."""
+    (:func:`~poinsot.app.live.hardening.network.board`)."""
+    from poinsot.app.live.hardening.network import board
     from poinsot.app.live.landing import Balancer, LandingServer
-    from poinsot.app.live.network import board
 
     check_port(host, port)
     workers = start_workers(count, host, port, preset, scene, origins)

@@ -1,7 +1,7 @@
 """A classroom of headless browsers in a child process of its own.
 
-The child connects ``count`` :class:`poinsot.app.live.probe.Probe` websockets (each decodes
-everything it receives and keeps the scene as a browser would draw it) and then measures on
+The child connects ``count`` :class:`poinsot.app.live.hardening.probe.Probe` websockets (each
+decodes everything it receives and keeps the scene as a browser would draw it) and then measures on
 request, in windows:
 
 - **frames**: the scene-pose messages each client receives (the orientation of
@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any
 from poinsot.app.load.children import Child
 
 if TYPE_CHECKING:
-    from poinsot.app.live.probe import Probe
+    from poinsot.app.live.hardening.probe import Probe
 
 #: The node whose orientation is sent once per frame (the body frame's attitude).
 POSE_NODE = "/space/body"
@@ -140,8 +140,8 @@ def _window(
 
 def _main(conn: Connection, port: int, count: int, lifetime: float) -> None:
     """The child: connect ``count`` clients, then serve window and stall requests."""
+    from poinsot.app.live.hardening.probe import Probe
     from poinsot.app.live.landing import resolve
-    from poinsot.app.live.probe import Probe
 
     deadline = time.monotonic() + lifetime
     probes: list[Probe] = []

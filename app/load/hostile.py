@@ -28,7 +28,7 @@ from typing import Any
 
 import websockets
 
-from poinsot.app.live.probe import Probe
+from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.load import crafted, procfs
 from poinsot.app.load.children import Child
 from poinsot.app.load.config import Config, Report, Say

@@ -44,7 +44,7 @@ VISIT_TIMEOUT = 30.0
 
 
 def _visit(port: int, kind: str, index: int) -> None:
-    from poinsot.app.live.probe import Probe
+    from poinsot.app.live.hardening.probe import Probe
 
     if kind in ("clean", "early"):
         probe = Probe(port, keep_batches=False)

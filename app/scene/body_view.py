@@ -20,6 +20,7 @@ import viser
 
 from poinsot.app.scene import meshes, palette, updates
 from poinsot.app.scene.batch import Frame
+from poinsot.app.scene.ellipsoid import add_ellipsoid, fit_ellipsoid
 from poinsot.app.scene.frames import rotation_from_wxyz, wxyz
 from poinsot.app.scene.geometry import (
     CONTACT_RADIUS,
@@ -28,7 +29,6 @@ from poinsot.app.scene.geometry import (
     OMEGA_ARROW,
     POLHODE_INFLATE,
     Geometry,
-    triple,
 )
 from poinsot.app.scene.palette import Look
 
@@ -55,17 +55,8 @@ class BodyView:
 
     def _add_body(self, api: viser.SceneApi, look: Look) -> None:
         """The body's nodes: the ellipsoid, its axes, the polhode, ω and the contact point."""
-        sphere = meshes.ellipsoid_unit_mesh()
-        self.ellipsoid = api.add_mesh_simple(
-            f"{ROOT}/ellipsoid",
-            sphere.vertices,
-            sphere.faces,
-            color=look.ellipsoid,
-            opacity=look.ellipsoid_opacity,
-            material="standard",
-            side="front",
-            cast_shadow=False,
-            receive_shadow=False,
+        self.ellipsoid = add_ellipsoid(
+            api, f"{ROOT}/ellipsoid", look.ellipsoid, look.ellipsoid_opacity
         )
         empty = np.zeros((1, 2, 3), np.float32)
         self.axes = [
@@ -134,7 +125,7 @@ class BodyView:
         """Show the body of ``geometry`` as it was at t = 0 (attitude ``attitude0``, wxyz)."""
         self.geometry = geometry
         self.frame.wxyz = np.asarray(attitude0, dtype=np.float64)
-        self.ellipsoid.scale = triple(geometry.semi_axes)
+        fit_ellipsoid(self.ellipsoid, geometry.semi_axes)
         for line, end in zip(self.axes, geometry.axis_ends(), strict=True):
             line.points = np.array([[-end, end]], dtype=np.float32)
         self.polhode.points = geometry.polhode_segments()

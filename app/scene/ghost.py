@@ -10,7 +10,7 @@ error (the geodesic angle between the two rotations) and of the energy error aga
 simulated time.
 
 A :class:`Ghost` exists only while the ghost is switched on (its controls, which create and
-remove it, are :mod:`poinsot.app.live.ghost_controls`). It owns the scene nodes
+remove it, are :mod:`poinsot.app.live.ui.ghost_controls`). It owns the scene nodes
 ``/space/ghost`` (a faint shell, the three principal sections and the principal axes, posed
 by the ghost's attitude) and ``/space/ghost_tip`` (the tip of the ghost's ω, which leaves the
 invariable plane when the energy drifts), and the readout and the plot in the panel folder it
@@ -41,8 +41,9 @@ import numpy as np
 import viser
 import viser.uplot
 
-from poinsot.app.scene import meshes, palette, updates
+from poinsot.app.scene import palette, updates
 from poinsot.app.scene.batch import Frame
+from poinsot.app.scene.ellipsoid import add_ellipsoid, fit_ellipsoid
 from poinsot.app.scene.frames import rotation_from_wxyz, wxyz_from_xyzw, xyzw_from_wxyz
 from poinsot.app.scene.geometry import Geometry, triple
 from poinsot.physics import FreeRigidBody, errors, rotations
@@ -251,18 +252,9 @@ class GhostCage:
     """The ghost's scene nodes: its shell, principal sections and axes, and the tip of its ω."""
 
     def __init__(self, scene: viser.SceneApi, root: str) -> None:
-        sphere = meshes.ellipsoid_unit_mesh()
         self.node = scene.add_frame(f"{root}/ghost", show_axes=False)
-        self.shell = scene.add_mesh_simple(
-            f"{root}/ghost/ellipsoid",
-            sphere.vertices,
-            sphere.faces,
-            color=palette.GHOST,
-            opacity=palette.GHOST_OPACITY,
-            material="standard",
-            side="front",
-            cast_shadow=False,
-            receive_shadow=False,
+        self.shell = add_ellipsoid(
+            scene, f"{root}/ghost/ellipsoid", palette.GHOST, palette.GHOST_OPACITY
         )
         self.axes, self.rings = (
             scene.add_line_segments(
@@ -281,7 +273,7 @@ class GhostCage:
     def fit(self, geometry: Geometry) -> None:
         """Size the cage as the body's ellipsoid (a new body)."""
         semi = geometry.semi_axes
-        self.shell.scale = triple(semi * GHOST_INFLATE)
+        fit_ellipsoid(self.shell, semi * GHOST_INFLATE)
         ends = geometry.axis_ends()
         self.axes.points = np.stack([-ends, ends], axis=1).astype(np.float32)
         self.rings.points = principal_sections(semi * GHOST_INFLATE, GHOST_RING_SEGMENTS)
@@ -297,7 +289,8 @@ class GhostCage:
 
 def add_error_plot(gui: viser.GuiApi, t0: float) -> viser.GuiUplotHandle:
     """The plot of log₁₀ of the errors, created with two samples at the floor (see
-    :meth:`poinsot.app.live.panel.ControlPanel`: an empty first data set breaks uPlot's range)."""
+    :meth:`poinsot.app.live.ui.panel.ControlPanel`: an empty first data set breaks uPlot's
+    range)."""
     return gui.add_uplot(
         data=(t0 + np.array([0.0, 1.0]), *(np.full(2, _LOG_FLOOR) for _ in range(3))),
         series=(
@@ -474,7 +467,7 @@ class Ghost:
     # -- removal -------------------------------------------------------------------------
     def remove(self) -> list[viser.GuiMarkdownHandle | viser.GuiUplotHandle]:
         """Remove the scene nodes now; return the widgets, for the caller to retire (hide now,
-        delete later: :mod:`poinsot.app.live.widgets`)."""
+        delete later: :mod:`poinsot.app.live.ui.widgets`)."""
         self.cage.remove()
         return [self.readout, self.plot]
 

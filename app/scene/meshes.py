@@ -22,12 +22,6 @@ def unit_sphere_vertices_faces() -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(sphere.vertices), np.asarray(sphere.faces)
 
 
-def ellipsoid_unit_mesh() -> trimesh.Trimesh:
-    """The unit icosphere behind the ellipsoid; the scene scales it by the semi-axes."""
-    vertices, faces = unit_sphere_vertices_faces()
-    return trimesh.Trimesh(vertices=vertices.copy(), faces=faces.copy(), process=False)
-
-
 def disc_mesh(radius: float, sections: int = 96) -> tuple[np.ndarray, np.ndarray]:
     """A flat disc in the local xy plane (triangle fan), as (vertices, faces)."""
     angles = np.linspace(0.0, 2.0 * np.pi, sections, endpoint=False)

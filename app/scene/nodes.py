@@ -8,6 +8,9 @@ the contact point, the omega arrow, the traces' increments) is sent by
 :attr:`Trace.trail`. A drawing takes a :class:`~poinsot.app.scene.palette.Look` in
 :meth:`Drawing.restyle` (theme, projector), and offers its labels to the layout
 (:mod:`poinsot.app.scene.labels`) in :meth:`Drawing.slots` and :meth:`Drawing.place`.
+
+The base class is in :mod:`.drawing`, the ellipsoid in :mod:`.ellipsoid`, the traced curves
+in :mod:`.traces`; this module holds the other fixed elements and :func:`draw`.
 """
 
 from __future__ import annotations
@@ -19,10 +22,20 @@ import viser
 
 from poinsot.app.elements import Element
 from poinsot.app.scene import meshes, palette, updates
+from poinsot.app.scene.drawing import (
+    BEYOND,
+    BODY_CLEARANCE,
+    HEAD_CLEARANCE,
+    MARKER_CLEARANCE,
+    NO_SEGMENT,
+    ORIGIN_RADIUS,
+    UNIT_ARROW,
+    Drawing,
+)
+from poinsot.app.scene.ellipsoid import Ellipsoid
 from poinsot.app.scene.geometry import (
     CONTACT_RADIUS,
     GRID_SPACING,
-    HERPOLHODE_LIFT,
     L_ARROW,
     L_OVERSHOOT,
     OMEGA_ARROW,
@@ -31,87 +44,12 @@ from poinsot.app.scene.geometry import (
     Geometry,
     triple,
 )
-from poinsot.app.scene.label_nodes import LabelNode, Pose, screen_right_in_plane
+from poinsot.app.scene.label_nodes import LabelNode, Pose
 from poinsot.app.scene.labels import Placement, Slot
 from poinsot.app.scene.palette import Look
-from poinsot.app.scene.trail import Trail
+from poinsot.app.scene.traces import Trace, draw_trace
 
-#: Radius of the marker at the fixed point (the origin) [display units].
-ORIGIN_RADIUS = 0.03
-#: How far a label's point lies beyond the tip it names [display units].
-BEYOND = 0.05
-#: Screen distance [CSS px] a label keeps from the contact point's marker and from L's head.
-MARKER_CLEARANCE = 14.0
-HEAD_CLEARANCE = 6.0
-#: How far the labels on the body (axes, polhode) may be pushed beyond their tips [CSS px]:
-#: far enough to step round the contact point's marker where the tips crowd together.
-BODY_CLEARANCE = 10.0
-#: An arrow's points before its first fit: along +z, unit length.
-_UNIT_ARROW = np.array([[[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]], np.float32)
-#: A line-segments node's points before its first fit: one degenerate segment.
-_NO_SEGMENT = np.zeros((1, 2, 3), np.float32)
-
-
-class Drawing:
-    """The nodes of one element."""
-
-    def __init__(self, handles: list[viser.SceneNodeHandle] | None = None) -> None:
-        self.handles: list[viser.SceneNodeHandle] = handles or []
-        self.visible = True
-
-    def fit(self, geometry: Geometry) -> None:
-        """Send what changes with the body (sizes, static curves); nothing by default."""
-
-    def restyle(self, look: Look) -> None:
-        """Take the colours, widths and label size of ``look``; nothing by default."""
-
-    def slots(self, pose: Pose) -> list[Slot]:
-        """The drawing's labels for the layout (world points at ``pose``); none by default."""
-        return []
-
-    def place(self, placements: dict[str, Placement]) -> None:
-        """Send what the layout chose for the drawing's labels; nothing by default."""
-
-    def set_visible(self, visible: bool) -> None:
-        self.visible = visible
-        for handle in self.handles:
-            handle.visible = visible
-
-    def remove(self) -> None:
-        """Remove the nodes that are under none of the others: viser removes the nodes under
-        them (an axis's label, the plane's grid) and warns if one is removed again."""
-        names = [handle.name for handle in self.handles]
-        for handle in self.handles:
-            if not any(handle.name.startswith(name + "/") for name in names):
-                handle.remove()
-        self.handles = []
-
-
-class Ellipsoid(Drawing):
-    """The energy ellipsoid: the unit icosphere, scaled by the semi-axes."""
-
-    def __init__(self, api: viser.SceneApi, root: str) -> None:
-        # Sent as a plain mesh (the browser computes smooth normals; a GLB with normals
-        # and a non-uniform node scale did not render in viser 1.1).
-        sphere = meshes.ellipsoid_unit_mesh()
-        self.mesh = api.add_mesh_simple(
-            f"{root}/body/ellipsoid",
-            sphere.vertices,
-            sphere.faces,
-            color=palette.ELLIPSOID,
-            opacity=palette.ELLIPSOID_OPACITY,
-            material="standard",
-            side="front",
-            cast_shadow=False,
-            receive_shadow=False,
-        )
-        super().__init__([self.mesh])
-
-    def fit(self, geometry: Geometry) -> None:
-        self.mesh.scale = triple(geometry.semi_axes)
-
-    def restyle(self, look: Look) -> None:
-        self.mesh.color, self.mesh.opacity = look.ellipsoid, look.ellipsoid_opacity
+__all__ = ["Drawing", "Ellipsoid", "Trace", "draw"]
 
 
 class PrincipalAxes(Drawing):
@@ -123,7 +61,7 @@ class PrincipalAxes(Drawing):
         self.lines = [
             api.add_line_segments(
                 f"{root}/body/axis{i + 1}",
-                _NO_SEGMENT,
+                NO_SEGMENT,
                 palette.AXES[i],
                 thickness=palette.AXIS_WIDTH_PX,
                 thickness_units="screen",
@@ -242,7 +180,7 @@ class OmegaArrow(Drawing):
     def __init__(self, api: viser.SceneApi, root: str) -> None:
         self.arrow = api.add_arrows(
             f"{root}/omega",
-            _UNIT_ARROW,
+            UNIT_ARROW,
             palette.OMEGA,
             shaft_radius=OMEGA_ARROW.shaft_radius,
             head_radius=OMEGA_ARROW.head_radius,
@@ -284,7 +222,7 @@ class MomentumArrow(Drawing):
     def __init__(self, api: viser.SceneApi, root: str) -> None:
         self.arrow = api.add_arrows(
             f"{root}/L",
-            _UNIT_ARROW,
+            UNIT_ARROW,
             palette.ANGULAR_MOMENTUM,
             shaft_radius=L_ARROW.shaft_radius,
             head_radius=L_ARROW.head_radius,
@@ -322,7 +260,7 @@ class FullPolhode(Drawing):
     def __init__(self, api: viser.SceneApi, root: str) -> None:
         self.curve = api.add_line_segments(
             f"{root}/body/polhode_full",
-            _NO_SEGMENT,
+            NO_SEGMENT,
             palette.POLHODE_FULL,
             thickness=palette.FULL_POLHODE_WIDTH_PX,
             thickness_units="screen",
@@ -382,109 +320,10 @@ class SolidBody(Drawing):
         self.mesh, self._key = None, None
 
 
-class Trace(Drawing):
-    """A live trace (polhode or herpolhode): a :class:`Trail` the scene extends per frame, and
-    the label that names it."""
-
-    def __init__(self, trail: Trail, label: viser.LabelHandle, element: Element) -> None:
-        super().__init__([label])
-        self.trail, self.element = trail, element
-        self.node = LabelNode(label, element.value, label.text, LABEL_SCALE)
-        self.point = np.zeros(3)  # the named point: on the polhode (body), on the ring (space)
-        self.ring = (0.0, 0.0)  # herpolhode: the radius of its ring and the plane's height
-        self._base = np.zeros(3)  # herpolhode: the label's point before the layout's push
-        self._attitude: np.ndarray | None = None  # polhode: the body's attitude at the layout
-
-    def fit(self, geometry: Geometry) -> None:
-        if self.element is Element.POLHODE:  # a point of the curve, on the body
-            self.point = geometry.polhode[int(np.argmax(geometry.polhode[:, 0]))]
-            radius = float(np.linalg.norm(self.point))
-            outward = self.point / radius if radius > 0 else np.zeros(3)
-            self.node.position = self.point * POLHODE_INFLATE + BEYOND * outward
-            updates.set_position(self.node.handle, self.node.position)
-        else:  # the ring's near side in the default view, until the layout turns it
-            self.ring = (geometry.herpolhode_radius, geometry.plane_height)
-            self.node.position = self._on_ring(np.array([0.93, 0.37]), BEYOND)
-            updates.set_position(self.node.handle, self.node.position)
-
-    def _on_ring(self, direction: np.ndarray, beyond: float = 0.0) -> np.ndarray:
-        radius, height = self.ring
-        return np.array([*((radius + beyond) * direction), height + HERPOLHODE_LIFT])
-
-    def restyle(self, look: Look) -> None:
-        polhode = self.element is Element.POLHODE
-        self.trail.restyle(look.polhode if polhode else look.herpolhode, look.trace_width)
-        self.node.restyle(look.label_scale)
-
-    def slots(self, pose: Pose) -> list[Slot]:
-        if self.element is Element.POLHODE:
-            self._attitude = pose.attitude
-            tip = pose.attitude @ self.point
-            radius = float(np.linalg.norm(tip))
-            point = tip * (1.0 + BEYOND / radius) if radius > 0 else tip
-            return [self.node.slot(point, tip, np.zeros(3), movable=True, clearance=BODY_CLEARANCE)]
-        toward = screen_right_in_plane(pose)
-        tip, centre = self._on_ring(toward), np.array([0.0, 0.0, self.ring[1]])
-        self._base = self._on_ring(toward, BEYOND)
-        return [self.node.slot(self._base, tip, centre, movable=True, clearance=HEAD_CLEARANCE)]
-
-    def place(self, placements: dict[str, Placement]) -> None:
-        placement = placements.get(self.node.key)
-        if self.element is Element.POLHODE:
-            radius = float(np.linalg.norm(self.point))
-            base = self.point * (POLHODE_INFLATE + BEYOND / radius) if radius > 0 else self.point
-            self.node.place(placement, base, self._attitude)
-        else:
-            self.node.place(placement, self._base)
-
-    def set_visible(self, visible: bool) -> None:
-        super().set_visible(visible)
-        self.trail.visible = visible
-
-    def remove(self) -> None:
-        super().remove()
-        self.trail.clear()
-        self.trail.group.remove()
-
-
-#: Font scale of the curves' labels.
-LABEL_SCALE = 1.1
-
-
 def draw(element: Element, api: viser.SceneApi, root: str, trail_points: int) -> Drawing:
     """Create the nodes of ``element`` under the scene root ``root``."""
-    if element is Element.POLHODE:
-        trail = Trail(
-            api,
-            f"{root}/body/polhode",
-            palette.POLHODE,
-            palette.TRACE_WIDTH_PX,
-            trail_points,
-            scale=POLHODE_INFLATE,
-        )
-        label = api.add_label(
-            f"{root}/body/polhode_label",
-            "polhode",
-            anchor="top-left",
-            font_screen_scale=LABEL_SCALE,
-        )
-        return Trace(trail, label, element)
-    if element is Element.HERPOLHODE:
-        trail = Trail(
-            api,
-            f"{root}/herpolhode",
-            palette.HERPOLHODE,
-            palette.TRACE_WIDTH_PX,
-            trail_points,
-            position=(0.0, 0.0, HERPOLHODE_LIFT),
-        )
-        label = api.add_label(
-            f"{root}/herpolhode_label",
-            "herpolhode",
-            anchor="center-left",
-            font_screen_scale=LABEL_SCALE,
-        )
-        return Trace(trail, label, element)
+    if element in (Element.POLHODE, Element.HERPOLHODE):
+        return draw_trace(element, api, root, trail_points)
     return _DRAWINGS[element](api, root)
 
 

@@ -251,7 +251,7 @@ class FamilyDrawing(PartsDrawing):
             current=True,
             radius=LANDAU_RADIUS,
         )
-        #: Landau's sphere takes a start pointed at (app/live/sphere_pointer.py).
+        #: Landau's sphere takes a start pointed at (app/live/ui/sphere_pointer.py).
         self.pointable = self.landau
         self.model: FamilyModel | None = None
 

@@ -1,8 +1,8 @@
 """One scene on one scene API: its model for the current settings, the elements of Poinsot's
 construction it reuses, and its own drawing, driven by explicit times.
 
-A live session (:mod:`poinsot.app.live.showcase`), the screenshot and the HTML export
-(:mod:`poinsot.app.scenes.stage`) all drive a scene through a :class:`Showcase`: :meth:`load`
+A live session (:mod:`poinsot.app.live.ui.showcase`), the screenshot and the HTML export
+(:mod:`poinsot.app.stage.scene_stage`) all drive a scene through a :class:`Showcase`: :meth:`load`
 per parameter change (physics once, then the static shapes), :meth:`advance` per frame (poses
 and trail increments only). Not thread-safe: one thread drives a showcase.
 """

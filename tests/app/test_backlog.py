@@ -1,5 +1,6 @@
-"""The per-client bounds: what a client leaves untaken (app/live/backlog.py) and the actions a
-session has queued (app/live/actions.py). Counts and events only, never wall-clock bounds."""
+"""The per-client bounds: what a client leaves untaken (app/live/hardening/backlog.py) and the
+actions a session has queued (app/live/ui/actions.py). Counts and events only, never wall-clock
+bounds."""
 
 from __future__ import annotations
 
@@ -11,10 +12,10 @@ import types
 
 from conftest import session_of, wait_until
 
-from poinsot.app.live.backlog import BacklogLimit, BacklogWatch
-from poinsot.app.live.probe import Probe
+from poinsot.app.live.hardening.backlog import BacklogLimit, BacklogWatch
+from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.live.server import PoinsotApp
-from poinsot.app.live.session import Session
+from poinsot.app.live.ui.session import Session
 
 FAST = 0.05  # the watch's poll in these tests [s]: sooner events, same rules
 
@@ -61,14 +62,14 @@ def test_a_client_over_its_unacknowledged_bound_past_the_grace_is_disconnected(
     the grace it is disconnected, once, with one log line; its session is closed and gone,
     and the other client goes on."""
     app = make_app(backlog=BacklogLimit(max_unacked=8 * 1024, grace=0.5, poll=FAST))
-    with caplog.at_level(logging.WARNING, logger="poinsot.app.live.backlog"):
+    with caplog.at_level(logging.WARNING, logger="poinsot.app.live.hardening.backlog"):
         slow, slow_session, fast, fast_session = _stalled(app, make_probe, skips=0)
         slow_id = slow_session.client.client_id
         assert wait_until(lambda: slow_id not in app.sessions(), 60)
     assert app.backlog.stats.closed == 1
     assert wait_until(lambda: not slow_session.running, 30)  # its frame thread stopped
     assert list(app.sessions()) == [fast_session.client.client_id]
-    lines = [r for r in caplog.records if r.name == "poinsot.app.live.backlog"]
+    lines = [r for r in caplog.records if r.name == "poinsot.app.live.hardening.backlog"]
     assert len(lines) == 1 and f"client {slow_id} closed" in lines[0].getMessage()
     slow.stall(False)
     assert wait_until(lambda: slow.closed, 30)  # it sees its connection closed

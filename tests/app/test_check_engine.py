@@ -14,7 +14,7 @@ from uploading import upload
 
 from poinsot.app.cli import main
 from poinsot.app.engine_logs import write_engine_log
-from poinsot.app.live.engine_upload import BUTTON, MOMENTS
+from poinsot.app.live.ui.engine_upload import BUTTON, MOMENTS
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.integrators import integrate
 

@@ -1,4 +1,4 @@
-"""The phone's and tablet's page (app/live/layout.py): who gets it, and the camera that frames
+"""The phone's and tablet's page (app/live/ui/layout.py): who gets it, and the camera that frames
 the whole construction for the screen's shape (app/scene/cameras.framed)."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from poinsot.app.live.layout import compact_aspect, touch_agent
+from poinsot.app.live.ui.layout import compact_aspect, touch_agent
 from poinsot.app.scene.cameras import construction_points, framed
 from poinsot.app.scene.view import DEFAULT_VIEW
 

@@ -282,7 +282,7 @@ def test_ride_along_view_turns_with_the_body():
 
 def test_every_preset_stages_and_seeks():
     """Each preset's stage loads and seeks (what the CLI does before it opens a browser)."""
-    from poinsot.app.exports.stage import Stage
+    from poinsot.app.stage.served import Stage
 
     for preset in PRESETS:
         with Stage.from_preset(preset) as stage:

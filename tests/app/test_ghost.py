@@ -1,4 +1,4 @@
-"""The numerical ghost (app/scene/ghost.py and its controls, app/live/ghost_controls.py),
+"""The numerical ghost (app/scene/ghost.py and its controls, app/live/ui/ghost_controls.py),
 server-side on a real ViserServer(port=0) observed through the websocket probe, and once in a
 real browser.
 
@@ -19,7 +19,7 @@ import viser
 from conftest import session_of, wait_until
 from scipy.spatial.transform import Rotation
 
-from poinsot.app.live.ghost_controls import METHOD_LABELS
+from poinsot.app.live.ui.ghost_controls import METHOD_LABELS
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import DEFAULT_PRESET, preset_by_key
 from poinsot.app.scene import ghost as ghost_module

@@ -1,4 +1,4 @@
-"""The labels' layout as a frame carries it (app/scene/labels.py, app/live/display.py): its
+"""The labels' layout as a frame carries it (app/scene/labels.py, app/live/ui/display.py): its
 shortcuts choose what the plain sums choose, it runs in steps that send only at their end, and
 a frame takes at most one step, never on a frame that sends the traces or the plot. Counts and
 events only, never wall-clock bounds."""
@@ -12,7 +12,7 @@ import pytest
 import viser
 from conftest import record_messages, session_of, wait_until
 
-from poinsot.app.live.session import PLOT_MIN_FRAMES
+from poinsot.app.live.ui.session import PLOT_MIN_FRAMES
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import DEFAULT_PRESET
 from poinsot.app.scene import labels

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from conftest import session_of, wait_until
 
-from poinsot.app.live.panel import D_STEP
-from poinsot.app.live.widgets import Shelf
+from poinsot.app.live.ui.panel import D_STEP
+from poinsot.app.live.ui.widgets import Shelf
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import preset_by_key
 from poinsot.physics import Regime
@@ -134,8 +134,8 @@ def test_a_callback_reads_the_users_value_not_a_later_server_write(make_probe):
 
     import viser
 
-    from poinsot.app.live.probe import Probe
-    from poinsot.app.live.widgets import on_user
+    from poinsot.app.live.hardening.probe import Probe
+    from poinsot.app.live.ui.widgets import on_user
 
     server = viser.ViserServer("127.0.0.1", 0, verbose=False)
     try:
@@ -167,7 +167,7 @@ def test_a_preset_shown_late_does_not_overwrite_the_users_newer_choice():
     read the server's value, and viser dropped the user's next choice as "unchanged"."""
     import viser
 
-    from poinsot.app.live.widgets import Sent, on_user, write_unless_newer
+    from poinsot.app.live.ui.widgets import Sent, on_user, write_unless_newer
 
     server = viser.ViserServer("127.0.0.1", 0, verbose=False)
     try:
@@ -213,9 +213,9 @@ def test_after_a_stall_no_trace_segment_cuts_through_the_body(stall):
     stays on the ellipsoid within the margin it is drawn off it, every herpolhode segment is a
     short chord."""
     from poinsot.app.elements import Element
-    from poinsot.app.exports.stage import Stage
     from poinsot.app.scene.construction import MAX_CHORD
     from poinsot.app.scene.geometry import POLHODE_INFLATE
+    from poinsot.app.stage.served import Stage
 
     with Stage.from_preset(preset_by_key("major"), trail_points=6000) as stage:
         times = [k / 60.0 for k in range(61)]
@@ -308,7 +308,7 @@ def test_a_label_box_is_as_wide_as_the_browser_draws_it():
 # -- the legend and the caption --------------------------------------------------------------
 def test_the_legend_lists_the_declared_elements_in_the_looks_colours():
     from poinsot.app.elements import ALL_ELEMENTS, TRACE_ELEMENTS
-    from poinsot.app.live.legend import entries, legend_html
+    from poinsot.app.live.ui.legend import entries, legend_html
     from poinsot.app.scene import palette
 
     for look in (palette.DARK, palette.LIGHT, palette.PROJECTOR_DARK):
@@ -325,7 +325,7 @@ def test_the_legend_lists_the_declared_elements_in_the_looks_colours():
 def test_every_preset_has_a_caption_and_a_scene_can_set_its_own():
     import dataclasses
 
-    from poinsot.app.live.legend import CAPTIONS, caption
+    from poinsot.app.live.ui.legend import CAPTIONS, caption
     from poinsot.app.presets import MENU, PRESETS
 
     for preset in PRESETS:
@@ -372,8 +372,8 @@ def test_an_inline_callback_sees_every_value_in_the_order_sent():
     a quick run of slider values reaches them all, in order, none read twice."""
     import viser
 
-    from poinsot.app.live.probe import Probe
-    from poinsot.app.live.widgets import on_user
+    from poinsot.app.live.hardening.probe import Probe
+    from poinsot.app.live.ui.widgets import on_user
 
     server = viser.ViserServer("127.0.0.1", 0, verbose=False)
     try:

@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 
 from poinsot.app import cli
-from poinsot.app.live import network
-from poinsot.app.live.links import LinkError, opening, parse
+from poinsot.app.live.hardening import network
+from poinsot.app.live.ui.links import LinkError, opening, parse
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, preset_by_key
 from poinsot.app.scenes import scene_by_name
 

@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from poinsot.app.live.readouts import rows
+from poinsot.app.live.ui.readouts import rows
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import PRESETS, Preset
 from poinsot.physics import Regime

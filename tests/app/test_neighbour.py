@@ -10,7 +10,7 @@ import re
 import numpy as np
 from conftest import session_of, wait_until
 
-from poinsot.app.live import neighbour
+from poinsot.app.live.ui import neighbour
 from poinsot.app.presets import preset_by_key
 from poinsot.app.scenes.twins import TWIN_STEP
 

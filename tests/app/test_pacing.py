@@ -1,5 +1,5 @@
 """Cheap frames: the messages a frame sends, and each client's frame rate following what it
-takes (app/live/pacing.py). Counts and events only, never wall-clock bounds."""
+takes (app/live/hardening/pacing.py). Counts and events only, never wall-clock bounds."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import socket
 import viser
 from conftest import record_messages, session_of, wait_until
 
-from poinsot.app.live.pacing import MAX_IN_FLIGHT, MAX_UNACKED, MIN_FPS, Pacer
+from poinsot.app.live.hardening.pacing import MAX_IN_FLIGHT, MAX_UNACKED, MIN_FPS, Pacer
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import DEFAULT_PRESET
 from poinsot.app.scene.construction import TRAIL_EVERY, PoinsotScene

@@ -16,7 +16,7 @@ from scipy.spatial.transform import Rotation
 
 from poinsot.app import cli
 from poinsot.app.elements import ALL_ELEMENTS, Element
-from poinsot.app.live.clock import SimClock
+from poinsot.app.live.ui.clock import SimClock
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import CUSTOM, PRESETS, preset_by_key, preset_by_label
 from poinsot.app.scene.frames import rotation_from_wxyz, wxyz
@@ -283,7 +283,7 @@ def test_console_script_and_module_forms_answer(command):
 
 
 def test_element_enum_matches_labels():
-    from poinsot.app.live.panel import ELEMENT_LABELS
+    from poinsot.app.live.ui.panel import ELEMENT_LABELS
 
     assert set(ELEMENT_LABELS) == set(Element)
 
@@ -325,7 +325,7 @@ def test_grid_step_keeps_trace_chords_short():
 def test_a_rebuild_holds_the_other_sessions_frames_for_a_bounded_time(probe, poinsot_app):
     """While some session rebuilds (a slider moved), the others hold their frames so that the
     rebuild runs alone; a rebuild that never ends holds them at most HOLD_SECONDS each."""
-    from poinsot.app.live.session import HOLD_SECONDS
+    from poinsot.app.live.ui.session import HOLD_SECONDS
 
     session = session_of(poinsot_app)
     budget = poinsot_app.budget
@@ -350,7 +350,7 @@ def test_a_held_frame_is_woken_when_the_last_rebuild_ends():
     is left (not before); with no rebuild on, nothing is held."""
     import threading
 
-    from poinsot.app.live.budget import RebuildGate
+    from poinsot.app.live.hardening.budget import RebuildGate
 
     gate, wake = RebuildGate(), threading.Event()
     assert not gate.hold(wake)

@@ -1,4 +1,4 @@
-"""A start pointed at on the live ellipsoid (app/live/pointer.py): a click sets it, a drag draws
+"""A start pointed at on the live ellipsoid (app/live/ui/pointer.py): a click sets it, a drag draws
 the polhode through it and starts there on release, the separatrix is reached by hand, a miss
 does nothing."""
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from conftest import session_of, wait_until
 
-from poinsot.app.live.pointer import SNAP_PX
-from poinsot.app.live.session import Session
+from poinsot.app.live.ui.pointer import SNAP_PX
+from poinsot.app.live.ui.session import Session
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.physics import FreeRigidBody, Regime
 

@@ -1,7 +1,7 @@
 """The rolling is visibly right, checked on the geometry the browser actually receives.
 
-A websocket probe (app/live/probe.py) decodes viser's wire messages and rebuilds the scene as the
-browser would: the ellipsoid mesh vertices, its node scale, the body pose, the plane height,
+A websocket probe (app/live/hardening/probe.py) decodes viser's wire messages and rebuilds the scene
+as the browser would: the ellipsoid mesh vertices, its node scale, the body pose, the plane height,
 the contact marker and the omega arrow. From those alone:
 - the ellipsoid mesh is the unit sphere scaled by the sent semi-axes;
 - no vertex pokes through the plane (n.x <= h), and the highest vertex reaches it up to the
@@ -19,7 +19,7 @@ import pytest
 from conftest import session_of, wait_until
 
 from poinsot.app.elements import Control
-from poinsot.app.live.probe import Probe
+from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.presets import PRESETS
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.meshes import ELLIPSOID_SUBDIVISIONS

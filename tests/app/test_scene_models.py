@@ -16,8 +16,7 @@ from poinsot.app.cli import build_parser
 from poinsot.app.elements import Control
 from poinsot.app.exports.html import scene_html
 from poinsot.app.exports.screenshot import resolve_scene
-from poinsot.app.exports.stage import ServedStage, Stage
-from poinsot.app.live.probe import Probe
+from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.presets import MENU, preset_by_key
 from poinsot.app.scene import palette
 from poinsot.app.scene.geometry import SceneDataError
@@ -32,8 +31,9 @@ from poinsot.app.scenes import (
     scene_names,
 )
 from poinsot.app.scenes.spec import Choice, Readout, SceneSpec, table
-from poinsot.app.scenes.stage import SceneStage
 from poinsot.app.scenes.tabulated import Player, Table
+from poinsot.app.stage.scene_stage import SceneStage
+from poinsot.app.stage.served import ServedStage, Stage
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 NAMES = (

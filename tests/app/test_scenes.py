@@ -21,7 +21,7 @@ from scene_probing import (
 )
 
 from poinsot.app.elements import Control, Element
-from poinsot.app.live.panel import ELEMENT_LABELS
+from poinsot.app.live.ui.panel import ELEMENT_LABELS
 from poinsot.app.presets import preset_by_key
 from poinsot.app.scenes import SCENES, scene_by_name
 from poinsot.app.scenes.spec import SceneSpec

@@ -1,6 +1,6 @@
 """Server-side behaviour on a real ViserServer(port=0), observed through websocket probes that
-speak viser's protocol like a browser (app/live/probe.py): what is created, what is sent per
-frame, the frame rate, sessions, invalid input, and robustness."""
+speak viser's protocol like a browser (app/live/hardening/probe.py): what is created, what is sent
+per frame, the frame rate, sessions, invalid input, and robustness."""
 
 from __future__ import annotations
 
@@ -13,9 +13,9 @@ from conftest import after_frames, record_frame_times, session_of, wait_until
 from test_scene_geometry import check_finite
 
 from poinsot.app.elements import Control, Element, Plot
-from poinsot.app.live.display import LABEL_MIN_FRAMES
-from poinsot.app.live.panel import ELEMENT_LABELS
-from poinsot.app.live.session import MAX_FPS, STEP_SECONDS
+from poinsot.app.live.ui.display import LABEL_MIN_FRAMES
+from poinsot.app.live.ui.panel import ELEMENT_LABELS
+from poinsot.app.live.ui.session import MAX_FPS, STEP_SECONDS
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, PRESETS, preset_by_key
 from poinsot.app.scene.trail import CHUNK_SEGMENTS
@@ -194,9 +194,9 @@ def test_the_loop_stops_when_the_client_leaves(poinsot_app, make_probe):
     probe.close()
     assert wait_until(lambda: not session.running, 5)
     assert poinsot_app.sessions() == {}
-    assert wait_until(lambda: not session._thread.is_alive(), 10)  # the frame thread ended
+    assert wait_until(lambda: not session.running, 10)  # the frame thread ended
     frames = session.stats.frames
-    assert not session._thread.is_alive() and session.stats.frames == frames
+    assert not session.running and session.stats.frames == frames
 
 
 #: Frames (about a second's worth at 60 Hz) the stalled client's session draws before the
@@ -405,7 +405,7 @@ def _session_threads() -> list[str]:
 def test_clients_that_leave_during_connect_leave_no_session(poinsot_app):
     """Connect and drop at once, 100 times (some drops land while the session is being built,
     some after it started): afterwards no session, no frame thread and no pending departure."""
-    from poinsot.app.live.probe import Probe
+    from poinsot.app.live.hardening.probe import Probe
 
     before = len(_session_threads())
     for i in range(100):

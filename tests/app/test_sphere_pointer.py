@@ -1,5 +1,5 @@
 """A start pointed at on Landau's momentum sphere in the polhode-family scene
-(app/live/sphere_pointer.py): a click sets it at |L| kept, a drag draws the polhode through it
+(app/live/ui/sphere_pointer.py): a click sets it at |L| kept, a drag draws the polhode through it
 on the sphere and on the ellipsoid and starts there on release, the separatrix is reached by
 hand, a miss does nothing, the D slider takes the motion back."""
 
@@ -10,8 +10,8 @@ import pytest
 from conftest import wait_until
 from scene_probing import start
 
-from poinsot.app.live.pointer import SNAP_PX, snap_length
-from poinsot.app.live.session import Session
+from poinsot.app.live.ui.pointer import SNAP_PX, snap_length
+from poinsot.app.live.ui.session import Session
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.geometry import POLHODE_INFLATE
 from poinsot.app.scenes import scene_by_name

@@ -7,7 +7,7 @@ import threading
 
 from conftest import wait_until
 
-from poinsot.app.live.upkeep import MemoryTrim, fixed_pool
+from poinsot.app.live.hardening.upkeep import MemoryTrim, fixed_pool
 
 
 def _pool_threads(name: str) -> int:
@@ -58,7 +58,7 @@ def test_a_server_builds_sessions_on_its_fixed_pool(make_app, make_probe):
 def test_a_process_shares_its_frames_among_its_browsers(make_app, make_probe):
     """Up to the cap each while few share a process, fewer as more join, never below the
     floor; a departure gives the others their share back."""
-    from poinsot.app.live.pacing import PROCESS_FRAMES, SHARED_MIN_FPS, frame_share
+    from poinsot.app.live.hardening.pacing import PROCESS_FRAMES, SHARED_MIN_FPS, frame_share
 
     assert frame_share(60.0, 1) == 60.0
     assert frame_share(60.0, 9) == 60.0

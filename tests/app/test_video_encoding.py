@@ -11,7 +11,7 @@ import pytest
 from PIL import Image
 
 from poinsot.app.exports.video import Clip, check_clip, encoder, rgb_on
-from poinsot.app.live.video_export import fit_within
+from poinsot.app.live.ui.video_export import fit_within
 
 
 def frames(count: int, size: tuple[int, int]) -> list[np.ndarray]:

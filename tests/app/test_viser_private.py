@@ -18,8 +18,8 @@ from conftest import session_of, wait_until
 from viser import _messages
 
 from poinsot.app import viser_private
-from poinsot.app.live.guard import WireGuard
-from poinsot.app.live.transfers import handle_id
+from poinsot.app.live.hardening.guard import WireGuard
+from poinsot.app.live.hardening.transfers import handle_id
 from poinsot.app.viser_private import scene as private_scene
 from poinsot.app.viser_private import transport as private_transport
 

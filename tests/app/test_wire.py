@@ -18,14 +18,14 @@ from uploading import MESH
 from viser import _messages
 
 from poinsot.app import viser_private
-from poinsot.app.live import guard
-from poinsot.app.live import transfers as transfers_module
-from poinsot.app.live.budget import MessageBudget
-from poinsot.app.live.guard import POLICY_VIOLATION, origin_allowed
-from poinsot.app.live.motion_window import PLOT_SAMPLES, MotionWindow
-from poinsot.app.live.probe import Probe
-from poinsot.app.live.transfers import handle_id
-from poinsot.app.live.widgets import checked
+from poinsot.app.live.hardening import guard
+from poinsot.app.live.hardening import transfers as transfers_module
+from poinsot.app.live.hardening.budget import MessageBudget
+from poinsot.app.live.hardening.guard import POLICY_VIOLATION, origin_allowed
+from poinsot.app.live.hardening.probe import Probe
+from poinsot.app.live.hardening.transfers import handle_id
+from poinsot.app.live.ui.motion_window import PLOT_SAMPLES, MotionWindow
+from poinsot.app.live.ui.widgets import checked
 from poinsot.app.load import crafted
 from poinsot.app.parameters import TRAIL_RANGE, Parameters
 from poinsot.app.presets import DEFAULT_PRESET, MESH_BODY

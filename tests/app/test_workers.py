@@ -24,9 +24,9 @@ import pytest
 import segno
 
 from poinsot.app import cli
-from poinsot.app.live import network
+from poinsot.app.live.hardening import network
+from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.live.landing import PENDING_SECONDS, Balancer, _loopback, resolve, status
-from poinsot.app.live.probe import Probe
 from tests.conftest import wait_until
 
 START = 180.0  # seconds two spawned workers may take to import and serve on a loaded box

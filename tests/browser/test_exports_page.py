@@ -31,7 +31,7 @@ from PIL import Image
 
 from poinsot.app.exports import html as html_export
 from poinsot.app.exports.screenshot import THEME_BACKGROUND
-from poinsot.app.live.lecture import LARGE_TEXT_PERCENT
+from poinsot.app.live.ui.lecture import LARGE_TEXT_PERCENT
 from poinsot.app.presets import preset_by_key
 from poinsot.app.scene.cameras import BODY_VIEW, ride_along
 from poinsot.app.scene.view import VIEWS

@@ -16,8 +16,8 @@ from conftest import session_of, wait_until
 from scipy import ndimage
 
 from poinsot.app.elements import Element
-from poinsot.app.live.display import PROJECTOR_TEXT_PERCENT, browser_camera
-from poinsot.app.live.legend import CAPTIONS
+from poinsot.app.live.ui.display import PROJECTOR_TEXT_PERCENT, browser_camera
+from poinsot.app.live.ui.legend import CAPTIONS
 from poinsot.app.presets import CUSTOM, preset_by_key
 from poinsot.app.scene import palette
 from poinsot.app.scene.view import VIEWS

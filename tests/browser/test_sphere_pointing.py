@@ -1,5 +1,5 @@
 """In Chromium at 1280×800: a click on Landau's momentum sphere in the polhode-family scene
-sets the start there, at |L| kept (app/live/sphere_pointer.py)."""
+sets the start there, at |L| kept (app/live/ui/sphere_pointer.py)."""
 
 from __future__ import annotations
 

@@ -17,7 +17,7 @@ from PIL import Image
 from strobe_counting import copies_in
 
 from poinsot.app.exports.video import BROWSER_MAX_SIZE, DEFAULT_FPS
-from poinsot.app.live.video_export import fit_within
+from poinsot.app.live.ui.video_export import fit_within
 from poinsot.app.presets import preset_by_key
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]

@@ -1,5 +1,5 @@
 """The left column of a session ("What you see"): the caption and the legend
-(:mod:`poinsot.app.live.legend`), the time, the readouts of the motion's constants, and the live
+(:mod:`poinsot.app.live.ui.legend`), the time, the readouts of the motion's constants, and the live
 plot of ω in the body frame.
 
 It is docked on the left edge and the control panel on the right one, so that neither covers
@@ -7,7 +7,7 @@ the 3D view (which takes the width between them, its picture centred there) and 
 the names, colours and numbers beside the scene without scrolling the control panel. The plot
 exists only while the preset declares it (:class:`~poinsot.app.elements.Plot`); the session
 records a sample and sends the window of the last PLOT_SAMPLES at the plot's refresh rate. For
-an uploaded toss the plot also shows the measured ω (:mod:`poinsot.app.live.overlay`).
+an uploaded toss the plot also shows the measured ω (:mod:`poinsot.app.live.ui.overlay`).
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ import numpy as np
 import viser
 import viser.uplot
 
-from poinsot.app.live import plots, readouts
-from poinsot.app.live.legend import Legend
-from poinsot.app.live.overlay import LEGEND, Measured, measured_series, merge
+from poinsot.app.live.ui import plots, readouts
+from poinsot.app.live.ui.legend import Legend
+from poinsot.app.live.ui.overlay import LEGEND, Measured, measured_series, merge
 from poinsot.app.scene import palette
 from poinsot.physics import FreeRigidBody
 
@@ -41,7 +41,7 @@ class MotionWindow:
             self.readouts = gui.add_markdown("", order=1.0)
             #: What the ω plot draws: ω, the angles of L to the axes, the Euler angles.
             self.choice = plots.PlotChoice(gui, order=1.9)
-            #: The text size's style element (:mod:`poinsot.app.live.display`; the control
+            #: The text size's style element (:mod:`poinsot.app.live.ui.display`; the control
             #: panel has one too: a folded column's content, and its style, is not on the page).
             self.style = gui.add_html("", order=100.0)
         gui.main_panel.dock_right()

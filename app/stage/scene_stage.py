@@ -2,22 +2,22 @@
 ``poinsot screenshot --scene`` photographs and ``poinsot export-html --scene`` records.
 
 The same :class:`~poinsot.app.scenes.runtime.Showcase` a live session draws, driven by explicit
-times (like :class:`poinsot.app.exports.stage.Stage` for the presets), so that a picture at time
+times (like :class:`poinsot.app.stage.served.Stage` for the presets), so that a picture at time
 T or a clip of S seconds is reproducible.
 """
 
 from __future__ import annotations
 
-from poinsot.app.exports.stage import (
+from poinsot.app.scene.batch import Frame
+from poinsot.app.scenes.runtime import Showcase
+from poinsot.app.scenes.spec import SceneSpec, Settings
+from poinsot.app.stage.served import (
     ClientOf,
     ServedStage,
     open_server,
     scene_target,
     themed_construction,
 )
-from poinsot.app.scene.batch import Frame
-from poinsot.app.scenes.runtime import Showcase
-from poinsot.app.scenes.spec import SceneSpec, Settings
 
 
 class SceneStage(ServedStage):

@@ -1,6 +1,6 @@
 """What the server checks on a websocket before viser acts on it: the handshake (its ``Host`` and
-``Origin``), how much a client sends (:class:`~poinsot.app.live.budget.MessageBudget`), and that
-each message is one viser's own client sends, with fields of the right types and sizes.
+``Origin``), how much a client sends (:class:`~poinsot.app.live.hardening.budget.MessageBudget`),
+and that each message is one viser's own client sends, with fields of the right types and sizes.
 
 Handshakes (:class:`HandshakeGate`) are checked at the HTTP upgrade, before viser sees the
 connection: a refused one gets ``403`` and leaves nothing behind (no client id, no state in
@@ -43,7 +43,7 @@ from websockets.datastructures import Headers
 from websockets.http11 import Request, Response
 
 from poinsot.app import viser_private
-from poinsot.app.live.budget import MessageBudget
+from poinsot.app.live.hardening.budget import MessageBudget
 
 #: Messages a second one client may send, sustained, and in one burst (a browser sends a few
 #: dozen a second at most: camera moves while orbiting, a dragged slider, upload parts).

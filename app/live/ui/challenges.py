@@ -1,4 +1,4 @@
-"""Predict, then play: the challenges of :mod:`~poinsot.app.live.challenge_set` in a folder of
+"""Predict, then play: the challenges of :mod:`~poinsot.app.live.ui.challenge_set` in a folder of
 the control panel, one browser's own.
 
 The student reads a challenge, answers it (flip or stay and the axis from two dropdowns, or a
@@ -22,9 +22,9 @@ from typing import Protocol
 
 import viser
 
-from poinsot.app.live.challenge_set import AXES, OUTCOMES, Challenge, challenge_set, parse_time
-from poinsot.app.live.clock import SimClock
-from poinsot.app.live.widgets import on_user
+from poinsot.app.live.ui.challenge_set import AXES, OUTCOMES, Challenge, challenge_set, parse_time
+from poinsot.app.live.ui.clock import SimClock
+from poinsot.app.live.ui.widgets import on_user
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import CUSTOM, Preset
 from poinsot.app.scenes import scene_by_name

@@ -16,7 +16,7 @@ import numpy as np
 import viser
 import viser.uplot
 
-from poinsot.app.live.widgets import Sent, on_user
+from poinsot.app.live.ui.widgets import Sent, on_user
 from poinsot.app.scene import palette
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.axis_angles import axis_angles, zxz_angles

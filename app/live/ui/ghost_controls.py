@@ -21,12 +21,12 @@ from __future__ import annotations
 
 import dataclasses
 import threading
-from typing import Any, Protocol
+from typing import Any
 
 import viser
 
-from poinsot.app.live.engine_upload import EngineLogUpload
-from poinsot.app.live.widgets import Retirement, Sent, on_user, set_value
+from poinsot.app.live.ui.engine_upload import EngineLogUpload
+from poinsot.app.live.ui.widgets import Retirement, Sent, on_user, set_value
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.ghost import (
@@ -64,20 +64,19 @@ METHOD_LABELS: dict[str, str] = {
 }
 
 
-class GhostSession(Protocol):
-    """What the ghost uses of a session."""
-
-    client: viser.ClientHandle
-    scene: PoinsotScene
-    retirement: Retirement
-
-
 class GhostControls:
     """The ghost's controls in the session's panel, and the ghost itself while it is on."""
 
-    def __init__(self, session: GhostSession, order: float = FOLDER_ORDER) -> None:
-        self.session = session
-        self.client = session.client
+    def __init__(
+        self,
+        client: viser.ClientHandle,
+        scene: PoinsotScene,
+        retirement: Retirement,
+        order: float = FOLDER_ORDER,
+    ) -> None:
+        """``scene``: the construction the ghost races (its body and geometry); ``retirement``:
+        where a removed ghost's widgets go to be deleted a moment later."""
+        self.client, self.scene, self.retirement = client, scene, retirement
         self._lock = threading.Lock()
         self._wanted = GhostConfig()
         self._applied = GhostConfig()
@@ -154,6 +153,13 @@ class GhostControls:
             return self._wanted
 
     # -- frame thread --------------------------------------------------------------------
+    def fit(self, exact_body: bool) -> None:
+        """After a rebuild: the ghost races an exact torque-free body; without one (a scene that
+        poses its own body) its controls are hidden and it is switched off."""
+        if not exact_body:
+            self.configure(enabled=False)
+        self.folder.visible = exact_body
+
     def on_frame(self, frame: Frame | None) -> None:
         """Per frame, after the exact scene: apply the wanted configuration, advance the ghost.
         Never raises: a failure switches the ghost off and says why in the panel."""
@@ -173,7 +179,7 @@ class GhostControls:
 
     def _drive(self, wanted: GhostConfig, frame: Frame) -> None:
         """Create, restart or advance the ghost for this frame."""
-        body, geometry = self.session.scene.body, self.session.scene.geometry
+        body, geometry = self.scene.body, self.scene.geometry
         if body is None or geometry is None:
             return
         ghost = self.ghost
@@ -224,7 +230,7 @@ class GhostControls:
     def _remove(self) -> None:
         ghost, self.ghost = self.ghost, None
         if ghost is not None:
-            self.session.retirement.retire(ghost.remove())
+            self.retirement.retire(ghost.remove())
 
     def _fail(self, exc: BaseException) -> None:
         try:
@@ -240,7 +246,10 @@ class GhostControls:
             self.message.content = text
 
 
-def add_ghost_controls(session: GhostSession, **kwargs: Any) -> GhostControls:
-    """Mount the ghost's folder on ``session``'s panel; call ``on_frame(frame)`` after each
-    frame (the ghost itself exists only while switched on)."""
-    return GhostControls(session, **kwargs)
+def add_ghost_controls(
+    client: viser.ClientHandle, scene: PoinsotScene, retirement: Retirement, **kwargs: Any
+) -> GhostControls:
+    """Mount the ghost's folder on ``client``'s panel; call ``on_frame(frame)`` after each frame
+    and :meth:`GhostControls.fit` after each rebuild (the ghost itself exists only while
+    switched on)."""
+    return GhostControls(client, scene, retirement, **kwargs)

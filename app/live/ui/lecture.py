@@ -1,7 +1,7 @@
 """Lecture comfort and exports in one session's panel: screenshot, CSV and GLB downloads, camera
 views (default, along-L, side, ride-along: the same names as ``poinsot screenshot --view``),
 dark/light theme, large text, the projector mode, the two views (space and body frame) and
-keyboard shortcuts. How the picture looks is :mod:`poinsot.app.live.display`'s.
+keyboard shortcuts. How the picture looks is :mod:`poinsot.app.live.ui.display`'s.
 
 A session mounts everything with one call, :func:`add_lecture_controls`, and calls
 :meth:`LectureControls.on_frame` after drawing each frame (the ride-along camera follows the
@@ -15,7 +15,7 @@ The commands are also listed in the palette (Ctrl/Cmd+K).
 Threads: button callbacks run on viser's thread pool. A screenshot waits there for the
 browser's render, bounded by ``render_timeout``; one render at a time per session, and every
 failure ends in a message in the panel, never in a hang. A video
-(:mod:`poinsot.app.live.video_export`) is filmed on a thread of its own. The data come from the
+(:mod:`poinsot.app.live.ui.video_export`) is filmed on a thread of its own. The data come from the
 session's body and clock (physics), never from the drawing.
 """
 
@@ -31,15 +31,15 @@ import viser
 from poinsot.app.exports.glb import scene_glb
 from poinsot.app.exports.run_csv import run_csv, run_span
 from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
-from poinsot.app.live.challenges import ChallengeControls, ChallengeSession, add_challenges
-from poinsot.app.live.clock import SimClock
-from poinsot.app.live.display import LARGE_TEXT_PERCENT, Display
-from poinsot.app.live.links import link_of
-from poinsot.app.live.motion_window import MotionWindow
-from poinsot.app.live.neighbour import Neighbour, add_neighbour
-from poinsot.app.live.strobe_shot import strobe_render
-from poinsot.app.live.video_export import VideoExport, browser_view
-from poinsot.app.live.widgets import Sent, on_user, set_value
+from poinsot.app.live.ui.challenges import ChallengeControls, ChallengeSession, add_challenges
+from poinsot.app.live.ui.clock import SimClock
+from poinsot.app.live.ui.display import LARGE_TEXT_PERCENT, Display
+from poinsot.app.live.ui.links import link_of
+from poinsot.app.live.ui.motion_window import MotionWindow
+from poinsot.app.live.ui.neighbour import Neighbour, add_neighbour
+from poinsot.app.live.ui.strobe_shot import strobe_render
+from poinsot.app.live.ui.video_export import VideoExport, browser_view
+from poinsot.app.live.ui.widgets import Sent, on_user, set_value
 from poinsot.app.presets import Preset
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.cameras import BODY_VIEW, CAMERA_NAMES, RIDE_ALONG, ride_along, space_view
@@ -105,7 +105,7 @@ class LectureControls:
         self.page = self.last_link = ""
         with self.client.gui.add_folder("Lecture: views and export", order=order):
             self._add_widgets(self.client.gui)
-        self.display = Display(session, session.panel.motion, self.style)
+        self.display = Display(session.client, session.scene, session.panel.motion, self.style)
         # Browser changes only, each value checked against its widget first (:func:`on_user`).
         for handle, callback in (
             (self.views, self._on_view),
@@ -382,8 +382,8 @@ class LectureControls:
 
 def add_lecture_controls(session: LectureSession, **kwargs: float) -> LectureControls:
     """Mount the lecture folder and hotkeys on ``session``'s panel, the challenges
-    (:mod:`~poinsot.app.live.challenges`, as ``.challenges``) and the neighbour
-    (:mod:`~poinsot.app.live.neighbour`, as ``.neighbour``); keep the returned object and
+    (:mod:`~poinsot.app.live.ui.challenges`, as ``.challenges``) and the neighbour
+    (:mod:`~poinsot.app.live.ui.neighbour`, as ``.neighbour``); keep the returned object and
     call its ``on_frame(frame)`` after each frame."""
     controls = LectureControls(session, **kwargs)
     controls.challenges = add_challenges(session)

@@ -2,7 +2,7 @@
 numerical ghost's folder, and the verdict of ``poinsot check-engine`` below them
 (:mod:`poinsot.app.engine_logs`).
 
-Threads, as for the other uploads (:mod:`~poinsot.app.live.uploads`): the button's callback
+Threads, as for the other uploads (:mod:`~poinsot.app.live.ui.uploads`): the button's callback
 (viser's thread pool) hands the bytes to the shared upload workers; a worker reads and judges
 the log and stores the answer under a lock; the session's frame thread alone writes it into
 the panel (:meth:`EngineLogUpload.on_frame`). A log that cannot be read gets its one line; the
@@ -19,7 +19,7 @@ from concurrent.futures import Future
 import viser
 
 from poinsot.app import engine_logs
-from poinsot.app.live.uploads import WORKERS
+from poinsot.app.live.ui.uploads import WORKERS
 from poinsot.app.own_bodies import display_name
 
 log = logging.getLogger(__name__)

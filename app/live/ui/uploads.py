@@ -28,10 +28,10 @@ import viser
 from poinsot.app import own_bodies
 from poinsot.app.bodies import BUNDLED, MeshBody, bundled_body
 from poinsot.app.elements import Control
-from poinsot.app.live.overlay import Measured
-from poinsot.app.live.panel import ControlPanel
-from poinsot.app.live.transfers import TransferGuard, handle_id
-from poinsot.app.live.widgets import Removable, Sent, on_user
+from poinsot.app.live.hardening.transfers import TransferGuard, handle_id
+from poinsot.app.live.ui.overlay import Measured
+from poinsot.app.live.ui.panel import ControlPanel
+from poinsot.app.live.ui.widgets import Removable, Sent, on_user
 from poinsot.app.own_bodies import FittedToss
 from poinsot.app.presets import FITTED_TOSS, MESH_BODY, Preset
 

@@ -37,7 +37,7 @@ import viser
 from numpy.typing import ArrayLike
 
 from poinsot.app.elements import Element
-from poinsot.app.live.clock import SimClock
+from poinsot.app.live.ui.clock import SimClock
 from poinsot.app.parameters import Parameters, Vector
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene

@@ -1,8 +1,8 @@
 """What one session may take from the others, and what one client may send.
 
 All sessions share one Python process (one GIL). How many frames each draws is its own
-client's business (:mod:`~poinsot.app.live.pacing`: as many as that browser takes). What is
-shared is precedence: while any session rebuilds its scene (:meth:`RebuildGate.rebuild`, a
+client's business (:mod:`~poinsot.app.live.hardening.pacing`: as many as that browser takes). What
+is shared is precedence: while any session rebuilds its scene (:meth:`RebuildGate.rebuild`, a
 slider moved), the other sessions hold their next frame (:meth:`RebuildGate.hold`), so the
 rebuild has the interpreter to itself and the student who moved the slider sees the new body
 at once; the others lose at most a frame or two. A held session sleeps until the rebuild ends

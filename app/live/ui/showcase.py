@@ -19,8 +19,8 @@ import numpy as np
 import viser
 import viser.uplot
 
-from poinsot.app.live.motion_window import MotionWindow
-from poinsot.app.live.widgets import Removable, Retirement, Sent, on_user, set_value
+from poinsot.app.live.ui.motion_window import MotionWindow
+from poinsot.app.live.ui.widgets import Removable, Retirement, Sent, on_user, set_value
 from poinsot.app.scene import palette
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
@@ -216,7 +216,7 @@ class LiveShowcase:
 
 def _add_plot(gui: viser.GuiApi, plot: PlotSpec, order: float) -> viser.GuiUplotHandle:
     """A plot with labelled axes, created with two samples (an empty first data set leaves
-    uPlot's x range NaN, see :class:`~poinsot.app.live.motion_window.MotionWindow`)."""
+    uPlot's x range NaN, see :class:`~poinsot.app.live.ui.motion_window.MotionWindow`)."""
     series = [viser.uplot.Series(label=plot.x_label)]
     for label, stroke in plot.series:
         series.append(viser.uplot.Series(label=label, stroke=stroke, width=2))

@@ -2,12 +2,12 @@
 a click, a tap or a drag on the sphere chooses the body-frame L where the motion starts, at
 |L| kept.
 
-As on the energy ellipsoid (:mod:`poinsot.app.live.pointer`, whose
-:class:`~poinsot.app.live.pointer.StartPointer` drags and releases here too): the sphere mesh's
+As on the energy ellipsoid (:mod:`poinsot.app.live.ui.pointer`, whose
+:class:`~poinsot.app.live.ui.pointer.StartPointer` drags and releases here too): the sphere mesh's
 ``on_click`` gives the ray, its ``on_drag`` the pointer on a plane facing the camera (the ray
 runs from the camera through it). The physics (:mod:`poinsot.physics.pointing`) meets the ray
 with the sphere ``|L| = G`` of the body on screen; ω = I⁻¹L and D follow from the point. Within
-:data:`~poinsot.app.live.pointer.SNAP_PX` pixels of the separatrix the point is snapped onto it
+:data:`~poinsot.app.live.ui.pointer.SNAP_PX` pixels of the separatrix the point is snapped onto it
 at |L| kept, and the body built from it is the exact separatrix.
 
 While a drag lasts the motion stands still and the polhode through the point is drawn twice:
@@ -24,7 +24,7 @@ from typing import Protocol
 
 import numpy as np
 
-from poinsot.app.live.pointer import (
+from poinsot.app.live.ui.pointer import (
     BaseSession,
     Look,
     Ray,
@@ -34,7 +34,7 @@ from poinsot.app.live.pointer import (
     segments,
     snap_length,
 )
-from poinsot.app.live.showcase import LiveShowcase
+from poinsot.app.live.ui.showcase import LiveShowcase
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.geometry import POLHODE_INFLATE
 from poinsot.app.scenes import colors
@@ -60,7 +60,7 @@ class SpherePointer(StartPointer[SphereSession]):
     """The sphere's pointer of one session (see the module's docstring)."""
 
     def __init__(self, session: SphereSession, drag: bool = True) -> None:
-        """``drag``: as :class:`~poinsot.app.live.pointer.Pointer`'s (off on a touch screen)."""
+        """``drag``: as :class:`~poinsot.app.live.ui.pointer.Pointer`'s (off on a touch screen)."""
         super().__init__(session, drag)
         self._bound: MomentumPicture | None = None
 

@@ -23,7 +23,6 @@ from typing import TYPE_CHECKING
 import viser
 
 from poinsot.app.exports.screenshot import THEME_BACKGROUND, filename, find_chromium
-from poinsot.app.exports.stage import ClientOf, Stage
 from poinsot.app.exports.video import (
     BROWSER_MAX_SECONDS,
     BROWSER_MAX_SIZE,
@@ -39,10 +38,11 @@ from poinsot.app.presets import CUSTOM
 from poinsot.app.scene.cameras import RIDE_ALONG
 from poinsot.app.scene.geometry import triple
 from poinsot.app.scene.view import View
-from poinsot.app.scenes.stage import SceneStage
+from poinsot.app.stage.scene_stage import SceneStage
+from poinsot.app.stage.served import ClientOf, Stage
 
 if TYPE_CHECKING:
-    from poinsot.app.live.lecture import LectureControls
+    from poinsot.app.live.ui.lecture import LectureControls
 
 #: Formats offered: label -> file suffix.
 FORMAT_CHOICES = {"MP4 (slides, web)": ".mp4", "GIF (loops)": ".gif"}

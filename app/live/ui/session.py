@@ -4,8 +4,8 @@ Threads: viser runs GUI callbacks on its thread pool; they only post small actio
 session's queue and wake its frame thread, which alone touches the scene and the body. So a
 callback never blocks or raises into viser, a slider drag is coalesced into one rebuild per
 wake-up, and a slow or departed browser never stalls another (each session has its own thread;
-viser gives each client its own send buffer, and :mod:`.pacing` sends a client a new frame only
-once it has taken the ones before, so that buffer never grows).
+viser gives each client its own send buffer, and :mod:`..hardening.pacing` sends a client a new
+frame only once it has taken the ones before, so that buffer never grows).
 """
 
 from __future__ import annotations
@@ -19,20 +19,23 @@ from collections.abc import Callable
 import viser
 
 from poinsot.app.elements import ALL_ELEMENTS, Control, Element, Plot
-from poinsot.app.live.actions import MAX_ACTIONS, ActionQueue
-from poinsot.app.live.budget import RebuildGate
-from poinsot.app.live.clock import SimClock
-from poinsot.app.live.ghost_controls import add_ghost_controls
-from poinsot.app.live.layout import Layout
-from poinsot.app.live.lecture import add_lecture_controls
-from poinsot.app.live.pacing import Outbox, Pacer, SessionStats
-from poinsot.app.live.panel import ControlPanel
-from poinsot.app.live.pointer import Pointer
-from poinsot.app.live.showcase import LiveShowcase
-from poinsot.app.live.sphere_pointer import SpherePointer
-from poinsot.app.live.uploads import UploadControls
-from poinsot.app.live.widgets import Retirement
-from poinsot.app.parameters import SPEED_RANGE, TRAIL_RANGE, Parameters, drawn_solid
+from poinsot.app.live.hardening.budget import RebuildGate
+from poinsot.app.live.hardening.pacing import Outbox, Pacer, SessionStats
+from poinsot.app.live.ui.actions import MAX_ACTIONS, ActionQueue
+from poinsot.app.live.ui.clock import SimClock
+from poinsot.app.live.ui.frame_loop import HOLD_SECONDS, FrameLoop
+from poinsot.app.live.ui.ghost_controls import add_ghost_controls
+from poinsot.app.live.ui.layout import Layout
+from poinsot.app.live.ui.lecture import add_lecture_controls
+from poinsot.app.live.ui.panel import ControlPanel
+from poinsot.app.live.ui.playback import STEP_SECONDS, Playback, clamp_trail
+from poinsot.app.live.ui.pointer import Pointer
+from poinsot.app.live.ui.refresh import PLOT_HZ, PLOT_MIN_FRAMES, TIME_HZ, Refresh
+from poinsot.app.live.ui.showcase import LiveShowcase
+from poinsot.app.live.ui.sphere_pointer import SpherePointer
+from poinsot.app.live.ui.uploads import UploadControls
+from poinsot.app.live.ui.widgets import Retirement
+from poinsot.app.parameters import SPEED_RANGE, Parameters, drawn_solid
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, Preset
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
@@ -42,18 +45,19 @@ from poinsot.physics import FreeRigidBody
 
 log = logging.getLogger(__name__)
 
+# The frame loop's and the refresh's rates, named here too: the session's knobs in one place.
+__all__ = [
+    "HOLD_SECONDS",
+    "MAX_FPS",
+    "PLOT_HZ",
+    "PLOT_MIN_FRAMES",
+    "STEP_SECONDS",
+    "TIME_HZ",
+    "Session",
+]
+
 #: The animation rate cap per client [frames per second].
 MAX_FPS = 60.0
-#: Plot and time-readout refresh rates [Hz]: the plot resends its whole window, at most every
-#: PLOT_MIN_FRAMES frames (12 Hz at 60 fps: a window that waits a frame still keeps up).
-PLOT_HZ = 10.0
-TIME_HZ = 5.0
-PLOT_MIN_FRAMES = 5
-#: "Step" advances this many wall seconds' worth of simulation time.
-STEP_SECONDS = 0.1
-#: While another session rebuilds, a due frame is held until the rebuild ends, for at most
-#: HOLD_SECONDS (so that many students dragging sliders never freeze the others).
-HOLD_SECONDS = 0.05
 
 
 class Session:
@@ -92,15 +96,12 @@ class Session:
         self.frame: Frame | None = None
         self.status = ""
         self.actions = ActionQueue(max_actions)
-        self._wake, self._stop = threading.Event(), threading.Event()
         self._applied = threading.Condition()
         self._generation = 0  # bumped after each rebuild (tests wait on it)
-        self._thread: threading.Thread | None = None
-        self._last_plot = self._last_time = 0.0  # monotonic times of the last refreshes
+        self.loop = self._frame_loop()
         #: The scene being shown, if one is chosen instead of a preset (frame thread).
         self.showcase: LiveShowcase | None = None
         self.sphere_pointer: SpherePointer | None = None  # mounted with the pointer below
-        self.speed_range = SPEED_RANGE
 
         apply_theme(client)
         view.apply(client.camera)
@@ -111,36 +112,46 @@ class Session:
         self.panel = ControlPanel(
             client.gui, self, preset if scene is None else scene.identity(), self.retirement
         )
+        self.refresh = Refresh(self.panel.motion, self.retirement)
+        self.playback = Playback(self.clock, self.scene, self.panel.show_playback, self.max_fps)
+        # The ghost's controls; the ghost itself when switched on (fitted after each rebuild).
+        self.ghost = add_ghost_controls(client, self.scene, self.retirement)
         self._apply_preset(preset) if scene is None else self._apply_scene(scene)
         self._rebuild()
+        self._mount_tools(user_agent)
+
+    def _frame_loop(self) -> FrameLoop:
+        return FrameLoop(
+            f"poinsot-session-{self.client.client_id}",
+            pacer=self.pacer,
+            budget=self.budget,
+            stats=self.stats,
+            max_fps=self.max_fps,
+            work=self._work,
+            draw=lambda now: self._frame_if_taken(now),  # looked up late: tests wrap it
+            report=self._report,
+        )
+
+    def _mount_tools(self, user_agent: str) -> None:
+        """What works on the first body: the lecture's tools, the page's layout, pointing."""
         self.lecture = add_lecture_controls(self)  # exports, views, theme, hotkeys
-        self.ghost = add_ghost_controls(self)  # its controls; the ghost when switched on
         self.layout = Layout(self, self.panel.motion, user_agent)  # a phone's, a tablet's page
         self.pointer = Pointer(self, drag=not self.layout.touch)  # a start pointed at
         self.sphere_pointer = SpherePointer(self, drag=not self.layout.touch)
         self.sphere_pointer.bind()  # on Landau's sphere, in a scene that draws one
-        self._fit_ghost()
 
     # -- lifecycle -----------------------------------------------------------------------
     def start(self) -> Session:
-        thread = threading.Thread(
-            target=self._run, name=f"poinsot-session-{self.client.client_id}", daemon=True
-        )
-        thread.start()
-        self._thread = thread  # only a started thread is ever joined by close()
+        self.loop.start()
         return self
 
     def close(self, timeout: float | None = None) -> None:
         """Stop the frame thread (never called from it). Safe to call twice."""
-        self._stop.set()
-        self._wake.set()
-        if timeout is not None and self._thread is not None:
-            if self._thread is not threading.current_thread():
-                self._thread.join(timeout)
+        self.loop.close(timeout)
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        return self.loop.running
 
     # -- actions (any thread; never block) -----------------------------------------------
     def post(self, action: Callable[[], None], key: object = None) -> None:
@@ -148,7 +159,7 @@ class Session:
         ``key`` replaces the one queued with the same key (it sets the same thing). Refused if
         the queue is full (:meth:`_drain` says so)."""
         self.actions.put(action, key)
-        self._wake.set()
+        self.loop.wake()
 
     def choose_preset(self, preset: Preset) -> None:
         count = self.panel.menu.count  # the menu's choices so far (Panel.show_preset)
@@ -184,35 +195,26 @@ class Session:
         self.post(lambda: self._edit(change, count))
 
     def set_speed(self, speed: float) -> None:
-        speed = min(max(float(speed), self.speed_range[0]), self.speed_range[1])
-
-        def action() -> None:
-            self.clock.speed = speed
-            self.scene.set_frame_time(self.frame_time)
-
-        self.post(action, "speed")
+        speed = self.playback.clamp_speed(speed)
+        self.post(lambda: self.playback.set_speed(speed), "speed")
 
     @property
     def frame_time(self) -> float:
         """Simulation time one frame advances at full frame rate."""
-        return self.clock.speed / self.max_fps
+        return self.playback.frame_time
 
     def toggle_pause(self) -> None:
-        self.post(self._toggle_pause)
+        self.post(self.playback.toggle_pause)
 
     def step(self) -> None:
-        self.post(self._step)
+        self.post(self.playback.step)
 
     def reset(self) -> None:
         self.post(self._reset)
 
     def set_trail(self, points: int) -> None:
-        points = min(max(int(points), TRAIL_RANGE[0]), TRAIL_RANGE[1])
-
-        def action() -> None:
-            self.scene.trail_points = points
-
-        self.post(action, "trail")
+        points = clamp_trail(points)
+        self.post(lambda: self.playback.set_trail(points), "trail")
 
     def set_visible(self, element: Element, visible: bool) -> None:
         self.post(lambda: self.scene.set_visible(element, visible), ("element", element))
@@ -232,36 +234,11 @@ class Session:
         return self._generation
 
     # -- frame thread --------------------------------------------------------------------
-    def _run(self) -> None:
-        next_frame = due = time.monotonic()
-        held = False  # a due frame waits for another session's rebuild (RebuildGate.hold)
-        while not self._stop.is_set():
-            delay = next_frame - time.monotonic()
-            if delay > 0 and not (held and not self.budget.rebuilding):
-                self._wake.wait(delay)  # set by an action, or by the rebuild's end if held
-                self._wake.clear()
-            if self._stop.is_set():
-                break
-            cpu0 = time.thread_time()
-            drawn = False
-            try:
-                self._drain()
-                if self._dirty:
-                    self._rebuild()
-                now = time.monotonic()
-                if held and not self.budget.rebuilding:
-                    next_frame = now  # the rebuild that held this frame is over
-                if now >= next_frame and now - due < HOLD_SECONDS and self.budget.hold(self._wake):
-                    held, next_frame = True, due + HOLD_SECONDS  # a slider move elsewhere first
-                elif now >= next_frame:
-                    held = False
-                    drawn = self._frame_if_taken(now)
-                    next_frame = due = now + self.pacer.interval
-            except Exception as exc:  # the loop must survive anything; the user sees it
-                self._report(exc)
-                next_frame = time.monotonic() + 1.0 / self.max_fps
-            if drawn:
-                self.stats.frame_cpu_seconds.append(time.thread_time() - cpu0)
+    def _work(self) -> None:
+        """Before each frame: the queued actions, then a rebuild if they asked for one."""
+        self._drain()
+        if self._dirty:
+            self._rebuild()
 
     def _frame_if_taken(self, now: float) -> bool:
         """Draw a frame, unless the browser has not yet taken the one before (:class:`Pacer`:
@@ -275,27 +252,11 @@ class Session:
         self.pacer.sent()
         return True
 
-    _frames_since_plot = PLOT_MIN_FRAMES  # frames drawn since the plot was last sent
-    _plot_unsent = False  # a sample was recorded since
-
     def _refresh(self, now: float) -> None:
-        """After a frame: a plot sample at PLOT_HZ; the whole window sent at most every
-        PLOT_MIN_FRAMES frames, on the first frame not busy already after a sample; the time
-        readout (and retired widgets) at TIME_HZ."""
-        motion = self.panel.motion
-        self._frames_since_plot += 1
-        if now - self._last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
-            self._last_plot = now
-            motion.record_plot(self.frame.t, self.frame.omega, self.frame.wxyz)
-            self._plot_unsent = True
+        """After a frame: the plot, the time readout and retired widgets at their rates
+        (:class:`~.refresh.Refresh`), and the scene's own readouts and plots."""
         busy = self.scene.sent_traces or self.lecture.display.laid_out_now  # a layout step
-        if self._plot_unsent and self._frames_since_plot >= PLOT_MIN_FRAMES and not busy:
-            self._frames_since_plot, self._plot_unsent = 0, False
-            motion.send_plot()
-        if now - self._last_time >= 1.0 / TIME_HZ:
-            self._last_time = now
-            motion.show_time(self.frame.t if self.frame is not None else 0.0, self.clock.paused)
-            self.retirement.collect(now)
+        self.refresh.after_frame(now, self.frame, self.clock.paused, busy)
         if self.showcase is not None and self.frame is not None:
             self.showcase.refresh(now, self.frame.t)  # its readouts and plots, at their rates
 
@@ -351,28 +312,25 @@ class Session:
             self._base = preset
             self._base_inertia = Parameters.from_preset(preset).inertia
             self._desired = Parameters.from_preset(preset)
-            self.clock.speed = preset.speed
-            self.scene.trail_points = preset.trail_points
+            self.playback.take(preset.speed, preset.trail_points)
             self._dirty = True
         self.scene.declare(preset.elements)
         self._declare(preset.controls, preset.plots, preset.elements, self._desired)
         self.panel.show_preset(preset, menu_count)
-        self._show_playback()
+        self.playback.show()
 
     def _apply_scene(self, scene: SceneSpec, menu_count: int | None = None) -> None:
         """Show ``scene``: the construction's elements it declares, the panel's groups it shares
         (speed, playback, trail, show/hide), and its own controls, parts, readouts and plots."""
         self._leave_scene()
         self.preset = scene.identity()
-        self.speed_range = scene.speed_range
-        self.clock.speed = scene.initial_speed()
-        self.scene.trail_points = scene.trail_points
+        self.playback.take(scene.initial_speed(), scene.trail_points, scene.speed_range)
         self.showcase = LiveShowcase(
             scene, self.client, self.scene, self.panel.motion, self, self.retirement
         )
         self._declare(scene.shared, frozenset(), scene.elements, self._desired)
         self.panel.show_preset(self.preset, menu_count)
-        self._show_playback()
+        self.playback.show()
         scene.view.apply(self.client.camera)
         if self.sphere_pointer is not None:
             self.sphere_pointer.bind()
@@ -394,19 +352,10 @@ class Session:
         if self.showcase is not None:
             self.showcase.remove()
             self.showcase = None
-            self.speed_range = SPEED_RANGE
+            self.playback.speed_range = SPEED_RANGE
             self.body = None
             self._dirty = True
             DEFAULT_VIEW.apply(self.client.camera)
-
-    def _fit_ghost(self) -> None:
-        """The numerical ghost races an exact torque-free body: without one (a scene that
-        poses its own body) its controls are hidden and it is switched off."""
-        ghost = getattr(self, "ghost", None)  # mounted after the first rebuild
-        if ghost is not None:
-            if self.body is None:
-                ghost.configure(enabled=False)
-            ghost.folder.visible = self.body is not None
 
     def _edit(
         self, change: Callable[[Parameters], Parameters], menu_count: int | None = None
@@ -442,7 +391,7 @@ class Session:
                     self._set_status(
                         f"{reason[:1].upper()}{reason[1:]}. Showing the last valid body."
                     )
-                self._fit_ghost()
+                self.ghost.fit(exact_body=self.body is not None)
             self.client.flush()  # out now, not at viser's next 1/60 s window
             self.stats.rebuild_seconds.append(time.perf_counter() - start)
             self.stats.rebuilds += 1
@@ -473,18 +422,6 @@ class Session:
         motion.record_plot(0.0, frame.omega, frame.wxyz)
         self._set_status("")
 
-    def _toggle_pause(self) -> None:
-        self.clock.paused = not self.clock.paused
-        self._show_playback()
-
-    def _step(self) -> None:
-        self.clock.paused = True
-        self.clock.step(STEP_SECONDS * self.clock.speed)
-        self._show_playback()
-
     def _reset(self) -> None:
         self.clock.reset(0.0)
         self.panel.motion.clear_plot()
-
-    def _show_playback(self) -> None:
-        self.panel.show_playback(self.clock.speed, self.clock.paused, self.scene.trail_points)

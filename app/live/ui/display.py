@@ -21,12 +21,11 @@ from __future__ import annotations
 import dataclasses
 import math
 import threading
-from typing import Protocol
 
 import numpy as np
 import viser
 
-from poinsot.app.live.motion_window import MotionWindow
+from poinsot.app.live.ui.motion_window import MotionWindow
 from poinsot.app.scene import palette
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.body_view import OFFSET, BodyView
@@ -65,13 +64,6 @@ class Style:
     large_text: bool = False
     projector: bool = False
     two_views: bool = False
-
-
-class DisplaySession(Protocol):
-    """What the display uses of a session."""
-
-    client: viser.ClientHandle
-    scene: PoinsotScene
 
 
 def two_view_camera() -> View:
@@ -123,10 +115,14 @@ class Display:
     """The look of one session's picture (see the module's docstring)."""
 
     def __init__(
-        self, session: DisplaySession, motion: MotionWindow, style_html: viser.GuiHtmlHandle
+        self,
+        client: viser.ClientHandle,
+        scene: PoinsotScene,
+        motion: MotionWindow,
+        style_html: viser.GuiHtmlHandle,
     ):
-        self.session = session
-        self.client = session.client
+        """``scene``: the session's construction, which the display restyles and lays out."""
+        self.client, self.scene = client, scene
         self.motion = motion
         self.style_html = style_html
         self.style = Style()
@@ -157,14 +153,14 @@ class Display:
         if wanted != self.style:
             self.apply(wanted)
         view = self.body_view
-        scene = self.session.scene
+        scene = self.scene
         if view is not None and frame is not None and scene.geometry is not None:
             if view.geometry is not scene.geometry:
                 view.fit(scene.geometry, self._attitude0(frame))
             view.advance(frame)
         self._frames_since_layout += 1
         stepped, self.laid_out_now = self.laid_out_now, False
-        if self.session.scene.sent_traces:
+        if self.scene.sent_traces:
             return  # this frame is heavier than most already: the labels wait for the next
         if self._steps is not None:
             if not stepped:  # every other frame: the plot finds one free between two steps
@@ -205,7 +201,7 @@ class Display:
         if t is not None and key == self._laid_out:
             return None
         self._laid_out = key
-        return self.session.scene.label_steps(camera)
+        return self.scene.label_steps(camera)
 
     def lay_out_labels(self, t: float | None = None, camera: Camera | None = None) -> dict:
         """Lay the labels out at once for the browser's camera (or ``camera``), not again for
@@ -219,7 +215,7 @@ class Display:
 
     def _attitude0(self, frame: Frame) -> np.ndarray:
         """The attitude at t = 0 (the body-frame picture is the body as it was then)."""
-        body = self.session.scene.body
+        body = self.scene.body
         return np.asarray(frame.wxyz) if body is None else wxyz(body.attitude(0.0))
 
     def apply(self, style: Style) -> None:
@@ -232,7 +228,7 @@ class Display:
         for html in (self.style_html, self.motion.style):  # whichever column is open
             html.content = text_css(style)
         look = palette.look(style.dark, style.projector)
-        self.session.scene.restyle(look)
+        self.scene.restyle(look)
         self.motion.legend.restyle(look)
         if self.body_view is not None:
             self.body_view.restyle(look)

@@ -24,7 +24,7 @@ Compact, the page differs in three ways (once, for that browser only):
   reports another aspect (the phone was turned).
 
 Touch needs nothing here: viser's camera turns under one finger and zooms under two, and a tap
-is a click (:mod:`poinsot.app.live.pointer`).
+is a click (:mod:`poinsot.app.live.ui.pointer`).
 
 Threads: the camera callback (viser's event loop) only compares the size and posts; the
 layout is the session thread's.
@@ -38,7 +38,7 @@ from typing import Protocol
 
 import viser
 
-from poinsot.app.live.motion_window import MotionWindow
+from poinsot.app.live.ui.motion_window import MotionWindow
 from poinsot.app.scene.cameras import construction_points, framed
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.geometry import L_OVERSHOOT, PLANE_RADIUS

@@ -19,7 +19,7 @@ from typing import Protocol
 import numpy as np
 import viser
 
-from poinsot.app.live.widgets import Sent, on_user
+from poinsot.app.live.ui.widgets import Sent, on_user
 from poinsot.app.scene import updates
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene

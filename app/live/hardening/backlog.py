@@ -1,20 +1,21 @@
 """The hard cap on what a client may leave untaken: past it, for longer than a grace period,
 the server closes that client's connection.
 
-:mod:`~poinsot.app.live.pacing` keeps a session's frames from piling up for a browser that
+:mod:`~poinsot.app.live.hardening.pacing` keeps a session's frames from piling up for a browser that
 does not take them. Other messages a session queues (the replies to the client's own actions:
 a rebuilt panel, readouts, status) are not paced, and a client that goes on sending while it
 reads nothing could make its queue grow until websockets' keepalive gives up on it (tens of
 seconds). :class:`BacklogWatch` is one thread per server that looks at every session's
-:class:`~poinsot.app.live.pacing.Outbox` a few times a second: a client with more than
+:class:`~poinsot.app.live.hardening.pacing.Outbox` a few times a second: a client with more than
 :attr:`BacklogLimit.max_pending` messages in viser's queue, or more than
 :attr:`BacklogLimit.max_unacked` bytes written to it and not acknowledged, for longer than
 :attr:`BacklogLimit.grace`, has its websocket closed (one log line). viser then runs the
 server's disconnect handler, which closes the session as for any browser that leaves.
 
 A client that keeps up never comes near the bounds: its queue holds about one frame (a few
-messages, :data:`~poinsot.app.live.pacing.MAX_IN_FLIGHT`), a rebuild adds a few dozen, and
-its unacknowledged bytes stay near one frame's (:data:`~poinsot.app.live.pacing.MAX_UNACKED`).
+messages, :data:`~poinsot.app.live.hardening.pacing.MAX_IN_FLIGHT`), a rebuild adds a few dozen, and
+its unacknowledged bytes stay near one frame's
+(:data:`~poinsot.app.live.hardening.pacing.MAX_UNACKED`).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from typing import Any, Protocol
 
 import viser
 
-from poinsot.app.live.pacing import Outbox
+from poinsot.app.live.hardening.pacing import Outbox
 from poinsot.app.viser_private.transport import connection_of
 
 log = logging.getLogger(__name__)

@@ -3,41 +3,38 @@
 Only the controls the current preset declares are shown (:meth:`ControlPanel.declare` creates
 whole groups, or shows them again; ``order`` keeps the layout stable whatever the creation
 order). A group the preset does not declare is put away: the panel's own groups are hidden and
-kept for when a preset declares them again (:class:`~poinsot.app.live.widgets.Shelf`: no
+kept for when a preset declares them again (:class:`~poinsot.app.live.ui.widgets.Shelf`: no
 widget of theirs is ever deleted, so no update can reach a deleted one), the groups other
 modules add are retired (hidden at once, deleted later).
 Callbacks never touch the scene or block: they hand a small action to the session's frame
 thread via :class:`Actions`. Programmatic value changes (``event.client is None``) are
 ignored, so the session can mirror its state into the widgets without feedback loops. The
 time, readouts and the plot of ω are in the floating "Motion" window
-(:mod:`poinsot.app.live.motion_window`).
+(:mod:`poinsot.app.live.ui.motion_window`).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from typing import Any, Protocol, TypeVar
 
 import viser
 
 from poinsot.app.elements import Control, Element, Plot
-from poinsot.app.live.legend import caption
-from poinsot.app.live.motion_window import MotionWindow
-from poinsot.app.live.widgets import (
+from poinsot.app.live.ui.body_controls import D_STEP, BodyControls
+from poinsot.app.live.ui.legend import caption
+from poinsot.app.live.ui.motion_window import MotionWindow
+from poinsot.app.live.ui.widgets import (
     Removable,
     Retirement,
     Sent,
     Shelf,
     on_user,
-    set_marks,
     set_value,
     write_unless_newer,
 )
 from poinsot.app.parameters import (
-    INERTIA_RANGE,
-    OMEGA_NORM_RANGE,
     SPEED_RANGE,
     TRAIL_RANGE,
     Parameters,
@@ -59,9 +56,7 @@ ELEMENT_LABELS: dict[Element, str] = {
     Element.HERPOLHODE: "herpolhode (live)",
     Element.SOLID: "solid body",
 }
-
-SIDE_OPTIONS = ("minor axis", "major axis")
-POLE_OPTIONS = ("+ pole", "− pole")
+__all__ = ["D_STEP", "ELEMENT_LABELS", "ControlPanel", "Widgets"]
 
 Group = Control | Plot
 
@@ -134,17 +129,6 @@ _MIRRORED: dict[Group, str] = {
 }
 #: The panel's own groups: put away on the :class:`Shelf` and shown again, never deleted.
 _SHELVED: frozenset[Group] = frozenset(Control) | {Plot.OMEGA}
-#: Step of the D slider; a value within half a step of I₂ is I₂ exactly (the separatrix).
-D_STEP = 0.001
-
-
-def slider_range(default: tuple[float, float], values: Iterable[float]) -> tuple[float, float]:
-    """A slider's range: ``default``, widened to hold ``values`` (a body of one's own can have
-    a moment below the usual range, or spin faster), to round ends (hundredths below, tenths
-    above)."""
-    values = [float(v) for v in values]
-    lo = min(default[0], *(math.floor(100.0 * v) / 100.0 if v >= 0.01 else v for v in values))
-    return lo, max(default[1], *(math.ceil(10.0 * v) / 10.0 for v in values))
 
 
 class ControlPanel:
@@ -173,6 +157,8 @@ class ControlPanel:
             self.source = gui.add_markdown(self._source_text(preset))
             self.status = gui.add_markdown("")
         self.motion = MotionWindow(gui, order=_ORDER["readouts"])
+        #: The body's groups (moments, D, side and pole, |ω₀|).
+        self.body = BodyControls(gui, actions.edit, self.widgets, self._folder, self._on_user)
         #: The browser's choices in the menu (a preset shown for an older one is not written
         #: over a newer one: :meth:`show_preset`).
         self.menu = Sent(preset.label)
@@ -211,10 +197,10 @@ class ControlPanel:
             if key not in wanted:
                 self._remove_group(key)
         builders: dict[Group, Callable[[], list[Removable]]] = {
-            Control.INERTIA: lambda: self._build_inertia(params),
-            Control.ENERGY: lambda: self._build_energy(params),
-            Control.SIDE: self._build_side,
-            Control.OMEGA_NORM: lambda: self._build_omega_norm(params),
+            Control.INERTIA: lambda: self.body.build_inertia(params),
+            Control.ENERGY: lambda: self.body.build_energy(params),
+            Control.SIDE: self.body.build_side,
+            Control.OMEGA_NORM: lambda: self.body.build_omega_norm(params),
             Control.SPEED: lambda: self._build_speed(speed),
             Control.PLAYBACK: self._build_playback,
             Control.TRAIL: lambda: self._build_trail(trail),
@@ -290,95 +276,6 @@ class ControlPanel:
                 folder.visible = name in used
 
     # -- groups --------------------------------------------------------------------------
-    def _build_inertia(self, params: Parameters) -> list[Removable]:
-        sliders = []
-        lo, hi = slider_range(INERTIA_RANGE, params.inertia)
-        with self._folder(Control.INERTIA, "Body: principal moments"):
-            for i in range(3):
-                slider = self.gui.add_slider(
-                    f"I{'₁₂₃'[i]}",
-                    lo,
-                    hi,
-                    0.01,
-                    float(params.inertia[i]),
-                    order=float(i),
-                    hint="A principal moment of inertia (mass × length²).",
-                )
-                sliders.append(self._on_user(slider, self._inertia_callback(i)))
-        self.widgets.inertia = tuple(sliders)
-        return list(sliders)
-
-    def _inertia_callback(self, index: int) -> Callable[[Sent], None]:
-        def callback(handle: Sent) -> None:
-            value = float(handle.value)
-            self.actions.edit(lambda p: p.with_inertia(index, value))
-
-        return callback
-
-    def _build_energy(self, params: Parameters) -> list[Removable]:
-        lo, hi = params.D_range
-        with self._folder("motion", "Motion"):
-            slider = self.gui.add_slider(
-                "D = |L|²/2T",
-                lo,
-                hi,
-                D_STEP,
-                float(params.D),
-                order=0.0,
-                marks=self._energy_marks(params),
-                hint="Energy parameter in [I_min, I_max]; D = I₂ (its mark) is the separatrix.",
-            )
-
-        def move(handle: Sent) -> None:
-            value = float(handle.value)
-            self.actions.edit(lambda p: p.with_D(value, snap=D_STEP / 2))
-
-        self.widgets.energy = self._on_user(slider, move)
-        return [slider]
-
-    @staticmethod
-    def _energy_marks(params: Parameters) -> tuple[tuple[float, str], ...]:
-        lo, hi = params.D_range
-        mid = params.intermediate
-        marks = [(lo, "min I"), (hi, "max I")]
-        if lo < mid < hi:
-            marks.insert(1, (mid, "I₂"))
-        return tuple(marks)
-
-    def _build_side(self) -> list[Removable]:
-        with self._folder("motion", "Motion"):
-            side = self.gui.add_button_group("Side of separatrix", SIDE_OPTIONS, order=1.0)
-            pole = self.gui.add_button_group("Polhode", POLE_OPTIONS, order=2.0)
-
-        def choose_side(handle: Sent) -> None:
-            choice = "major" if handle.value == SIDE_OPTIONS[1] else "minor"
-            self.actions.edit(lambda p: p.mirrored(choice))
-
-        def choose_pole(handle: Sent) -> None:
-            sign = 1 if handle.value == POLE_OPTIONS[0] else -1
-            self.actions.edit(lambda p: p.with_pole(sign))
-
-        self.widgets.side = side
-        return [self._on_user(side, choose_side), self._on_user(pole, choose_pole)]
-
-    def _build_omega_norm(self, params: Parameters) -> list[Removable]:
-        with self._folder("motion", "Motion"):
-            slider = self.gui.add_slider(
-                "|ω₀|",
-                *slider_range(OMEGA_NORM_RANGE, (params.omega_norm,)),
-                0.05,
-                float(params.omega_norm),
-                order=3.0,
-                hint="Initial angular speed (rad per time unit).",
-            )
-
-        def move(handle: Sent) -> None:
-            value = float(handle.value)
-            self.actions.edit(lambda p: p.with_omega_norm(value))
-
-        self.widgets.omega_norm = self._on_user(slider, move)
-        return [slider]
-
     def _build_speed(self, speed: float) -> list[Removable]:
         with self._folder("playback", "Playback"):
             slider = self.gui.add_slider(
@@ -463,23 +360,7 @@ class ControlPanel:
 
     def show_parameters(self, params: Parameters) -> None:
         """Mirror parameters into the sliders (and the D slider's range and marks)."""
-        w = self.widgets
-        lo, hi = slider_range(INERTIA_RANGE, params.inertia)
-        for slider, moment in zip(w.inertia, params.inertia, strict=False):
-            if (slider.min, slider.max) != (lo, hi):
-                slider.min, slider.max = lo, hi
-            set_value(slider, float(moment))
-        if w.energy is not None:
-            w.energy.min, w.energy.max = params.D_range
-            set_marks(w.energy, self._energy_marks(params))
-            set_value(w.energy, float(params.D))
-        if w.side is not None and w.side.visible != params.has_separatrix:
-            w.side.visible = params.has_separatrix  # a symmetric body has no separatrix
-        if w.omega_norm is not None:
-            lo, hi = slider_range(OMEGA_NORM_RANGE, (params.omega_norm,))
-            if (w.omega_norm.min, w.omega_norm.max) != (lo, hi):
-                w.omega_norm.min, w.omega_norm.max = lo, hi
-            set_value(w.omega_norm, float(params.omega_norm))
+        self.body.show(params)
 
     def show_playback(self, speed: float, paused: bool, trail: int) -> None:
         w = self.widgets
