@@ -14,6 +14,7 @@ import viser
 from poinsot.app.live import links
 from poinsot.app.live.backlog import BacklogLimit, BacklogWatch
 from poinsot.app.live.budget import RebuildGate
+from poinsot.app.live.follow import FollowHub
 from poinsot.app.live.guard import WireGuard, guarded_viser
 from poinsot.app.live.pacing import frame_share
 from poinsot.app.live.session import MAX_FPS, Session
@@ -49,16 +50,21 @@ class PoinsotApp:
         allow_origins: Iterable[str] = (),
         backlog: BacklogLimit | None = None,
         landing_port: int = 0,
+        follow: FollowHub | None = None,
     ) -> None:
         """Each new browser starts with ``preset``, or with ``scene`` if one is given. A
         browser's websocket is refused unless it comes from a page this server served, or from
         one of ``allow_origins`` (``scheme://host[:port]``); see :mod:`.guard`. A browser that
         leaves more than ``backlog`` untaken for longer than its grace is disconnected
         (:mod:`.backlog`; its defaults if None). ``landing_port``: a landing in front of this
-        server (:mod:`.landing`), named by the links copied from the pages served here."""
+        server (:mod:`.landing`), named by the links copied from the pages served here.
+        ``follow``: the lead and its followers (:mod:`.follow`; this server's alone, with a
+        new lecturer code, if None)."""
         self.preset = preset
         self.scene = scene
         self.landing_port = landing_port
+        #: The lecturer code, the lead and its followers (:mod:`.follow`).
+        self.follow = follow if follow is not None else FollowHub()
         self.max_fps = max_fps
         self._lock = threading.Lock()
         self._sessions: dict[int, Session] = {}
@@ -150,6 +156,7 @@ class PoinsotApp:
             budget=self.budget,
             scene=link.scene,
             user_agent=self.guard.user_agent(client.client_id),
+            follow=self.follow,
         )
         links.apply(session, link)
         with self._connected:

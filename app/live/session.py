@@ -22,8 +22,10 @@ from poinsot.app.elements import ALL_ELEMENTS, Control, Element, Plot
 from poinsot.app.live.actions import MAX_ACTIONS, ActionQueue
 from poinsot.app.live.budget import RebuildGate
 from poinsot.app.live.clock import SimClock
+from poinsot.app.live.follow import FollowHub
 from poinsot.app.live.ghost_controls import add_ghost_controls
 from poinsot.app.live.layout import Layout
+from poinsot.app.live.lead import LeadControls
 from poinsot.app.live.lecture import add_lecture_controls
 from poinsot.app.live.pacing import Outbox, Pacer, SessionStats
 from poinsot.app.live.panel import ControlPanel
@@ -71,12 +73,11 @@ class Session:
         scene: SceneSpec | None = None,
         max_actions: int = MAX_ACTIONS,
         user_agent: str = "",
+        follow: FollowHub | None = None,
     ) -> None:
-        """``budget``: the server's rebuild gate, through which a rebuild goes first (one per
-        session if None); ``scene``: start with this scene (:mod:`poinsot.app.scenes`) instead
-        of ``preset``. Frames: as many as the client takes, up to ``max_fps`` (:attr:`pacer`).
-        At most ``max_actions`` actions queued (:mod:`.actions`). ``user_agent``: the browser's
-        (a phone's or a tablet's page is laid out for it: :mod:`.layout`)."""
+        """``budget``: the server's rebuild gate (its own if None); ``scene``: start with it,
+        not ``preset``. Frames: as many as taken, up to ``max_fps`` (:attr:`pacer`). Others:
+        ``max_actions`` :mod:`.actions`, ``user_agent`` :mod:`.layout`, ``follow`` :mod:`.lead`."""
         self.client = client
         self.max_fps = float(max_fps)
         self.budget = budget if budget is not None else RebuildGate()
@@ -120,6 +121,7 @@ class Session:
         self.sphere_pointer = SpherePointer(self, drag=not self.layout.touch)
         self.sphere_pointer.bind()  # on Landau's sphere, in a scene that draws one
         self._fit_ghost()
+        self.follow = LeadControls(self, follow if follow is not None else FollowHub())
 
     # -- lifecycle -----------------------------------------------------------------------
     def start(self) -> Session:
@@ -134,6 +136,7 @@ class Session:
         """Stop the frame thread (never called from it). Safe to call twice."""
         self._stop.set()
         self._wake.set()
+        self.follow.close()
         if timeout is not None and self._thread is not None:
             if self._thread is not threading.current_thread():
                 self._thread.join(timeout)
@@ -283,6 +286,7 @@ class Session:
         PLOT_MIN_FRAMES frames, on the first frame not busy already after a sample; the time
         readout (and retired widgets) at TIME_HZ."""
         motion = self.panel.motion
+        self.follow.on_frame(now)  # a lead publishes its state
         self._frames_since_plot += 1
         if now - self._last_plot >= 1.0 / PLOT_HZ and self.frame is not None:
             self._last_plot = now
@@ -319,7 +323,7 @@ class Session:
         if (self.body is None) if showcase is None else not showcase.loaded:
             return
         start = time.perf_counter()
-        t = self.clock.now()
+        t = self.follow.now(self.clock)  # the lecturer's time while following
         self.frame = self.scene.advance(t) if showcase is None else showcase.advance(t)
         self.lecture.on_frame(self.frame)
         self.ghost.on_frame(self.frame)
