@@ -26,6 +26,8 @@ from poinsot.app.live import links
 from poinsot.app.live.backlog import close_connection
 from poinsot.app.live.follow import FollowHub, LeadState
 from poinsot.app.live.widgets import Sent, hold_input, on_user, set_value
+from poinsot.app.parameters import Parameters
+from poinsot.app.presets import PRESETS
 
 #: Order of the folder in the main panel (before the ghost's).
 FOLDER_ORDER = 44.0
@@ -184,10 +186,10 @@ class LeadControls:
         if self.camera.value and state.camera and state.camera != self._applied_camera:
             self._applied_camera = state.camera
             position, look_at, up = state.camera
-            with self.client.atomic():
+            with self.client.atomic():  # the position moves look_at along: look_at after it
                 self.client.camera.up_direction = up
-                self.client.camera.look_at = look_at
                 self.client.camera.position = position
+                self.client.camera.look_at = look_at
 
     def _open(self, query: str) -> None:
         try:
@@ -195,10 +197,14 @@ class LeadControls:
         except links.LinkError as exc:  # a lead on another version: keep the last state
             self.say(f"The lecturer's state could not be shown ({exc}).")
             return
+        session = self.session
         if link.scene is not None:
-            self.session.choose_scene(link.scene)
-        else:
-            self.session.choose_preset(link.preset)
+            session.choose_scene(link.scene)
+        elif link.preset in PRESETS or session.showcase is not None:
+            session.choose_preset(link.preset)
+        else:  # a body of the lead's own: as a slider move would (no panel redeclared)
+            params = Parameters.from_preset(link.preset)
+            session.edit(lambda _: params)
 
     def on_frame(self, now: float) -> None:
         """Each frame: a lead publishes its state if it changed, or if it is due again."""

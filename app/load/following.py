@@ -2,16 +2,17 @@
 
 For each size in ``Config.followers``, a child process connects the lead and N followers
 through the landing (:class:`FollowFleet`); the lead types the lecturer code and leads, every
-follower ticks "Follow the lecturer". Then two windows of ``follow_seconds``:
+follower ticks "Follow the lecturer". Then three windows of ``follow_seconds``:
 
-- following: each follower's frames (poses received, as in :mod:`.fleet`), and every
+- following, moving: each follower's frames (poses received, as in :mod:`.fleet`), and every
   ``slider_period`` the lead moves the I₂ slider: the time until each follower receives the
   rebuilt ellipsoid (the lead's move on every follower's screen);
-- exploring: every follower presses "Explore from here" and runs as an ordinary session.
+- following, still: nothing moves but the motion;
+- exploring, still: every follower has pressed "Explore from here" and runs as a session.
 
-The server's CPU time (its worker processes) over each window, divided by the frames the
-followers received, gives the CPU per follower-frame against the CPU per session-frame of
-the same clients, in the same run, on the same (shared) machine.
+The server's CPU time (its worker processes) over each still window, divided by the frames the
+clients received, gives the CPU per follower-frame against the CPU per session-frame of the
+same clients, in the same run, on the same (shared) machine.
 """
 
 from __future__ import annotations
@@ -158,14 +159,16 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         with FollowFleet(server.port, server.code, count, cfg.lifetime) as fleet:
             time.sleep(warmup(cfg.follow_seconds))
             pids = server.worker_pids or [server.pid]
-            cpu0 = _cpu(pids)
             following = fleet.window(cfg.follow_seconds, cfg.slider_period)
+            cpu0 = _cpu(pids)
+            still = fleet.window(cfg.follow_seconds, 0.0)
             cpu1 = _cpu(pids)
             explored = fleet.explore()
             cpu2 = _cpu(pids)
             own = fleet.window(cfg.follow_seconds, 0.0)
             cpu3 = _cpu(pids)
-        report.add(*_figures(count, following, own, cpu1 - cpu0, cpu3 - cpu2, explored))
+        costs = (_ms_per_frame(cpu1 - cpu0, still), _ms_per_frame(cpu3 - cpu2, own))
+        report.add(*_figures(count, following, own, costs, explored))
 
 
 def _ms_per_frame(cpu: float, window: dict) -> float:
@@ -174,12 +177,12 @@ def _ms_per_frame(cpu: float, window: dict) -> float:
 
 
 def _figures(
-    count: int, following: dict, own: dict, cpu_follow: float, cpu_own: float, explored: bool
+    count: int, following: dict, own: dict, costs: tuple[float, float], explored: bool
 ) -> list[Figure]:
     fps, latencies = following["fps"], following["latencies"]
     lost = following["moves"] * count - len(latencies)
     p95 = 1e3 * percentile(latencies, 95) if latencies else math.nan
-    follow_ms, own_ms = _ms_per_frame(cpu_follow, following), _ms_per_frame(cpu_own, own)
+    follow_ms, own_ms = costs
     name = f"{count} followers"
     return [
         Figure(
@@ -203,7 +206,7 @@ def _figures(
             "follow",
             f"{name}: server CPU per frame",
             f"{follow_ms:.2f} ms per follower-frame, {own_ms:.2f} ms per session-frame "
-            f"(the same clients after Explore from here; {own_fps_text(own)})",
+            f"(the same clients after Explore from here, {own_fps_text(own)}; nothing moved)",
             follower_ms=follow_ms,
             session_ms=own_ms,
             explored=float(explored),

@@ -16,8 +16,9 @@ from poinsot.app.live.follow import ENDED, MAX_WRONG_CODES, FollowHub, LeadState
 from poinsot.app.live.lead import HELD
 from poinsot.app.live.probe import Probe
 from poinsot.app.live.relay import Relay
+from poinsot.app.viser_private import wire_message
 from tests.app.test_workers import start_classroom, stop_classroom
-from tests.conftest import after_frames, session_of
+from tests.conftest import after_frames, session_of, wait_until
 
 D = "D = |L|²/2T"
 POLHODES = "Scene: the polhode family"
@@ -160,6 +161,32 @@ def test_a_second_leader_takes_over_and_the_first_is_told(poinsot_app, make_prob
     assert first.wait_for(lambda p: _says(p, "Another lecturer took over"), 30)
     sessions = sorted(poinsot_app.sessions().values(), key=lambda s: s.client.client_id)
     assert [s.follow.mode for s in sessions] == ["own", "lead"]
+
+
+def test_a_follower_may_take_the_lecturers_camera(poinsot_app, make_probe):
+    lead = _ready(make_probe(poinsot_app))
+    _lead(lead, poinsot_app.follow.code)
+    lead.send(
+        wire_message(
+            "ViewerCameraMessage",
+            wxyz=(1.0, 0.0, 0.0, 0.0),
+            position=(1.0, 2.0, 3.0),
+            fov=0.8,
+            near=0.01,
+            far=100.0,
+            image_height=720,
+            image_width=1280,
+            look_at=(0.0, 0.0, 0.5),
+            up_direction=(0.0, 0.0, 1.0),
+        )
+    )
+    follower = _ready(make_probe(poinsot_app))
+    session = session_of(poinsot_app, 2)
+    _set(follower, "Lecturer's camera", True)
+    _follow(follower)
+    camera = session.client.camera
+    assert wait_until(lambda: tuple(camera.position) == pytest.approx((1.0, 2.0, 3.0)), 30)
+    assert tuple(camera.look_at) == pytest.approx((0.0, 0.0, 0.5))
 
 
 def test_a_link_asks_to_follow():
