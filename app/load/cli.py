@@ -67,14 +67,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=cfg.hostile_quiet_seconds,
         help="the innocent client's reference windows [s]",
     )
-    add(
-        "--followers",
-        type=positive_int,
-        nargs="+",
-        default=list(cfg.followers),
-        help="followers of one lead in the follow phase, one run per number",
-    )
-    add("--follow-seconds", type=positive_float, default=cfg.follow_seconds, help="each window")
+    _add_follow(parser, cfg)
     add("--debug", action="store_true", help="show the traceback of a failure (else one line)")
     goals = parser.add_argument_group("goals")
     goals.add_argument("--min-fps", type=non_negative_float, default=bounds.min_fps)
@@ -89,6 +82,20 @@ def build_parser() -> argparse.ArgumentParser:
     goals.add_argument("--min-innocent-keep", type=fraction, default=bounds.min_innocent_keep)
     goals.add_argument("--max-follow-ms", type=positive_float, default=bounds.max_follow_ms)
     return parser
+
+
+def _add_follow(parser: argparse.ArgumentParser, cfg: Config) -> None:
+    """The follow phase's sizes (``--phase follow``)."""
+    parser.add_argument(
+        "--followers",
+        type=positive_int,
+        nargs="+",
+        default=list(cfg.followers),
+        help="followers of one lead in the follow phase, one run per number",
+    )
+    parser.add_argument(
+        "--follow-seconds", type=positive_float, default=cfg.follow_seconds, help="each window"
+    )
 
 
 def _options(args: argparse.Namespace) -> tuple[list[str], Config, Bounds]:
