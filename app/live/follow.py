@@ -122,6 +122,11 @@ class FollowHub:
             token, self._lead, self._lead_token = self._lead_token, None, ""
         self._send(("gone", token, message))
 
+    def forget(self, client_key: int) -> None:
+        """A client left: its count of wrong codes goes with it."""
+        with self._lock:
+            self._wrong.pop(client_key, None)
+
     def lead_token(self, lead: Any) -> str:
         with self._lock:
             return self._lead_token if lead is self._lead else ""

@@ -252,4 +252,5 @@ class LeadControls:
         """The browser left."""
         hold_input(self.client, None)
         self.hub.unwatch(id(self))
+        self.hub.forget(id(self.client))
         self.hub.leave(self)
