@@ -189,6 +189,15 @@ def test_a_follower_may_take_the_lecturers_camera(poinsot_app, make_probe):
     assert tuple(camera.look_at) == pytest.approx((0.0, 0.0, 0.5))
 
 
+def test_a_link_with_follow_follows(poinsot_app, make_probe):
+    probe = _ready(make_probe(poinsot_app))
+    session = session_of(poinsot_app)
+    page = "http://127.0.0.1:8080/?follow=1"
+    links.apply(session, links.opening(page, session.preset, None))
+    assert probe.wait_for(lambda p: _says(p, "Waiting for the lecturer"), 30)
+    assert session.follow.mode == "follow" and _value(probe, "Follow the lecturer") is True
+
+
 def test_a_link_asks_to_follow():
     assert links.parse("follow=1").follow and not links.parse("t=2").follow
     with pytest.raises(links.LinkError, match="follow='maybe' is not 0 or 1"):
