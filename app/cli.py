@@ -90,6 +90,7 @@ def serve(
         print(f"poinsot serve: {exc}", file=sys.stderr)
         return 2
     from poinsot.app.live.server import PoinsotApp
+    from poinsot.app.live.workers import lecturer_line
 
     app = PoinsotApp(
         host, port, preset=preset_by_key(preset), scene=start_scene, allow_origins=allow_origin
@@ -99,6 +100,7 @@ def serve(
         print(f"poinsot serve: {port_problem(host, port)}", file=sys.stderr)
         return 2
     print(board(host, app.port, link or ""), flush=True)
+    print(lecturer_line(app.follow.code), flush=True)
     try:
         while True:
             time.sleep(3600)

@@ -18,6 +18,7 @@ from poinsot.app.live.hardening.guard import WireGuard, guarded_viser
 from poinsot.app.live.hardening.pacing import frame_share
 from poinsot.app.live.hardening.upkeep import MemoryTrim, fixed_pool
 from poinsot.app.live.ui import links
+from poinsot.app.live.ui.follow import FollowHub
 from poinsot.app.live.ui.session import MAX_FPS, Session
 from poinsot.app.presets import DEFAULT_PRESET, Preset
 from poinsot.app.scenes.spec import SceneSpec
@@ -50,16 +51,21 @@ class PoinsotApp:
         allow_origins: Iterable[str] = (),
         backlog: BacklogLimit | None = None,
         landing_port: int = 0,
+        follow: FollowHub | None = None,
     ) -> None:
         """Each new browser starts with ``preset``, or with ``scene`` if one is given. A
         browser's websocket is refused unless it comes from a page this server served, or from
         one of ``allow_origins`` (``scheme://host[:port]``); see :mod:`.hardening.guard`. A browser
         that leaves more than ``backlog`` untaken for longer than its grace is disconnected
         (:mod:`.hardening.backlog`; its defaults if None). ``landing_port``: a landing in front of
-        this server (:mod:`.landing`), named by the links copied from the pages served here."""
+        this server (:mod:`.landing`), named by the links copied from the pages served here.
+        ``follow``: the lead and its followers (:mod:`.ui.follow`; this server's alone, with a
+        new lecturer code, if None)."""
         self.preset = preset
         self.scene = scene
         self.landing_port = landing_port
+        #: The lecturer code, the lead and its followers (:mod:`.ui.follow`).
+        self.follow = follow if follow is not None else FollowHub()
         self.max_fps = max_fps
         self._lock = threading.Lock()
         self._sessions: dict[int, Session] = {}
@@ -152,6 +158,7 @@ class PoinsotApp:
             budget=self.budget,
             scene=link.scene,
             user_agent=self.guard.user_agent(client.client_id),
+            follow=self.follow,
         )
         links.apply(session, link)
         with self._connected:

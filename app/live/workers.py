@@ -9,6 +9,9 @@ the least-loaded one.
 Workers never outlive the parent: each holds the read end of a pipe from it and stops when the
 pipe closes, which the kernel does however the parent ends (even ``kill -9``). A worker that
 ends on its own is reported in one line and gets no more browsers.
+
+The lecturer code is made by the parent and given to every worker; a second pipe per worker
+(its feed) carries the lead's state to the others (:mod:`poinsot.app.live.relay`).
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ from multiprocessing.connection import Connection
 from typing import TYPE_CHECKING, Any
 
 from poinsot.app.live.hardening.network import PortError, check_port, port_problem
+from poinsot.app.live.ui.follow import new_code
 
 if TYPE_CHECKING:
     from poinsot.app.live.server import PoinsotApp
@@ -62,6 +66,8 @@ def _worker_main(
     scene: str | None,
     origins: tuple[str, ...] = (),
     landing: int = 0,
+    feed: Connection | None = None,
+    code: str = "",
 ) -> None:
     """The worker: serve, report ``("ready", port)``, stop when told or when the parent's end
     of the pipe closes (then, whatever happens, the process ends within ``STOP_GRACE``).
@@ -74,7 +80,7 @@ def _worker_main(
     app = None
     status = 0
     try:
-        app = _serve(host, port, preset, scene, origins, landing)
+        app = _serve(host, port, preset, scene, origins, landing, feed, code)
         if port and app.port != port:  # viser moved on to the next free port: refuse
             conn.send(("error", port_problem(host, port)))
             return
@@ -102,7 +108,10 @@ def _serve(
     scene: str | None,
     origins: tuple[str, ...],
     landing: int = 0,
+    feed: Connection | None = None,
+    code: str = "",
 ) -> PoinsotApp:
+    from poinsot.app.live.relay import worker_hub
     from poinsot.app.live.server import PoinsotApp
     from poinsot.app.presets import preset_by_key
     from poinsot.app.scenes import scene_by_name
@@ -115,6 +124,7 @@ def _serve(
         scene=start_scene,
         allow_origins=origins,
         landing_port=landing,
+        follow=worker_hub(feed, code) if feed is not None else None,
     )
 
 
@@ -130,19 +140,33 @@ class Worker:
         scene: str | None,
         origins: tuple[str, ...] = (),
         landing: int = 0,
+        code: str = "",
     ):
         ctx = mp.get_context("spawn")
         self.index = index
         self.load = ctx.RawArray("q", 2)  # clients now, clients ever (written by the worker)
         self.conn, child_end = ctx.Pipe()
+        self.feed, child_feed = ctx.Pipe()  # the lead's state, both ways (:mod:`.relay`)
         self.process = ctx.Process(
             target=_worker_main,
-            args=(child_end, self.load, host, port, preset, scene, origins, landing),
+            args=(
+                child_end,
+                self.load,
+                host,
+                port,
+                preset,
+                scene,
+                origins,
+                landing,
+                child_feed,
+                code,
+            ),
             name=f"poinsot-worker-{index}",
             daemon=True,
         )
         self.process.start()
         child_end.close()
+        child_feed.close()
         self.port = 0
         self.reported = False  # its unexpected end has been reported
 
@@ -196,6 +220,7 @@ class Worker:
             self.process.terminate()
             self.process.join(5.0)
         self.conn.close()
+        self.feed.close()
 
 
 def start_workers(
@@ -205,6 +230,7 @@ def start_workers(
     preset: str,
     scene: str | None,
     origins: tuple[str, ...] = (),
+    code: str = "",
 ) -> list[Worker]:
     """Start ``count`` workers (all at once) and wait until every one serves. With a fixed
     ``port`` they take the next ports, ``port + 1`` to ``port + count`` (one range to open in
@@ -214,7 +240,8 @@ def start_workers(
     for p in ports:
         check_port(host, p)
     # Links copied from a worker's page name the landing (a fixed port: known now).
-    workers = [Worker(i, host, p, preset, scene, origins, port) for i, p in enumerate(ports)]
+    code = code or new_code()
+    workers = [Worker(i, host, p, preset, scene, origins, port, code) for i, p in enumerate(ports)]
     try:
         for worker in workers:
             worker.wait_ready(START_TIMEOUT)
@@ -269,9 +296,12 @@ def serve_classroom(
     (:func:`~poinsot.app.live.hardening.network.board`)."""
     from poinsot.app.live.hardening.network import board
     from poinsot.app.live.landing import Balancer, LandingServer
+    from poinsot.app.live.relay import Relay
 
     check_port(host, port)
-    workers = start_workers(count, host, port, preset, scene, origins)
+    code = new_code()
+    workers = start_workers(count, host, port, preset, scene, origins, code)
+    relay = Relay([w.feed for w in workers]).start()
     try:
         landing = LandingServer(host, port, Balancer(workers))
     except PortError:
@@ -282,6 +312,7 @@ def serve_classroom(
         print(board(host, landing.port, link), flush=True)
         ports = ", ".join(str(w.port) for w in workers)
         print(f"{count} workers on ports {ports}; each new browser goes to the least busy")
+        print(lecturer_line(code), flush=True)
     try:
         while report_ended(workers, 1.0):
             pass
@@ -293,3 +324,9 @@ def serve_classroom(
         landing.shutdown()
         landing.server_close()
         stop_workers(workers)
+        relay.stop()
+
+
+def lecturer_line(code: str) -> str:
+    """What ``poinsot serve`` prints for the lecturer: the code "Lead this class" takes."""
+    return f'Lecturer code: {code} (type it under "Class: lead or follow" to lead this class)'

@@ -20,7 +20,7 @@ from poinsot.app.arguments import (
 )
 from poinsot.app.load.config import Config, Report, server_processes
 from poinsot.app.load.figures import Bounds, exit_status, format_table, missed
-from poinsot.app.load.phases import PHASES, run_phase
+from poinsot.app.load.phases import ALL_PHASES, PHASES, run_phase
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -32,7 +32,13 @@ def build_parser() -> argparse.ArgumentParser:
         "figures and goals; exits 1 when a goal is missed.",
     )
     add = parser.add_argument
-    add("--phase", nargs="+", choices=PHASES, default=list(PHASES), help="phases to run, in order")
+    add(
+        "--phase",
+        nargs="+",
+        choices=ALL_PHASES,
+        default=list(PHASES),
+        help="phases to run, in order (default: all but follow)",
+    )
     add("--clients", type=positive_int, default=cfg.clients, help="clients in each phase")
     add(
         "--workers",
@@ -61,6 +67,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=cfg.hostile_quiet_seconds,
         help="the innocent client's reference windows [s]",
     )
+    _add_follow(parser, cfg)
     add("--debug", action="store_true", help="show the traceback of a failure (else one line)")
     goals = parser.add_argument_group("goals")
     goals.add_argument("--min-fps", type=non_negative_float, default=bounds.min_fps)
@@ -73,21 +80,38 @@ def build_parser() -> argparse.ArgumentParser:
         "--max-hostile-rss-growth", type=non_negative_float, default=bounds.max_hostile_rss_growth
     )
     goals.add_argument("--min-innocent-keep", type=fraction, default=bounds.min_innocent_keep)
+    goals.add_argument("--max-follow-ms", type=positive_float, default=bounds.max_follow_ms)
     return parser
+
+
+def _add_follow(parser: argparse.ArgumentParser, cfg: Config) -> None:
+    """The follow phase's sizes (``--phase follow``)."""
+    parser.add_argument(
+        "--followers",
+        type=positive_int,
+        nargs="+",
+        default=list(cfg.followers),
+        help="followers of one lead in the follow phase, one run per number",
+    )
+    parser.add_argument(
+        "--follow-seconds", type=positive_float, default=cfg.follow_seconds, help="each window"
+    )
 
 
 def _options(args: argparse.Namespace) -> tuple[list[str], Config, Bounds]:
     fields = vars(args)
     bounds = Bounds(**{f.name: fields[f.name] for f in dataclasses.fields(Bounds)})
     names = {f.name for f in dataclasses.fields(Config)} - {"settle_tolerance"}
-    cfg = Config(**{name: fields[name] for name in names}, settle_tolerance=bounds.storm_tolerance)
+    values = {name: fields[name] for name in names}
+    values["followers"] = tuple(values["followers"])
+    cfg = Config(**values, settle_tolerance=bounds.storm_tolerance)
     return list(args.phase), cfg, bounds
 
 
 def _check(parser: argparse.ArgumentParser, phases: list[str], cfg: Config) -> None:
     """What the converters cannot see alone (each option is checked by its ``type``)."""
-    if cfg.workers > 1 and phases != ["soak"]:
-        parser.error("--workers more than 1 only with --phase soak")
+    if cfg.workers > 1 and set(phases) - {"soak", "follow"}:
+        parser.error("--workers more than 1 only with --phase soak or follow")
     if {"stall", "flood"} & set(phases) and cfg.clients < 2:
         parser.error("stall and flood need --clients >= 2 (one stalls, the others are measured)")
 

@@ -40,6 +40,8 @@ class Config:
     flood_rate: float = 10_000.0  # its messages a second
     hostile_handshakes: int = 2000  # refused handshakes in the hostile phase
     hostile_quiet_seconds: float = 8.0  # the innocent client's frames before and after it
+    followers: tuple[int, ...] = (30, 60)  # the follow phase's sizes, one lead each
+    follow_seconds: float = 15.0  # each of its windows (following, then exploring)
 
     @property
     def lifetime(self) -> float:
@@ -83,6 +85,8 @@ def fps_text(values: list[float]) -> str:
 
 def server_processes(cfg: Config, phase: str) -> int:
     """The server processes a phase runs against (see :attr:`Config.workers`)."""
+    if phase == "follow":  # across workers, as a classroom runs
+        return max(cfg.workers, 2)
     if cfg.workers:
         return cfg.workers
     return (os.cpu_count() or 1) if phase == "soak" else 1

@@ -24,6 +24,7 @@ class Bounds:
     max_errors: int = 0  # server log error lines, silent clients, lost sessions in the soak
     max_hostile_rss_growth: float = 0.05  # after the hostile phase's bad handshakes
     min_innocent_keep: float = 0.95  # of its frame rate, for a client while the hostile plays
+    max_follow_ms: float = 150.0  # a lead's slider move on every follower's screen, p95
 
 
 @dataclasses.dataclass(frozen=True)

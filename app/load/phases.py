@@ -3,7 +3,8 @@
 - ``soak`` (:mod:`poinsot.app.load.soak`): many clients for minutes;
 - ``storm`` (:mod:`poinsot.app.load.storm`): connects and departures, clean and abrupt;
 - ``stall``, ``flood`` (:mod:`poinsot.app.load.contention`): one client misbehaves;
-- ``hostile`` (:mod:`poinsot.app.load.hostile`): crafted messages, handshakes and inputs.
+- ``hostile`` (:mod:`poinsot.app.load.hostile`): crafted messages, handshakes and inputs;
+- ``follow`` (:mod:`poinsot.app.load.following`, on request): a lead and its followers.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import os
 import time
 from collections.abc import Callable
 
-from poinsot.app.load import contention, hostile, procfs, soak, storm
+from poinsot.app.load import contention, following, hostile, procfs, soak, storm
 from poinsot.app.load.config import Config, Report, Say, server_processes
 from poinsot.app.load.figures import COMPLETES, Figure, at_most, info
 from poinsot.app.load.server_process import ServerProcess
@@ -25,8 +26,11 @@ BODIES: dict[str, Phase] = {
     "stall": contention.stall,
     "flood": contention.flood,
     "hostile": hostile.phase,
+    "follow": following.phase,
 }
-PHASES = tuple(BODIES)
+#: The phases ``make load`` runs by default; every phase that can be asked for.
+PHASES = ("soak", "storm", "stall", "flood", "hostile")
+ALL_PHASES = tuple(BODIES)
 
 
 def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:

@@ -61,10 +61,14 @@ class _Classroom:
 
     def __init__(self, count: int) -> None:
         from poinsot.app.live.landing import Balancer, LandingServer
+        from poinsot.app.live.relay import Relay
+        from poinsot.app.live.ui.follow import new_code
         from poinsot.app.live.workers import start_workers
         from poinsot.app.presets import DEFAULT_PRESET
 
-        self.workers = start_workers(count, "127.0.0.1", 0, DEFAULT_PRESET.key, None)
+        self.code = new_code()  # the lecturer's, as poinsot serve makes it
+        self.workers = start_workers(count, "127.0.0.1", 0, DEFAULT_PRESET.key, None, (), self.code)
+        self.relay = Relay([w.feed for w in self.workers]).start()
         self.landing = LandingServer("127.0.0.1", 0, Balancer(self.workers))
         self.landing.start()
         self.port = self.landing.port
@@ -83,6 +87,7 @@ class _Classroom:
         self.landing.shutdown()
         self.landing.server_close()
         stop_workers(self.workers)
+        self.relay.stop()
 
 
 def _main(conn: Connection, log_path: str, lifetime: float, workers: int = 1) -> None:
@@ -100,7 +105,8 @@ def _main(conn: Connection, log_path: str, lifetime: float, workers: int = 1) ->
 
     app: Any = PoinsotApp("127.0.0.1", 0) if workers == 1 else _Classroom(workers)
     pids = [w.pid for w in app.workers] if workers > 1 else []
-    conn.send(("ready", (app.port, pids)))
+    code = app.code if workers > 1 else app.follow.code
+    conn.send(("ready", (app.port, pids, code)))
     deadline = time.monotonic() + lifetime
     try:
         while time.monotonic() < deadline:
@@ -133,7 +139,8 @@ class ServerProcess(Child):
         self.port: int
         #: The worker processes' pids (none for one process): their CPU and memory count too.
         self.worker_pids: list[int]
-        self.port, self.worker_pids = self.receive(start_timeout, "the server to start")
+        self.code: str  # the lecturer code (:mod:`poinsot.app.live.ui.follow`)
+        self.port, self.worker_pids, self.code = self.receive(start_timeout, "the server to start")
 
     def __enter__(self) -> ServerProcess:
         return self

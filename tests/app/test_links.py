@@ -47,7 +47,7 @@ def test_viser_s_own_parameters_are_left_to_viser():
     ("query", "named"),
     [
         ("preset=nope", "preset='nope'"),
-        ("follow=1", "'follow'"),
+        ("lead=1", "'lead'"),
         ("preset=t_handle&scene=dzhanibekov", "not both"),
         ("scene=dzhanibekov&D=2", "brings its own body"),
         ("scene=dzhanibekov&epsilon=3", "epsilon='3'"),

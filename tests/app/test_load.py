@@ -45,6 +45,7 @@ LENIENT = Bounds(
     max_errors=1000,
     max_hostile_rss_growth=10.0,
     min_innocent_keep=0.01,
+    max_follow_ms=60_000.0,
 )
 LENIENT_ARGS = [
     "--min-fps=1",
@@ -55,6 +56,7 @@ LENIENT_ARGS = [
     "--max-errors=1000",
     "--max-hostile-rss-growth=10",
     "--min-innocent-keep=0.01",
+    "--max-follow-ms=60000",
 ]
 
 
@@ -142,6 +144,21 @@ def test_hostile_replays_every_crafted_input_and_nothing_gets_through(report):
     assert report.figure("hostile", "server memory").value < 10.0
 
 
+@pytest.mark.slow
+def test_follow_phase_measures_followers_and_their_cost():
+    """One lead and three followers on two workers: every follower draws frames, the lead's
+    slider moves reach every follower, and the CPU per frame is measured both ways."""
+    tiny = dataclasses.replace(TINY, followers=(3,), follow_seconds=2.0)
+    report = run(("follow",), tiny, verbose=False)
+    failures = [f.text for f in report.figures if f.name == "completed"]
+    assert not failures, failures
+    assert report.figure("follow", "3 followers: fps each").value > 0
+    moves = report.figure("follow", "3 followers: lead's slider move").detail
+    assert moves["moves"] >= 2 and moves["lost"] == 0 and moves["redraws"] == 3 * moves["moves"]
+    cost = report.figure("follow", "3 followers: server CPU per frame").detail
+    assert cost["explored"] == 1.0 and cost["follower_ms"] > 0 and cost["session_ms"] > 0
+
+
 # -- the goals, judged on the same figures -----------------------------------------------------
 @pytest.mark.slow
 def test_met_bounds_give_zero_and_each_impossible_bound_gives_one(report):
@@ -155,6 +172,7 @@ def test_met_bounds_give_zero_and_each_impossible_bound_gives_one(report):
         "max_errors": -1,
         "max_hostile_rss_growth": -1.0,
         "min_innocent_keep": 1e9,
+        "max_follow_ms": -1.0,
     }
     assert set(impossible) == {f.name for f in dataclasses.fields(Bounds)}
     for name, value in impossible.items():

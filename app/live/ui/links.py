@@ -6,7 +6,9 @@ the query of what is on screen.
   number, a choice's option or its number);
 - ``?I=1,2,2.6&D=2.1&side=major&pole=plus&w=1.2``: a body of one's own (the moments, D, the
   side of the separatrix, the pole, |ω₀|), on top of ``preset`` if one is named;
-- with any of them ``speed=0.5`` and ``paused=1``.
+- with any of them ``speed=0.5`` and ``paused=1``;
+- ``?follow=1``: follow the lecturer (:mod:`.lead`), alone or after any of these (a lecturer
+  who leads soon after replaces them).
 
 A link with a parameter that is unknown, repeated or out of range opens the server's default
 scene with a message naming it (:func:`opening` never raises). viser's own page parameters
@@ -30,7 +32,7 @@ from poinsot.app.scenes import scene_by_name, scene_names
 from poinsot.app.scenes.spec import Choice, SceneControl, SceneSpec, Slider, Value
 
 #: Parameters of every link; a scene's control keys come on top.
-GENERAL = ("preset", "scene", "t", "view", "speed", "paused")
+GENERAL = ("preset", "scene", "t", "view", "speed", "paused", "follow")
 #: A body of one's own.
 BODY = ("I", "D", "side", "pole", "w")
 #: The page parameters viser's client reads itself (prefixes).
@@ -55,6 +57,7 @@ class Opening:
     view: str | None = None
     speed: float | None = None
     paused: bool = False
+    follow: bool = False
     problem: str = ""
     page: str = ""  # the page's address without its query
 
@@ -208,10 +211,15 @@ def _general(
     if "speed" in pairs:
         lo, hi = SPEED_RANGE if scene is None else scene.speed_range
         speed = _number("speed", pairs["speed"], lo, hi)
-    paused = pairs.get("paused", "0").lower()
-    if paused not in _TRUE + _FALSE:
-        raise LinkError(f"paused={pairs['paused']!r} is not 0 or 1")
-    return Opening(preset, scene, t, view, speed, paused in _TRUE, page=page)
+    paused, follow = (_flag(pairs, key) for key in ("paused", "follow"))
+    return Opening(preset, scene, t, view, speed, paused, follow, page=page)
+
+
+def _flag(pairs: Mapping[str, str], key: str) -> bool:
+    flag = pairs.get(key, "0").lower()
+    if flag not in _TRUE + _FALSE:
+        raise LinkError(f"{key}={pairs[key]!r} is not 0 or 1")
+    return flag in _TRUE
 
 
 def opening(
@@ -259,6 +267,7 @@ class LinkSession(Protocol):
     preset: Preset
     params: Parameters
     frame: Any
+    follow: Any
 
     def set_speed(self, speed: float) -> None: ...
     def post(self, action: Any, key: object = None) -> None: ...
@@ -285,6 +294,8 @@ def apply(session: LinkSession, link: Opening) -> None:
             session.panel.show_status(link.problem)
 
     session.post(action)
+    if link.follow:
+        session.follow.start_following()
 
 
 def _text(value: float) -> str:

@@ -23,9 +23,11 @@ from poinsot.app.live.hardening.budget import RebuildGate
 from poinsot.app.live.hardening.pacing import Outbox, Pacer, SessionStats
 from poinsot.app.live.ui.actions import MAX_ACTIONS, ActionQueue
 from poinsot.app.live.ui.clock import SimClock
+from poinsot.app.live.ui.follow import FollowHub
 from poinsot.app.live.ui.frame_loop import HOLD_SECONDS, FrameLoop
 from poinsot.app.live.ui.ghost_controls import add_ghost_controls
 from poinsot.app.live.ui.layout import Layout
+from poinsot.app.live.ui.lead import LeadControls
 from poinsot.app.live.ui.lecture import add_lecture_controls
 from poinsot.app.live.ui.panel import ControlPanel
 from poinsot.app.live.ui.playback import STEP_SECONDS, Playback, clamp_trail
@@ -75,12 +77,11 @@ class Session:
         scene: SceneSpec | None = None,
         max_actions: int = MAX_ACTIONS,
         user_agent: str = "",
+        follow: FollowHub | None = None,
     ) -> None:
-        """``budget``: the server's rebuild gate, through which a rebuild goes first (one per
-        session if None); ``scene``: start with this scene (:mod:`poinsot.app.scenes`) instead
-        of ``preset``. Frames: as many as the client takes, up to ``max_fps`` (:attr:`pacer`).
-        At most ``max_actions`` actions queued (:mod:`.actions`). ``user_agent``: the browser's
-        (a phone's or a tablet's page is laid out for it: :mod:`.layout`)."""
+        """``budget``: the server's rebuild gate (its own if None); ``scene``: start with it,
+        not ``preset``. Frames: as many as taken, up to ``max_fps`` (:attr:`pacer`). Others:
+        ``max_actions`` :mod:`.actions`, ``user_agent`` :mod:`.layout`, ``follow`` :mod:`.lead`."""
         self.client = client
         self.max_fps = float(max_fps)
         self.budget = budget if budget is not None else RebuildGate()
@@ -119,6 +120,7 @@ class Session:
         self._apply_preset(preset) if scene is None else self._apply_scene(scene)
         self._rebuild()
         self._mount_tools(user_agent)
+        self.follow = LeadControls(self, follow if follow is not None else FollowHub())
 
     def _frame_loop(self) -> FrameLoop:
         return FrameLoop(
@@ -147,6 +149,7 @@ class Session:
 
     def close(self, timeout: float | None = None) -> None:
         """Stop the frame thread (never called from it). Safe to call twice."""
+        self.follow.close()
         self.loop.close(timeout)
 
     @property
@@ -255,6 +258,7 @@ class Session:
     def _refresh(self, now: float) -> None:
         """After a frame: the plot, the time readout and retired widgets at their rates
         (:class:`~.refresh.Refresh`), and the scene's own readouts and plots."""
+        self.follow.on_frame(now)  # a lead publishes its state
         busy = self.scene.sent_traces or self.lecture.display.laid_out_now  # a layout step
         self.refresh.after_frame(now, self.frame, self.clock.paused, busy)
         if self.showcase is not None and self.frame is not None:
@@ -280,7 +284,7 @@ class Session:
         if (self.body is None) if showcase is None else not showcase.loaded:
             return
         start = time.perf_counter()
-        t = self.clock.now()
+        t = self.follow.now(self.clock)  # the lecturer's time while following
         self.frame = self.scene.advance(t) if showcase is None else showcase.advance(t)
         self.lecture.on_frame(self.frame)
         self.ghost.on_frame(self.frame)

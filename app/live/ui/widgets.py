@@ -33,6 +33,31 @@ from poinsot.app import viser_private
 #: stalls longer than this (1.5 s was seen to be too short for software WebGL switching
 #: between the sphere and a custom body) could still log an update to a deleted widget.
 RETIRE_SECONDS = 30.0
+#: Clients whose changes are refused (a follower's: :mod:`.lead`), by ``id()`` of their
+#: handle, each with what to call when one is refused. Set and cleared by :func:`hold_input`.
+_HELD: dict[int, Callable[[], None]] = {}
+
+
+def hold_input(client: Any, refused: Callable[[], None] | None) -> None:
+    """Refuse ``client``'s changes to every widget but the free ones (:func:`on_user`), each
+    put back to its last value and ``refused()`` called (on viser's loop: it must only post);
+    None accepts them again."""
+    if refused is None:
+        _HELD.pop(id(client), None)
+    else:
+        _HELD[id(client)] = refused
+
+
+def _refused(event: viser.GuiEvent[Any], handle: Any, last: Sent) -> bool:
+    """A held client's change: the widget shows its last value again (the lead's)."""
+    held = None if event.client is None else _HELD.get(id(event.client))
+    if held is None:
+        return False
+    if hasattr(handle, "value"):
+        handle.value = last.value
+    held()
+    return True
+
 
 T = TypeVar("T")
 
@@ -223,6 +248,7 @@ def on_user(
     sent: Sent | None = None,
     *,
     inline: bool = False,
+    free: bool = False,
 ) -> Any:
     """Run ``callback(sent)`` for changes made in a browser only (a value set by the server
     fires the same viser callbacks, with no client). The callback runs on a worker thread,
@@ -236,8 +262,8 @@ def on_user(
     Nothing a client sends is trusted: a value is first :func:`checked` against the widget, as
     the browser would (a number clamped into the slider's range, an option among the options);
     a value no widget could send (NaN, an option not offered) never reaches the callback, and
-    the widget shows its last valid value again. ``sent``: the record to keep the browser's
-    values in (one is made if not given)."""
+    the widget shows its last valid value again (so does a held one: :func:`hold_input`,
+    unless ``free``). ``sent``: the browser's values (one is made if not given)."""
     sent = Sent(getattr(handle, "value", None)) if sent is None else sent
     last = Sent(sent.value)  # the last valid value, the server's or the browser's
 
@@ -254,6 +280,8 @@ def on_user(
             asyncio.get_running_loop().run_in_executor(None, run)  # never waits on the callback
 
     async def received(event: viser.GuiEvent[Any]) -> None:
+        if not free and _refused(event, handle, last):  # a follower's (:func:`hold_input`)
+            return
         if not hasattr(handle, "value"):  # a button
             if event.client is not None:
                 dispatch()

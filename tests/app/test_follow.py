@@ -1,0 +1,225 @@
+"""Follow the lecturer: a lead, its followers on two workers, and what a follower may not do.
+
+Headless probes stand for the browsers (:mod:`poinsot.app.live.hardening.probe`); every wait is on
+an event the probes receive (a widget's value, a readout's text), never on wall-clock time.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import re
+
+import pytest
+
+from poinsot.app.live.hardening.probe import Probe
+from poinsot.app.live.relay import Relay
+from poinsot.app.live.ui import links
+from poinsot.app.live.ui.follow import ENDED, MAX_WRONG_CODES, FollowHub, LeadState
+from poinsot.app.live.ui.lead import HELD
+from poinsot.app.viser_private import wire_message
+from tests.app.test_workers import start_classroom, stop_classroom
+from tests.conftest import after_frames, session_of, wait_until
+
+D = "D = |L|²/2T"
+POLHODES = "Scene: the polhode family"
+
+
+def _markdown(probe: Probe, prefix: str) -> str:
+    """The text of the probe's markdown widget that starts with ``prefix`` ("" if none)."""
+    _, widgets = probe.snapshot()
+    for widget in widgets.values():
+        text = str(widget.props.get("_markdown", ""))
+        if widget.type == "GuiMarkdownMessage" and text.startswith(prefix):
+            return text
+    return ""
+
+
+def _says(probe: Probe, words: str) -> bool:
+    _, widgets = probe.snapshot()
+    return any(words in str(w.props.get("_markdown", "")) for w in widgets.values())
+
+
+def _value(probe: Probe, label: str) -> object:
+    return probe.widget(label)[1].value
+
+
+def _set(probe: Probe, label: str, value: object = True) -> None:
+    probe.set_value(probe.widget(label)[0], value)
+
+
+def _ready(probe: Probe) -> Probe:
+    assert probe.wait_for(lambda p: p.has_widget("Explore from here"), 60), "no panel"
+    return probe
+
+
+def _lead(probe: Probe, code: str) -> None:
+    _set(probe, "Lecturer code", code)
+    _set(probe, "Lead this class")
+    assert probe.wait_for(lambda p: _says(p, "You lead this class"), 30)
+
+
+def _follow(probe: Probe) -> None:
+    _set(probe, "Follow the lecturer", True)
+    assert probe.wait_for(lambda p: _says(p, "Following the lecturer"), 30)
+
+
+# -- one lead, three followers, two workers ------------------------------------------------
+@pytest.mark.slow
+def test_followers_on_two_workers_follow_detach_and_keep_the_last_state():
+    room = start_classroom()
+    probes: list[Probe] = []
+    try:
+        code = re.search(r"Lecturer code: (\w+)", "".join(room.stdout)).group(1)
+        first, second = room.worker_ports
+        lead, *followers = [_ready(Probe(p)) for p in (first, first, second, second)]
+        probes += [lead, *followers]
+        _lead(lead, code)
+        for follower in followers:
+            _follow(follower)
+
+        # A slider move: every follower's slider and body readouts show the lead's.
+        before = _markdown(lead, "| quantity")
+        _set(lead, D, 2.3)
+        assert lead.wait_for(lambda p: _markdown(p, "| quantity") != before, 30)
+        table = _markdown(lead, "| quantity")
+        for follower in followers:
+            assert follower.wait_for(lambda p: _value(p, D) == pytest.approx(2.3), 30)
+            assert follower.wait_for(lambda p: _markdown(p, "| quantity") == table, 30)
+
+        # A scene change, then a pause: the followers show the scene, paused at the lead's t.
+        _set(lead, "Preset", POLHODES)
+        for follower in followers:
+            assert follower.wait_for(lambda p: _value(p, "Preset") == POLHODES, 60)
+        _set(lead, "Pause")
+        assert lead.wait_for(lambda p: "_paused_" in _markdown(p, "**t ="), 30)
+        paused_at = _markdown(lead, "**t =")
+        for follower in followers:
+            assert follower.wait_for(lambda p: _markdown(p, "**t =") == paused_at, 30)
+
+        # One follower explores from here; the lead goes on: the others follow, it does not.
+        explorer, *rest = followers
+        _set(explorer, "Explore from here")
+        assert explorer.wait_for(lambda p: _says(p, "Exploring on your own"), 30)
+        _set(lead, "Preset", "Sphere (a cube)")
+        for follower in rest:
+            assert follower.wait_for(lambda p: _value(p, "Preset") == "Sphere (a cube)", 60)
+        assert _value(explorer, "Preset") == POLHODES
+        assert _markdown(explorer, "**t =") == paused_at  # paused at the lecturer's time
+
+        # The lead leaves: the followers keep its last state and are told.
+        lead.close()
+        for follower in rest:
+            assert follower.wait_for(lambda p: _says(p, "The lecturer left"), 30)
+            assert _value(follower, "Preset") == "Sphere (a cube)"
+    finally:
+        for probe in probes:
+            probe.close()
+        stop_classroom(room)
+
+
+# -- bad input -----------------------------------------------------------------------------
+def test_a_wrong_code_is_refused_and_too_many_close_the_page(poinsot_app, make_probe):
+    probe = _ready(make_probe(poinsot_app))
+    session = session_of(poinsot_app)
+    for attempt in range(1, MAX_WRONG_CODES):
+        _set(probe, "Lecturer code", f"nope{attempt}")
+        _set(probe, "Lead this class")
+        left = MAX_WRONG_CODES - attempt
+        assert probe.wait_for(lambda p, n=left: _says(p, f"({n} tries left)"), 30)
+    assert session.follow.mode == "own" and poinsot_app.follow.token == ""
+    _set(probe, "Lead this class")
+    assert probe.wait_for(lambda p: p.closed, 30), "the page was not closed"
+
+
+def test_a_follower_cannot_change_its_controls_the_lead_or_another_follower(
+    poinsot_app, make_probe
+):
+    lead = _ready(make_probe(poinsot_app))
+    lead_session = session_of(poinsot_app, 1)
+    _lead(lead, poinsot_app.follow.code)
+    one, other = _ready(make_probe(poinsot_app)), _ready(make_probe(poinsot_app))
+    _follow(one), _follow(other)
+    follower = session_of(poinsot_app, 3)
+    before = lead_session.params.D
+    _set(one, D, 2.1)  # refused, put back, said once
+    assert one.wait_for(lambda p: _says(p, HELD), 30)
+    assert one.wait_for(lambda p: _value(p, D) == pytest.approx(before), 30)
+    _set(one, "Pause")
+    _set(one, "Lead this class")  # no code: refused, whoever asks
+    assert one.wait_for(lambda p: _says(p, "Wrong lecturer code"), 30)
+    after_frames(lead_session), after_frames(follower)
+    assert lead_session.params.D == before and not lead_session.clock.paused
+    assert all(s.params.D == before for s in poinsot_app.sessions().values())
+    assert _value(other, D) == pytest.approx(before)
+    assert lead_session.follow.mode == "lead"
+
+
+def test_a_second_leader_takes_over_and_the_first_is_told(poinsot_app, make_probe):
+    first, second = _ready(make_probe(poinsot_app)), _ready(make_probe(poinsot_app))
+    _lead(first, poinsot_app.follow.code)
+    _lead(second, poinsot_app.follow.code)
+    assert first.wait_for(lambda p: _says(p, "Another lecturer took over"), 30)
+    sessions = sorted(poinsot_app.sessions().values(), key=lambda s: s.client.client_id)
+    assert [s.follow.mode for s in sessions] == ["own", "lead"]
+
+
+def test_a_follower_may_take_the_lecturers_camera(poinsot_app, make_probe):
+    lead = _ready(make_probe(poinsot_app))
+    _lead(lead, poinsot_app.follow.code)
+    lead.send(
+        wire_message(
+            "ViewerCameraMessage",
+            wxyz=(1.0, 0.0, 0.0, 0.0),
+            position=(1.0, 2.0, 3.0),
+            fov=0.8,
+            near=0.01,
+            far=100.0,
+            image_height=720,
+            image_width=1280,
+            look_at=(0.0, 0.0, 0.5),
+            up_direction=(0.0, 0.0, 1.0),
+        )
+    )
+    follower = _ready(make_probe(poinsot_app))
+    session = session_of(poinsot_app, 2)
+    _set(follower, "Lecturer's camera", True)
+    _follow(follower)
+    camera = session.client.camera
+    assert wait_until(lambda: tuple(camera.position) == pytest.approx((1.0, 2.0, 3.0)), 30)
+    assert tuple(camera.look_at) == pytest.approx((0.0, 0.0, 0.5))
+
+
+def test_a_link_with_follow_follows(poinsot_app, make_probe):
+    probe = _ready(make_probe(poinsot_app))
+    session = session_of(poinsot_app)
+    page = "http://127.0.0.1:8080/?follow=1"
+    links.apply(session, links.opening(page, session.preset, None))
+    assert probe.wait_for(lambda p: _says(p, "Waiting for the lecturer"), 30)
+    assert session.follow.mode == "follow" and _value(probe, "Follow the lecturer") is True
+
+
+def test_a_link_asks_to_follow():
+    assert links.parse("follow=1").follow and not links.parse("t=2").follow
+    with pytest.raises(links.LinkError, match="follow='maybe' is not 0 or 1"):
+        links.parse("follow=maybe")
+
+
+def test_a_dead_lead_worker_leaves_its_followers_the_last_state():
+    """The relay between workers: a worker whose pipe closes while it held the lead (it
+    ended, even by kill -9) is reported to the others as a lead gone."""
+    lead_parent, lead_worker = multiprocessing.Pipe()
+    other_parent, other_worker = multiprocessing.Pipe()
+    relay = Relay([lead_parent, other_parent]).start()
+    hub = FollowHub("code")
+    try:
+        state = LeadState("tok", "preset=major", 1.5, 0.0, True, 1.0)
+        for message in (("lead", "tok"), ("state", state)):
+            lead_worker.send(message)
+            assert other_worker.poll(30)
+            hub.deliver(other_worker.recv())
+        lead_worker.close()  # the lead's worker is gone
+        assert other_worker.poll(30)
+        hub.deliver(other_worker.recv())
+        assert hub.gone == ENDED and hub.state == state and hub.now() == 1.5
+    finally:
+        relay.stop()
