@@ -10,7 +10,7 @@ regime, plus the geometry of Poinsot's construction (polhode, herpolhode, invari
     >>> FreeRigidBody.from_energy((1.0, 2.0, 2.6), 2.0).regime.label
     'separatrix'
 
-Rooms: :mod:`~poinsot.physics.free_body` (the public object), :mod:`~.classification` and
+Rooms: :mod:`~poinsot.physics.core.free_body` (the public object), :mod:`~.classification` and
 :mod:`~.closed_forms` (regimes and their solutions), :mod:`~.evaluation` (a solution in the
 caller's axes, units and attitude), :mod:`~.elliptic` (Jacobi functions and integrals),
 :mod:`~.exact` and :mod:`~.precise` (exact and extra-precise arithmetic), :mod:`~.rotations`
@@ -20,15 +20,15 @@ input check: a ValueError, or an InputTypeError for what is no real number),
 :mod:`~.relabelling`, :mod:`~.solids`, :mod:`~.geometric_phase` (Montgomery's split of the turn
 per period, the solid angle of the cone of L in closed form), :mod:`~.racket` (the tennis racket
 effect: the head's twist over one turn of the handle), :mod:`~.fuzz` (odd input of every kind
-against the whole API: ``python -m poinsot.physics.fuzz --cases 100000``).
+against the whole API: ``python -m poinsot.physics.tools.fuzz --cases 100000``).
 """
 
-from poinsot.physics.free_body import FreeRigidBody
-from poinsot.physics.geometric_phase import montgomery_phase, solid_angle
-from poinsot.physics.initial_state import attitude_with_L_along_z, omega_from_energy
-from poinsot.physics.racket import measure_twist, separatrix_twist
-from poinsot.physics.regime import Regime
-from poinsot.physics.solids import box_dimensions, check_real_body
+from poinsot.physics.core.free_body import FreeRigidBody
+from poinsot.physics.core.initial_state import attitude_with_L_along_z, omega_from_energy
+from poinsot.physics.core.regime import Regime
+from poinsot.physics.models.geometric_phase import montgomery_phase, solid_angle
+from poinsot.physics.models.racket import measure_twist, separatrix_twist
+from poinsot.physics.models.solids import box_dimensions, check_real_body
 
 __all__ = [
     "FreeRigidBody",
