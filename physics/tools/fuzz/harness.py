@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+import poinsot.physics
 from poinsot.physics.tools.fuzz.checks import InvariantError
 from poinsot.physics.tools.fuzz.values import Source
 
@@ -32,9 +33,10 @@ CLEAN = ("ValueError", "TypeError", "finite")
 #: A refusal shorter than this cannot say what is wrong and what to change.
 _SHORTEST_MESSAGE = 20
 
-#: The fuzz's own modules (physics/tools/fuzz/): an error raised there is no refusal.
+#: The fuzz's own modules (physics/tools/fuzz/): an error raised there is no refusal, nor one
+#: raised outside the physics package's folder (whichever room of it the fuzz sits in).
 _FUZZ = __file__.replace("\\", "/").rsplit("/", 1)[0] + "/"
-_PHYSICS = _FUZZ.rstrip("/").rsplit("/", 1)[0] + "/"
+_PHYSICS = poinsot.physics.__file__.replace("\\", "/").rsplit("/", 1)[0] + "/"
 _LINES: dict[str, list[str]] = {}
 
 
