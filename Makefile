@@ -60,7 +60,7 @@ test-fast: install-test
 	$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not browser and not server and not slow"
 
 bench: install
-	$(PY) -m poinsot.physics.benchmark
+	$(PY) -m poinsot.physics.tools.benchmark
 
 # Both benchmarks of this working tree against another revision, alternating, as ratios new/old
 # (exits 1 when a figure regressed), e.g. make bench-compare AGAINST=8b3cd8c ARGS="--rounds 5".

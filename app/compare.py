@@ -4,7 +4,7 @@
 ``make bench-compare AGAINST=REV``).
 
 The other revision is checked out into a temporary ``git worktree`` (removed afterwards). Each
-round runs ``physics.benchmark`` and/or ``app.benchmark`` of today's working tree and of that
+round runs the physics benchmark and/or ``app.benchmark`` of today's working tree and of that
 revision one after the other (new, old, new, old, ...: both see the same machine load), each
 in a fresh Python of this environment. The tool parses the figures each benchmark prints and
 shows, per figure, the ratio new/old: the median over the rounds and the min–max. A cost
@@ -247,22 +247,37 @@ class Tree:
     pythonpath: pathlib.Path
 
     def module(self, benchmark: str) -> str:
-        return f"poinsot.{benchmark}.benchmark" if self.namespaced else f"{benchmark}.benchmark"
+        dotted = f"{benchmark}.{_place(self.root, benchmark).replace('/', '.')}"
+        return f"poinsot.{dotted}" if self.namespaced else dotted
 
     def supports(self, benchmark: str, option: str) -> bool:
-        return option in (self.root / benchmark / "benchmark.py").read_text()
+        return option in _source(self.root, benchmark).read_text()
+
+
+#: Where a package's benchmark module sits, the newest layout first (physics/ keeps it among
+#: its tools since it was grouped into rooms).
+PLACES = {"physics": ("tools/benchmark", "benchmark"), "app": ("benchmark",)}
+
+
+def _place(root: pathlib.Path, benchmark: str) -> str:
+    places = PLACES[benchmark]
+    return next((p for p in places if (root / benchmark / f"{p}.py").is_file()), places[-1])
+
+
+def _source(root: pathlib.Path, benchmark: str) -> pathlib.Path:
+    return root / benchmark / f"{_place(root, benchmark)}.py"
 
 
 def _imports_through_poinsot(root: pathlib.Path) -> bool:
-    text = (root / "physics" / "benchmark.py").read_text()
+    text = _source(root, "physics").read_text()
     return re.search(r"^\s*(from|import) poinsot\.", text, re.MULTILINE) is not None
 
 
 def prepare(root: pathlib.Path, scratch: pathlib.Path) -> Tree:
     """How to run the checkout at ``root``: for the ``poinsot.`` layout, a folder of links
     ``scratch/poinsot/{physics,app}`` to put on ``PYTHONPATH``; else ``root`` itself."""
-    if not (root / "physics" / "benchmark.py").is_file():
-        raise ValueError(f"{root} has no physics/benchmark.py: not a Poinsot checkout")
+    if not _source(root, "physics").is_file():
+        raise ValueError(f"{root} has no physics benchmark: not a Poinsot checkout")
     if not _imports_through_poinsot(root):
         return Tree(root, False, root)
     (scratch / "poinsot").mkdir(parents=True, exist_ok=True)

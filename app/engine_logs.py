@@ -1,5 +1,6 @@
 """A physics engine's log of one free body: read it, write one, and say in words whether it
-moves as a free rigid body should (:func:`poinsot.physics.engine_check.check_log` measures).
+moves as a free rigid body should (:func:`poinsot.physics.integrators.engine_check.check_log`
+measures).
 
 The log is a CSV with a header line: ``t, wx, wy, wz`` (seconds; body-frame angular velocity,
 rad/s) and optionally ``qw, qx, qy, qz`` (the attitude, body -> space, as engines report a
@@ -21,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from poinsot.physics.engine_check import LogCheck, check_log
+from poinsot.physics.integrators.engine_check import LogCheck, check_log
 
 __all__ = [
     "DRIFT_LIMIT",

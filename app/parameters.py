@@ -18,7 +18,7 @@ from poinsot.physics import (
     box_dimensions,
     check_real_body,
 )
-from poinsot.physics.pointing import body_from_start, energy_parameter
+from poinsot.physics.models.pointing import body_from_start, energy_parameter
 
 #: Slider ranges.
 INERTIA_RANGE = (0.1, 5.0)

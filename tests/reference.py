@@ -1,7 +1,7 @@
 """Reference solutions for the physics tests, independent of the closed forms they check.
 
 Three references, each built without any closed form or elliptic function from ``physics/``
-(they share only its error measure, :mod:`poinsot.physics.errors`):
+(they share only its error measure, :mod:`poinsot.physics.core.errors`):
 
 * :class:`ReferenceBody` -- the closed form of [LL76 §37, Eqs. 37.10, 37.13-37.16],
   re-derived here in mpmath at ``MP_DPS`` significant digits *from the float inputs*: the
@@ -32,7 +32,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics.errors import attitude_error
+from poinsot.physics.core.errors import attitude_error
 
 EPS = float(np.finfo(float).eps)
 
@@ -125,7 +125,7 @@ def hat(w: np.ndarray) -> np.ndarray:
 
 def geodesic_angle(ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
     """Angle [rad] of ``ra^T rb`` for (3, 3) or (N, 3, 3) rotation matrices (broadcasting):
-    the project's one attitude error measure, :func:`poinsot.physics.errors.attitude_error`,
+    the project's one attitude error measure, :func:`poinsot.physics.core.errors.attitude_error`,
     on their quaternions (accurate near 0 and near pi)."""
     return attitude_error(Rotation.from_matrix(ra), Rotation.from_matrix(rb))
 

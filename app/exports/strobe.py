@@ -34,7 +34,7 @@ from poinsot.app.scene.view import View
 from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.app.stage.served import Stage
 from poinsot.physics import FreeRigidBody
-from poinsot.physics.flip import measure_flips
+from poinsot.physics.models.flip import measure_flips
 
 RGB = tuple[int, int, int]
 #: The copies' colour on the dark and on the light theme (hue 81 degrees: no other element of

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from poinsot.physics import FreeRigidBody, errors
+from poinsot.physics import FreeRigidBody
+from poinsot.physics.core import errors
 
 __all__ = [
     "UNIT_ROUNDOFF",

@@ -16,7 +16,8 @@ from numpy.typing import NDArray
 from poinsot.app.report.conditioning import FlipCounter
 from poinsot.app.report.runs import ExactGrid
 from poinsot.app.report.timing import timed
-from poinsot.physics import FreeRigidBody, errors
+from poinsot.physics import FreeRigidBody
+from poinsot.physics.core import errors
 
 if TYPE_CHECKING:
     from poinsot.app.report.reference import TaylorReference

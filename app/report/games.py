@@ -5,8 +5,8 @@ Two starts of the T-handle, each followed for one simulated minute: the preset a
 shows it (|ω| = 2 rad/s, on a polhode near the separatrix), and the same body flicked at
 12 rad/s (about two turns a second) 0.05 rad from its middle axis, the rate of a thrown
 wing nut. The measures (flip times, drifts per minute) are
-:mod:`poinsot.physics.engine_check`'s; the exact flip times are measured the same way on the
-exact solution sampled finely.
+:mod:`poinsot.physics.integrators.engine_check`'s; the exact flip times are measured the same way on
+the exact solution sampled finely.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ import numpy as np
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import preset_by_key
 from poinsot.physics import FreeRigidBody
-from poinsot.physics.engine_check import FlipRun, exact_flip_times, run_flips
 from poinsot.physics.integrators import GAME_STEPS
+from poinsot.physics.integrators.engine_check import FlipRun, exact_flip_times, run_flips
 
 __all__ = ["GAME_STEP_SIZES", "GameCase", "GameRow", "game_rows", "games_section", "write_csv"]
 

@@ -38,7 +38,7 @@ from typing import Any
 
 import mpmath
 
-from poinsot.physics.rotations import conjugate, hamilton
+from poinsot.physics.core.rotations import conjugate, hamilton
 
 #: Significant digits the reference is accurate to: >= 30, so that errors of the closed form
 #: near 1e-16 are measured with ~14 digits to spare.

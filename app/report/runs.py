@@ -4,7 +4,7 @@ measuring each run against the exact solution on the output grid.
 Every method runs at a ladder of settings (step sizes as fractions of the case's time scale, or
 relative tolerances), cheapest first; a setting whose predicted run time exceeds the budget
 ends the ladder. The errors are the project's one set of measures,
-:mod:`poinsot.physics.errors`.
+:mod:`poinsot.physics.core.errors`.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from poinsot.app.report.cases import CaseSettings
 from poinsot.app.report.conditioning import FlipCounter, separatrix_distance
 from poinsot.app.report.progress import Progress
 from poinsot.app.report.timing import timed
-from poinsot.physics import errors
+from poinsot.physics.core import errors
 from poinsot.physics.integrators import INTEGRATORS, Integrator, integrate
 
 __all__ = [
@@ -93,7 +93,8 @@ class ExactGrid:
 
 
 def measure_errors(exact: ExactGrid, omega: NDArray[np.float64], attitude: Rotation) -> RunErrors:
-    """A numerical solution on the grid against the exact one (:mod:`poinsot.physics.errors`)."""
+    """A numerical solution on the grid against the exact one
+    (:mod:`poinsot.physics.core.errors`)."""
     return RunErrors(
         errors.omega_error(omega, exact.omega),
         errors.attitude_error(attitude, exact.attitude),

@@ -24,7 +24,8 @@ from poinsot.app.report.cases import GENERIC, StudyConfig
 from poinsot.app.report.progress import Progress
 from poinsot.app.report.runs import REPORT_MAX_STEPS
 from poinsot.app.report.timing import median_seconds, timed
-from poinsot.physics import FreeRigidBody, errors
+from poinsot.physics import FreeRigidBody
+from poinsot.physics.core import errors
 from poinsot.physics.integrators import integrate
 
 if TYPE_CHECKING:

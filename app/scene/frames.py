@@ -1,6 +1,6 @@
 """The one place where an attitude becomes a viser orientation, and back.
 
-scipy's ``Rotation.as_quat()`` and :mod:`poinsot.physics.rotations` are scalar-last
+scipy's ``Rotation.as_quat()`` and :mod:`poinsot.physics.core.rotations` are scalar-last
 (x, y, z, w); viser's ``wxyz`` is scalar-first. Every pose the app sends goes through
 :func:`wxyz`; every pose read back from the scene goes through :func:`rotation_from_wxyz` or
 :func:`xyzw_from_wxyz`; nothing else in the app touches a quaternion's component order.

@@ -19,7 +19,7 @@ is given. Per frame only the two poses travel; the readout refreshes at 5 Hz and
 
 The numbers come from :class:`poinsot.physics.integrators.Propagation`, which carries the
 integrator's whole state from frame to frame (restarting RK45 at every frame would hide its
-drift, see there), and the error measures from :mod:`poinsot.physics.errors`.
+drift, see there), and the error measures from :mod:`poinsot.physics.core.errors`.
 
 Work per frame: each frame advances the propagation to the frame's time with at most as many
 steps (or RHS evaluations) as fit into WORK_BUDGET seconds at the measured cost per step. A
@@ -46,7 +46,8 @@ from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.ellipsoid import add_ellipsoid, fit_ellipsoid
 from poinsot.app.scene.frames import rotation_from_wxyz, wxyz_from_xyzw, xyzw_from_wxyz
 from poinsot.app.scene.geometry import Geometry, triple
-from poinsot.physics import FreeRigidBody, errors, rotations
+from poinsot.physics import FreeRigidBody
+from poinsot.physics.core import errors, rotations
 from poinsot.physics.integrators import GAME_STEPS, METHODS, Propagation, State
 
 #: Relative tolerances offered for the adaptive pairs (log scale).
@@ -198,7 +199,7 @@ class GhostErrors:
         exact_xyzw: np.ndarray,
     ) -> GhostErrors:
         """The ghost's ``omega`` and attitude quaternion against the exact ones at ``t``
-        (:mod:`poinsot.physics.errors`). Raises GhostDiverged if any number is not finite."""
+        (:mod:`poinsot.physics.core.errors`). Raises GhostDiverged if any number is not finite."""
         if not (np.all(np.isfinite(omega)) and np.all(np.isfinite(quat_xyzw))):
             raise GhostDiverged(f"the numerical solution is not finite at t = {t:.3g}")
         L = float(np.linalg.norm(body.angular_momentum))

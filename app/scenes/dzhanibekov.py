@@ -6,7 +6,7 @@ density) spun at the angle ε from its intermediate axis e₂, in Poinsot's cons
 come like a clock: every 2K(k)/λ, the first one at (K ± δ)/λ; the perturbation off e₂ first
 grows like e^{σt}; and 2K/λ tends to ln(16/(1 − k²))/λ, so the time between flips grows like
 ln(1/ε). A dropdown takes ε over the decades 1e-1 … 1e-12; the motion is exact at every one
-(an integrator is not at 1e-12: ``python -m poinsot.physics.flip``). A plot shows
+(an integrator is not at 1e-12: ``python -m poinsot.physics.models.flip``). A plot shows
 log₁₀ sin(angle of ω from e₂) against time with the theory's slope σ.
 
 A twin (on by default, ε′ = ε/10; a dropdown takes ε/2 … ε/1000 or none) is the same handle
@@ -18,9 +18,10 @@ against its asymptote; the first flip against (K ± δ)/λ; the growth rate fitt
 against σ; the twin's first flip, its lag behind the first measured from the two motions
 against the theory, and that lag against its small-ε limit ln(ε/ε′)/σ.
 
-Physics: :func:`poinsot.physics.flip.flip_initial_omega`, :func:`~.flip_theory`,
-:func:`~.measure_flips`, :func:`~.measure_growth_rate`; :func:`poinsot.physics.twins.twin_clock`;
-:func:`poinsot.app.bodies.bundled_body` (the mesh and its moments).
+Physics: :func:`poinsot.physics.models.flip.flip_initial_omega`, :func:`~.flip_theory`,
+:func:`~.measure_flips`, :func:`~.measure_growth_rate`;
+:func:`poinsot.physics.models.twins.twin_clock`; :func:`poinsot.app.bodies.bundled_body` (the mesh
+and its moments).
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from poinsot.app.scenes.base import CONSTRUCTION, OwnSolid, SceneModel
 from poinsot.app.scenes.spec import Choice, Part, PlotSpec, Readout, SceneSpec, Settings, number
 from poinsot.app.scenes.twins import twin_drawing
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
-from poinsot.physics.flip import (
+from poinsot.physics.models.flip import (
     FlipTheory,
     GrowthFit,
     flip_initial_omega,
@@ -46,7 +47,7 @@ from poinsot.physics.flip import (
     measure_flips,
     measure_growth_rate,
 )
-from poinsot.physics.twins import TwinClock, twin_clock
+from poinsot.physics.models.twins import TwinClock, twin_clock
 
 #: The decades of ε offered (the angle of ω₀ from e₂, rad).
 DECADES = tuple(range(1, 13))

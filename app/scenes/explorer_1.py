@@ -19,8 +19,8 @@ Readouts: the separatrix crossing t* of the law against the first time the motio
 I₂; |L| kept and L fixed in space (measured on the motion shown); D and the family now; the
 flatness of the final spin.
 
-Physics: :class:`poinsot.physics.dissipation.EnergySink` (the law, and the motion, exact in
-short windows), :func:`poinsot.physics.family.polhode_family` (the family on the sphere); the
+Physics: :class:`poinsot.physics.models.dissipation.EnergySink` (the law, and the motion, exact in
+short windows), :func:`poinsot.physics.models.family.polhode_family` (the family on the sphere); the
 moments of the drawn mesh by trimesh (:func:`poinsot.app.bodies.body_from_mesh`).
 """
 
@@ -53,9 +53,10 @@ from poinsot.app.scenes.spec import (
     Settings,
 )
 from poinsot.app.scenes.tabulated import Player, Table
-from poinsot.physics import Regime, attitude_with_L_along_z, rotations
-from poinsot.physics.dissipation import EnergySink
-from poinsot.physics.family import PolhodeCurve, family_D_values, polhode_family
+from poinsot.physics import Regime, attitude_with_L_along_z
+from poinsot.physics.core import rotations
+from poinsot.physics.models.dissipation import EnergySink
+from poinsot.physics.models.family import PolhodeCurve, family_D_values, polhode_family
 
 #: The satellite: a cylinder along its axis 1 with one pair of whip antennas along axis 2.
 CYLINDER = (2.0, 0.12)  # length, radius

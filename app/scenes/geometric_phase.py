@@ -16,7 +16,7 @@ complete elliptic integral of the third kind in Carlson's form) against a quadra
 ``∮ (1 − l·p) dα`` over ω(t); Montgomery's sum against the angle the attitude turns about L over
 one period; Ω against its separatrix limit.
 
-Physics: :func:`poinsot.physics.geometric_phase.solid_angle`, :func:`~.montgomery_phase`,
+Physics: :func:`poinsot.physics.models.geometric_phase.solid_angle`, :func:`~.montgomery_phase`,
 :func:`~.solid_angle_quadrature`, :func:`~.separatrix_solid_angles`, :func:`~.cone_of_L`.
 """
 
@@ -48,7 +48,7 @@ from poinsot.app.scenes.spec import (
     number,
 )
 from poinsot.physics import FreeRigidBody
-from poinsot.physics.geometric_phase import (
+from poinsot.physics.models.geometric_phase import (
     MontgomeryPhase,
     cone_of_L,
     montgomery_phase,

@@ -17,8 +17,8 @@ recovered from the integrated attitude (ω = 2 Im(q* q̇), fourth-order differen
 quaternions drawn), and the attitude's error estimate at the time shown. The plot: log₁₀ of the
 error estimate and of the mismatch between that recovered ω and the closed-form ω.
 
-Physics: :class:`poinsot.physics.gyroscope.Gyroscope` (``omega``, ``attitude``,
-``measure_drift``), :mod:`poinsot.physics.rotations` (products of the drawn quaternions).
+Physics: :class:`poinsot.physics.models.gyroscope.Gyroscope` (``omega``, ``attitude``,
+``measure_drift``), :mod:`poinsot.physics.core.rotations` (products of the drawn quaternions).
 """
 
 from __future__ import annotations
@@ -50,8 +50,8 @@ from poinsot.app.scenes.spec import (
     number,
 )
 from poinsot.app.scenes.tabulated import Player, Table
-from poinsot.physics import rotations
-from poinsot.physics.gyroscope import AttitudeRun, DriftMeasurement, Gyroscope
+from poinsot.physics.core import rotations
+from poinsot.physics.models.gyroscope import AttitudeRun, DriftMeasurement, Gyroscope
 
 #: The body: the presets' homogeneous disc (its moments checked against trimesh by
 #: tests/app/test_parts.py); J transverse, J₃ axial.

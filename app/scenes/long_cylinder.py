@@ -15,9 +15,9 @@ Readouts: how far the contact point has moved along its polhode (the fraction of
 the arc length, against the chord length of ω(t) sampled), the circuits done, the time one
 circuit takes (4K/λ against the zeros of ω₂), and the sizes of the herpolhode and the polhode.
 
-Physics: :class:`poinsot.physics.family.PolhodeArc` (arc length along the polhode, circuit time
-and length), :class:`FreeRigidBody`, :func:`poinsot.physics.flip.measure_flips`; the moments of
-the drawn mesh by trimesh (:func:`poinsot.app.bodies.body_from_mesh`).
+Physics: :class:`poinsot.physics.models.family.PolhodeArc` (arc length along the polhode, circuit
+time and length), :class:`FreeRigidBody`, :func:`poinsot.physics.models.flip.measure_flips`; the
+moments of the drawn mesh by trimesh (:func:`poinsot.app.bodies.body_from_mesh`).
 """
 
 from __future__ import annotations
@@ -35,8 +35,8 @@ from poinsot.app.scenes import colors
 from poinsot.app.scenes.base import CONSTRUCTION, OwnSolid, SceneModel, riding_mesh
 from poinsot.app.scenes.spec import Choice, Part, Readout, SceneSpec, Settings, number
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
-from poinsot.physics.family import PolhodeArc
-from poinsot.physics.flip import measure_flips
+from poinsot.physics.models.family import PolhodeArc
+from poinsot.physics.models.flip import measure_flips
 
 #: The cylinder: length, and the semi-axes of its elliptic cross-section (1 % apart).
 LENGTH = 2.4

@@ -6,7 +6,7 @@ no torque acts) and on the energy ellipsoid ``Σ mᵢ²/Iᵢ = 2T`` (semi-axes `
 curve where the two meet is the polhode, mapped by ``I``. The group shows the sphere, the
 ellipsoid, their intersection (or the whole family), the body axes and the moving point
 ``m(t)``, scaled so that the sphere has a given radius (display units). Every number comes
-from :mod:`poinsot.physics.family`.
+from :mod:`poinsot.physics.models.family`.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from poinsot.app.scene.geometry import triple
 from poinsot.app.scenes import colors
 from poinsot.app.scenes.drawing import Parts, many_segments, unit_sphere
 from poinsot.physics import Regime
-from poinsot.physics.family import PolhodeCurve
+from poinsot.physics.models.family import PolhodeCurve
 
 #: Radius of the momentum sphere on screen [display units], unless a scene says otherwise.
 SPHERE_RADIUS = 0.8

@@ -13,10 +13,10 @@ Beside it, Landau's view [LL76 §37]: in momentum space the sphere |m| = G cut b
 moving body runs along it. A point of the sphere (pointed at by hand) is a start at |L| kept:
 ω = I⁻¹L, and D follows from it (the setting :data:`START_KEY`, until the slider moves).
 
-Physics: :func:`poinsot.physics.family.polhode_family` and :func:`~.polhode_curves` (the
+Physics: :func:`poinsot.physics.models.family.polhode_family` and :func:`~.polhode_curves` (the
 curves, at the body's energy), :func:`~.momentum_view` (Landau's picture at the body's |L|),
 :meth:`FreeRigidBody.from_energy` (the body on the polhode of D),
-:func:`poinsot.physics.flip.measure_flips` (the period read off the motion).
+:func:`poinsot.physics.models.flip.measure_flips` (the period read off the motion).
 """
 
 from __future__ import annotations
@@ -56,8 +56,8 @@ from poinsot.app.scenes.spec import (
     parse_start,
 )
 from poinsot.physics import FreeRigidBody, Regime
-from poinsot.physics.axis_angles import measure_wobble, wobble_theory
-from poinsot.physics.family import (
+from poinsot.physics.models.axis_angles import measure_wobble, wobble_theory
+from poinsot.physics.models.family import (
     MomentumView,
     PolhodeCurve,
     family_D_values,
@@ -65,8 +65,8 @@ from poinsot.physics.family import (
     polhode_curves,
     polhode_family,
 )
-from poinsot.physics.flip import measure_flips
-from poinsot.physics.pointing import body_from_start, omega_from_momentum
+from poinsot.physics.models.flip import measure_flips
+from poinsot.physics.models.pointing import body_from_start, omega_from_momentum
 
 #: The body: the presets' homogeneous 3 × 2 × 1 box (its moments are checked against trimesh's
 #: mass properties of the drawn mesh by tests/app/test_parts.py), sorted I₁ < I₂ < I₃.

@@ -13,7 +13,7 @@ Readouts: p and s predicted against the rates measured from the motion (the azim
 about L, and of ω about e₃), and the cones' half-angles and the nutation angle against the angles
 read from the motion.
 
-Physics: :func:`poinsot.physics.symmetric.symmetric_top` (rates, cones, the body),
+Physics: :func:`poinsot.physics.models.symmetric.symmetric_top` (rates, cones, the body),
 :func:`~.measure_precession_rate`, :func:`~.measure_spin_rate`. The bodies are the presets' disc
 and rod (their moments checked against trimesh by tests/app/test_parts.py).
 """
@@ -44,7 +44,7 @@ from poinsot.app.scenes.spec import (
     Slider,
 )
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
-from poinsot.physics.symmetric import (
+from poinsot.physics.models.symmetric import (
     SymmetricTop,
     measure_precession_rate,
     measure_spin_rate,

@@ -14,10 +14,11 @@ over the window (one turn, from the attitude); the head's twist Δψ read off th
 the separatrix formula 2 atan(sinh τ₁/c₃), within its stated accuracy (1 − k²) cosh²τ₁; the
 defect π − Δψ against the formula's bounds; τ₁ against σ times half the window.
 
-Physics: :func:`poinsot.physics.racket.separatrix_twist` (the formula and its bounds, derived in
-its docstring: the papers' own text was not available to us), :func:`~.measure_twist` (the
-window and the twist from the exact attitude); :func:`poinsot.physics.flip.flip_initial_omega`;
-:data:`poinsot.app.bodies.MEASURED` (Brody's moments) and :func:`~.bundled_body` (the mesh).
+Physics: :func:`poinsot.physics.models.racket.separatrix_twist` (the formula and its bounds, derived
+in its docstring: the papers' own text was not available to us), :func:`~.measure_twist` (the
+window and the twist from the exact attitude);
+:func:`poinsot.physics.models.flip.flip_initial_omega`; :data:`poinsot.app.bodies.MEASURED` (Brody's
+moments) and :func:`~.bundled_body` (the mesh).
 """
 
 from __future__ import annotations
@@ -46,8 +47,8 @@ from poinsot.app.scenes.spec import (
     Settings,
 )
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
-from poinsot.physics.flip import flip_initial_omega
-from poinsot.physics.racket import (
+from poinsot.physics.models.flip import flip_initial_omega
+from poinsot.physics.models.racket import (
     LIMIT_ACCURACY,
     TwistMeasurement,
     TwistTheory,

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics import FreeRigidBody
+from poinsot.physics.core.free_body import FreeRigidBody
 from poinsot.physics.fit.omega import free_omega
 
 #: Starting points keep each second moment at least this fraction of their sum (see angles).

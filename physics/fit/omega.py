@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import special
 
-from poinsot.physics import FreeRigidBody
+from poinsot.physics.core.free_body import FreeRigidBody
 
 #: Below this complementary parameter ``ellipj`` loses digits: FreeRigidBody takes over.
 _MC_FLOOR = 1e-6

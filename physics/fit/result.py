@@ -10,7 +10,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics import FreeRigidBody, Regime
+from poinsot.physics.core.free_body import FreeRigidBody
+from poinsot.physics.core.regime import Regime
 
 #: A fit is "explained" when its rms residual is within 3 noise levels, or at most this
 #: fraction of the rms of |ω|: a free flight recorded by a phone fits to a few tenths of a

@@ -12,8 +12,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics import FreeRigidBody
-from poinsot.physics.validation import real_array
+from poinsot.physics.core.free_body import FreeRigidBody
+from poinsot.physics.core.validation import real_array
 
 #: Fewest samples a fit accepts: 5 to 11 parameters need several times as many data.
 MIN_SAMPLES = 20

@@ -10,7 +10,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics import FreeRigidBody
+from poinsot.physics.core.free_body import FreeRigidBody
+from poinsot.physics.core.validation import check_flag
 from poinsot.physics.fit import model
 from poinsot.physics.fit.model import Layout
 from poinsot.physics.fit.result import (
@@ -32,7 +33,6 @@ from poinsot.physics.fit.samples import (
     smooth,
 )
 from poinsot.physics.fit.start import Start, euler_estimate, family_starts
-from poinsot.physics.validation import check_flag
 
 #: ω must vary by at least this fraction of |ω| during the segment: a steady spin about one
 #: principal axis reveals nothing of the moments.
@@ -191,7 +191,7 @@ def fit_angular_velocity(
         ValueError: wrong shapes, too few samples, NaN or infinite values, times that do not
             increase, a body that hardly turns, or a ω that stays constant (a steady spin about
             a principal axis, which does not reveal the moments); also (as
-            :class:`~poinsot.physics.validation.InputTypeError`) values that are not real
+            :class:`~poinsot.physics.core.validation.InputTypeError`) values that are not real
             numbers, or flags that are not True or False.
 
     Method: Euler's equations, linear in the moments once ω and dω/dt are smoothed out of the

@@ -4,7 +4,7 @@ A fixed-step method turns the body by one small rotation ``X_k`` per step, ``R_{
 The running product is sequential by nature; here it is formed for all requested step counts
 at once by a product tree (vectorised, rounding ~log2(S) eps), chunk by chunk. Quaternions are
 stored component-first, shape (4, n), so that each component is one contiguous array for the
-products of :func:`poinsot.physics.rotations.hamilton`.
+products of :func:`poinsot.physics.core.rotations.hamilton`.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics.rotations import hamilton
+from poinsot.physics.core.rotations import hamilton
 
 __all__ = ["attitudes_at", "axis_products", "prefix_products"]
 

@@ -36,9 +36,9 @@ from collections.abc import Callable
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from poinsot.physics.core.rotations import hamilton
 from poinsot.physics.integrators.attitudes import attitudes_at
 from poinsot.physics.integrators.interface import Trajectory, steps_per_interval
-from poinsot.physics.rotations import hamilton
 
 __all__ = [
     "run_gyro_explicit",

@@ -3,7 +3,7 @@
 Conventions (as in :mod:`poinsot.physics`): ``omega`` is the body-frame angular velocity,
 ``m = I omega`` the body angular momentum, the attitude ``R`` maps body to space coordinates and
 obeys ``R' = R [omega]x``; quaternions are scalar last ``(x, y, z, w)``
-(:mod:`poinsot.physics.rotations`). The principal moments are used in the caller's order:
+(:mod:`poinsot.physics.core.rotations`). The principal moments are used in the caller's order:
 Euler's equations and the splitting hold in any labelling.
 """
 

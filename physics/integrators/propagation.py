@@ -10,6 +10,7 @@ import numpy as np
 from scipy.integrate import OdeSolver
 from scipy.spatial.transform import Rotation
 
+from poinsot.physics.core.validation import check_count, check_number
 from poinsot.physics.integrators.registry import MAX_STEPS, Scaled, validated
 from poinsot.physics.integrators.runge_kutta import (
     DEFAULT_MAX_STEPS,
@@ -18,7 +19,6 @@ from poinsot.physics.integrators.runge_kutta import (
     scipy_atol,
     too_many_steps,
 )
-from poinsot.physics.validation import check_count, check_number
 
 __all__ = ["Propagation", "State"]
 

@@ -17,6 +17,16 @@ from typing import NamedTuple
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from poinsot.physics.core.validation import (
+    InputTypeError,
+    check_attitude,
+    check_count,
+    check_inertia,
+    check_moment_span,
+    check_positive,
+    check_time_array,
+    check_vector,
+)
 from poinsot.physics.integrators.games import (
     run_gyro_explicit,
     run_gyro_implicit,
@@ -28,16 +38,6 @@ from poinsot.physics.integrators.interface import Integrator, Trajectory
 from poinsot.physics.integrators.midpoint import run_midpoint
 from poinsot.physics.integrators.runge_kutta import DEFAULT_MAX_STEPS, run_scipy, solve
 from poinsot.physics.integrators.splitting import run_splitting
-from poinsot.physics.validation import (
-    InputTypeError,
-    check_attitude,
-    check_count,
-    check_inertia,
-    check_moment_span,
-    check_positive,
-    check_time_array,
-    check_vector,
-)
 
 __all__ = ["GAME_STEPS", "INTEGRATORS", "METHODS", "Scaled", "integrate", "validated"]
 

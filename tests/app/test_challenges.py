@@ -19,8 +19,8 @@ from scipy.integrate import solve_ivp
 from poinsot.app.live.ui import challenges
 from poinsot.app.live.ui.challenge_set import AXES, OUTCOMES, challenge_set, parse_time
 from poinsot.physics import FreeRigidBody
-from poinsot.physics.flip import integrated_flip_times
-from poinsot.physics.twins import measured_lag
+from poinsot.physics.models.flip import integrated_flip_times
+from poinsot.physics.models.twins import measured_lag
 
 
 def _dop853_zeros(J: np.ndarray, w0: np.ndarray, axis: int, t_end: float) -> np.ndarray:

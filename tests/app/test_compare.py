@@ -17,7 +17,7 @@ import pytest
 from poinsot.app import benchmark as app_benchmark
 from poinsot.app import compare
 from poinsot.app.compare import COST, RATE, Ratio
-from poinsot.physics import benchmark as physics_benchmark
+from poinsot.physics.tools import benchmark as physics_benchmark
 
 REPO = Path(compare.__file__).resolve().parents[1]
 

@@ -28,7 +28,7 @@ from poinsot.app.scene.cameras import BODY_VIEW, ride_along, space_view
 from poinsot.app.scene.frames import wxyz, xyzw_from_wxyz
 from poinsot.app.scene.geometry import HERPOLHODE_LIFT, POLHODE_INFLATE, Geometry
 from poinsot.app.scene.view import VIEWS
-from poinsot.physics import rotations
+from poinsot.physics.core import rotations
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: Relative agreement of independently computed quantities (double rounding only).
@@ -45,7 +45,7 @@ def body_of(key: str):
 
 def turned(q_wxyz: np.ndarray, v: np.ndarray) -> np.ndarray:
     """q v q^-1 for scalar-first unit quaternions (N, 4) and vectors (N, 3), by the project's
-    one quaternion algebra (physics.rotations, independent of scipy)."""
+    one quaternion algebra (physics.core.rotations, independent of scipy)."""
     return rotations.rotate(xyzw_from_wxyz(q_wxyz), v)
 
 

@@ -34,8 +34,8 @@ from poinsot.app.scene.ghost import (
     time_scale,
 )
 from poinsot.app.scene.sampling import evaluate
+from poinsot.physics.core.rotations import geodesic_angle, rotate_vector
 from poinsot.physics.integrators import METHODS, State
-from poinsot.physics.rotations import geodesic_angle, rotate_vector
 
 GHOST_NODES = {
     "/space/ghost",

@@ -11,7 +11,7 @@ from poinsot.app.live.ui.readouts import rows
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import PRESETS, Preset
 from poinsot.physics import Regime
-from poinsot.physics.geometric_phase import wrap_angle
+from poinsot.physics.models.geometric_phase import wrap_angle
 
 
 def _number(text: str) -> float:

@@ -18,7 +18,7 @@ from poinsot.app.scenes import dzhanibekov, scene_by_name
 from poinsot.app.scenes.twins import TWIN_STEP
 from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
-from poinsot.physics.flip import flip_initial_omega
+from poinsot.physics.models.flip import flip_initial_omega
 
 SPEC = scene_by_name("dzhanibekov")
 

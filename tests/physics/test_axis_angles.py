@@ -18,7 +18,12 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
-from poinsot.physics.axis_angles import axis_angles, measure_wobble, wobble_theory, zxz_angles
+from poinsot.physics.models.axis_angles import (
+    axis_angles,
+    measure_wobble,
+    wobble_theory,
+    zxz_angles,
+)
 
 RNG = np.random.default_rng(19)
 

@@ -1,4 +1,4 @@
-"""Every closed form keeps the one interface (``physics.closed_forms.ClosedForm``).
+"""Every closed form keeps the one interface (``physics.core.closed_forms.ClosedForm``).
 
 For each form -- triaxial (both families), separatrix, and the uniform one (symmetric body,
 sphere, permanent rotation, rest) -- and on the same dimensionless times:
@@ -21,11 +21,11 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics import FreeRigidBody, Regime
-from poinsot.physics.closed_forms import ClosedForm
-from poinsot.physics.closed_forms.separatrix import Separatrix
-from poinsot.physics.closed_forms.triaxial import Triaxial
-from poinsot.physics.closed_forms.uniform import Uniform
-from poinsot.physics.rotations import multiply, rotate
+from poinsot.physics.core.closed_forms import ClosedForm
+from poinsot.physics.core.closed_forms.separatrix import Separatrix
+from poinsot.physics.core.closed_forms.triaxial import Triaxial
+from poinsot.physics.core.closed_forms.uniform import Uniform
+from poinsot.physics.core.rotations import multiply, rotate
 
 EPS = float(np.finfo(float).eps)
 

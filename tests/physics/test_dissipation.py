@@ -18,7 +18,7 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics import FreeRigidBody, Regime
-from poinsot.physics.dissipation import EnergySink
+from poinsot.physics.models.dissipation import EnergySink
 
 INVARIANT_RTOL = 1e-12
 """|m| and L = R m over hundreds of windows: each window is exact and the carry keeps |m| = G

@@ -1,4 +1,4 @@
-"""``physics.elliptic.sncndn`` and ``ellipk`` against mpmath at high precision.
+"""``physics.core.elliptic.sncndn`` and ``ellipk`` against mpmath at high precision.
 
 The parameter is passed as the float pair ``(m, mc)``; the reference takes the smaller of the
 two as exact (``reference.mp_parameter``) and evaluates ``mpmath.ellipfun`` at ``MP_DPS`` digits
@@ -24,7 +24,7 @@ from reference import (
     mp_sncndn,
 )
 
-from poinsot.physics.elliptic import ellipk, sncndn
+from poinsot.physics.core.elliptic import ellipk, sncndn
 
 ELLIPK_RTOL = 1e-14
 """K(m) relative error: Carlson's ``R_F(0, mc, 1)`` is accurate to a few ulps for every ``mc`` in

@@ -15,7 +15,7 @@ import pytest
 from scipy import special
 
 from poinsot.physics import FreeRigidBody, Regime
-from poinsot.physics.family import (
+from poinsot.physics.models.family import (
     PolhodeArc,
     family_D_values,
     momentum_view,

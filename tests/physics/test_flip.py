@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from poinsot.physics import FreeRigidBody, Regime
-from poinsot.physics.flip import (
+from poinsot.physics.models.flip import (
     flip_initial_omega,
     flip_theory,
     integrated_flip_times,

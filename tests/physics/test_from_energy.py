@@ -21,15 +21,8 @@ from hypothesis import strategies as st
 from reference import integrate_dop853
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics import (
-    FreeRigidBody,
-    Regime,
-    attitude_with_L_along_z,
-    free_body,
-    initial_state,
-    omega_from_energy,
-    validation,
-)
+from poinsot.physics import FreeRigidBody, Regime, attitude_with_L_along_z, omega_from_energy
+from poinsot.physics.core import free_body, initial_state, validation
 
 EPS = float(np.finfo(float).eps)
 

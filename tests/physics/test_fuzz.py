@@ -1,7 +1,7 @@
 """Every call of the public API ends cleanly: a readable ValueError or TypeError raised by the
 package, or a finite result that keeps the invariants of the motion.
 
-The targets and their checks are those of the benchmark (``python -m poinsot.physics.fuzz
+The targets and their checks are those of the benchmark (``python -m poinsot.physics.tools.fuzz
 --cases 100000``); here hypothesis supplies the choices, a small
 fixed sample (``derandomize=True``) that runs in seconds, and shrinks a failure to its
 plainest arguments. Warnings are errors: inside each call (the harness) and around it.
@@ -16,9 +16,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from poinsot.physics.fuzz import CLEAN, TARGETS, Call, case, template
-from poinsot.physics.fuzz.harness import build, run_case
-from poinsot.physics.fuzz.values import RandomSource
+from poinsot.physics.tools.fuzz import CLEAN, TARGETS, Call, case, template
+from poinsot.physics.tools.fuzz.harness import build, run_case
+from poinsot.physics.tools.fuzz.values import RandomSource
 
 pytestmark = pytest.mark.filterwarnings("error")
 
@@ -81,7 +81,7 @@ def test_errors_of_libraries_warnings_and_bad_results_are_unclean() -> None:
     assert _outcome(lambda: [][1]) == "UNCLEAN"
 
     def not_finite(result):
-        from poinsot.physics.fuzz.checks import finite
+        from poinsot.physics.tools.fuzz.checks import finite
 
         finite(result)
 
@@ -103,7 +103,7 @@ def test_a_random_source_is_reproducible() -> None:
 
 
 def test_a_value_error_raised_by_the_fuzz_itself_is_no_refusal() -> None:
-    from poinsot.physics.fuzz import harness
+    from poinsot.physics.tools.fuzz import harness
 
     def raise_in(folder: str) -> None:
         code = "raise ValueError('a message long enough to say what to change')"
@@ -114,7 +114,7 @@ def test_a_value_error_raised_by_the_fuzz_itself_is_no_refusal() -> None:
 
 
 def test_the_benchmark_counts_a_short_run(capsys: pytest.CaptureFixture[str]) -> None:
-    from poinsot.physics.fuzz import main
+    from poinsot.physics.tools.fuzz import main
 
     assert main(["--cases", "60", "--only", "FreeRigidBody"]) == 0
     out = capsys.readouterr().out

@@ -1,8 +1,8 @@
 """The game engines' rotation steps (:data:`GAME_STEPS`) against the exact solution, the flip
-verdicts of :mod:`physics.engine_check`, and the step budget of the adaptive pairs.
+verdicts of :mod:`physics.integrators.engine_check`, and the step budget of the adaptive pairs.
 
 References: the exact solution (elliptic functions) and, for the flips, the elliptic flip clock
-of :func:`physics.flip.flip_theory` (2K/λ between flips), not the code under test.
+of :func:`physics.models.flip.flip_theory` (2K/λ between flips), not the code under test.
 """
 
 from __future__ import annotations
@@ -14,9 +14,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics import FreeRigidBody
-from poinsot.physics.engine_check import exact_flip_times, flip_times, run_flips
-from poinsot.physics.flip import flip_theory
 from poinsot.physics.integrators import GAME_STEPS, INTEGRATORS, METHODS, Propagation, integrate
+from poinsot.physics.integrators.engine_check import exact_flip_times, flip_times, run_flips
+from poinsot.physics.models.flip import flip_theory
 
 EPS = float(np.finfo(float).eps)
 ORDER_SLOPE_TOL = 0.15

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from poinsot.physics import FreeRigidBody, Regime
-from poinsot.physics.geometric_phase import (
+from poinsot.physics.models.geometric_phase import (
     montgomery_phase,
     separatrix_solid_angles,
     solid_angle,

@@ -4,7 +4,7 @@ Before, numpy converted them silently or failed with its own message: a complex 
 its real part (a ComplexWarning), text was parsed, True read as 1.0, a Python int beyond the
 double range raised ``OverflowError: int too large to convert to float``, ``polhode(inf)`` an
 ``OverflowError``, ``polhode(None)`` a TypeError about ``int()``. Now each is refused by the
-package's own check, as an :class:`~poinsot.physics.validation.InputTypeError` (a TypeError
+package's own check, as an :class:`~poinsot.physics.core.validation.InputTypeError` (a TypeError
 that is also a ValueError, so that ``except ValueError`` still catches every refusal) or a
 ValueError, with a message that names the argument.
 """
@@ -26,8 +26,8 @@ from poinsot.physics import (
     box_dimensions,
     omega_from_energy,
 )
+from poinsot.physics.core.validation import InputTypeError, real_array
 from poinsot.physics.integrators import Propagation, integrate
-from poinsot.physics.validation import InputTypeError, real_array
 
 pytestmark = pytest.mark.filterwarnings("error")
 

@@ -19,7 +19,7 @@ from scipy.spatial.transform import Rotation
 
 import poinsot.physics.integrators.attitudes as attitudes_module
 from poinsot.physics import FreeRigidBody
-from poinsot.physics.errors import attitude_error, energy, omega_error, relative_drift
+from poinsot.physics.core.errors import attitude_error, energy, omega_error, relative_drift
 from poinsot.physics.integrators import INTEGRATORS, Trajectory, integrate
 
 EPS = float(np.finfo(float).eps)

@@ -1,4 +1,4 @@
-"""A start pointed at by hand (physics/pointing.py): the ray's point, the start on the energy
+"""A start pointed at by hand (physics/models/pointing.py): the ray's point, the start on the energy
 ellipsoid, the polhode through it, the snap onto the exact separatrix."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics import FreeRigidBody, Regime
-from poinsot.physics.pointing import (
+from poinsot.physics.models.pointing import (
     body_from_start,
     energy_parameter,
     momentum_from_ray,

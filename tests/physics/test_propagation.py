@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics.errors import attitude_error, energy, relative_drift
+from poinsot.physics.core.errors import attitude_error, energy, relative_drift
 from poinsot.physics.integrators import INTEGRATORS, Propagation, integrate
 
 INERTIA = np.array([1.0, 2.0, 2.6])

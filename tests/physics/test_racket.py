@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
-from poinsot.physics.flip import flip_initial_omega
-from poinsot.physics.racket import LIMIT_ACCURACY, measure_twist, separatrix_twist
+from poinsot.physics.models.flip import flip_initial_omega
+from poinsot.physics.models.racket import LIMIT_ACCURACY, measure_twist, separatrix_twist
 
 BRODY = (0.00121, 0.01638, 0.01748)
 BODIES = [BRODY, (0.077, 0.925, 1.0), (1.0, 2.0, 3.0), (0.3, 0.5, 1.0)]

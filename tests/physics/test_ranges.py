@@ -16,17 +16,17 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics import FreeRigidBody, box_dimensions, omega_from_energy
-from poinsot.physics.dissipation import EnergySink
-from poinsot.physics.family import PolhodeArc, polhode_curves, polhode_family
-from poinsot.physics.flip import (
+from poinsot.physics.integrators import Propagation, integrate
+from poinsot.physics.models.dissipation import EnergySink
+from poinsot.physics.models.family import PolhodeArc, polhode_curves, polhode_family
+from poinsot.physics.models.flip import (
     flip_theory,
     integrated_flip_times,
     measure_flips,
     measure_growth_rate,
 )
-from poinsot.physics.gyroscope import Gyroscope
-from poinsot.physics.integrators import Propagation, integrate
-from poinsot.physics.symmetric import measure_precession_rate, symmetric_top
+from poinsot.physics.models.gyroscope import Gyroscope
+from poinsot.physics.models.symmetric import measure_precession_rate, symmetric_top
 
 pytestmark = pytest.mark.filterwarnings("error")
 

@@ -1,4 +1,5 @@
-"""The one quaternion algebra (``physics.rotations``) and the error measures (``physics.errors``).
+"""The one quaternion algebra (``physics.core.rotations``) and the error measures
+(``physics.core.errors``).
 
 Against scipy's ``Rotation`` (composition, ``apply``, ``from_rotvec``, ``inv``), against mpmath
 for the geodesic angle, and on known values. The component functions must give the same bits
@@ -14,8 +15,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics import errors
-from poinsot.physics.rotations import (
+from poinsot.physics.core import errors
+from poinsot.physics.core.rotations import (
     axis_angle,
     conjugate,
     geodesic_angle,

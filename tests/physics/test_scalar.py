@@ -22,8 +22,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from poinsot.physics import FreeRigidBody, Regime, elliptic, precise
-from poinsot.physics.exact import sqrt_ratio
+from poinsot.physics import FreeRigidBody, Regime
+from poinsot.physics.core import elliptic, precise
+from poinsot.physics.core.exact import sqrt_ratio
 
 SCALAR_RTOL = 4e-16
 """Scalar against array path, relative to |ω| (ω, contact point) or to 1 (quaternions):

@@ -17,7 +17,7 @@ from reference import integrate_dop853
 from scipy.spatial.transform import Rotation
 
 from poinsot.physics import FreeRigidBody, Regime
-from poinsot.physics.symmetric import (
+from poinsot.physics.models.symmetric import (
     measure_precession_rate,
     measure_spin_rate,
     symmetric_top,

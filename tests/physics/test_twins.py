@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from poinsot.physics import FreeRigidBody
-from poinsot.physics.flip import flip_initial_omega, flip_theory, integrated_flip_times
-from poinsot.physics.twins import (
+from poinsot.physics.models.flip import flip_initial_omega, flip_theory, integrated_flip_times
+from poinsot.physics.models.twins import (
     first_flip_times,
     growth_rate,
     lag_limit,

@@ -20,9 +20,9 @@ import numpy as np
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import preset_by_key
 from poinsot.app.scenes import dzhanibekov
-from poinsot.physics.axis_angles import wobble_theory
-from poinsot.physics.flip import flip_initial_omega, flip_theory, measure_flips
-from poinsot.physics.twins import twin_clock
+from poinsot.physics.models.axis_angles import wobble_theory
+from poinsot.physics.models.flip import flip_initial_omega, flip_theory, measure_flips
+from poinsot.physics.models.twins import twin_clock
 
 #: A time answer within this fraction of the theory's scores.
 TIME_TOLERANCE = 0.2

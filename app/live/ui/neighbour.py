@@ -1,9 +1,9 @@
 """Compare with a neighbour: any preset's body and a second one started ε′ away from it
-(:func:`poinsot.physics.twins.neighbour_start`: ω₀ turned by ε′, the same |ω₀|), drawn over
+(:func:`poinsot.physics.models.twins.neighbour_start`: ω₀ turned by ε′, the same |ω₀|), drawn over
 the first in cyan with the preset's own solid, both exact.
 
 A dropdown of the control panel chooses ε′ (or no neighbour). Near the intermediate axis the
-folder reads both first flips, (K ± δ)/λ (:func:`poinsot.physics.flip.flip_theory`), and the
+folder reads both first flips, (K ± δ)/λ (:func:`poinsot.physics.models.flip.flip_theory`), and the
 lag between them, theory against the lag measured from the two motions (the first zeros of
 ω₂); near a stable axis the neighbour simply stays close. The callback only records the
 choice (one attribute, assigned atomically); the session's frame thread builds the neighbour
@@ -29,9 +29,9 @@ from poinsot.app.scene.sampling import MotionSampler, Samples
 from poinsot.app.scenes import colors
 from poinsot.app.scenes.twins import TWIN_STEP
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
-from poinsot.physics.axis_angles import axis_angles
-from poinsot.physics.flip import FlipTheory, flip_theory, measure_flips
-from poinsot.physics.twins import neighbour_start
+from poinsot.physics.models.axis_angles import axis_angles
+from poinsot.physics.models.flip import FlipTheory, flip_theory, measure_flips
+from poinsot.physics.models.twins import neighbour_start
 
 FOLDER = "Compare with a neighbour"
 LABEL = "Neighbour's start ε′"

@@ -3,8 +3,8 @@ L and the body axes (the intermediate axis's flip is ∠(L, e₂) swinging throu
 Z-X-Z Euler angles of the attitude about L. A dropdown above the plot chooses.
 
 Each is three series over the recorded samples (t, ω, attitude), computed when the plot is
-sent by :mod:`poinsot.physics.axis_angles` (no physics here): its title, legend and y axis say
-what and in which unit. The dropdown's callback only records the choice (one attribute,
+sent by :mod:`poinsot.physics.models.axis_angles` (no physics here): its title, legend and y axis
+say what and in which unit. The dropdown's callback only records the choice (one attribute,
 assigned atomically); the session's frame thread applies it when it next sends the plot.
 """
 
@@ -19,7 +19,7 @@ import viser.uplot
 from poinsot.app.live.ui.widgets import Sent, on_user
 from poinsot.app.scene import palette
 from poinsot.physics import FreeRigidBody
-from poinsot.physics.axis_angles import axis_angles, zxz_angles
+from poinsot.physics.models.axis_angles import axis_angles, zxz_angles
 
 LABEL = "Plot"
 

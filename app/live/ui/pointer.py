@@ -4,8 +4,8 @@ The browser reports a click or a tap on the ellipsoid with its ray (the mesh's `
 viser's scene-wide ``on_click`` hears no tap: its camera holds a touch pointer), and a drag on
 it (the mesh's ``on_drag``) with the pointer on a plane facing the camera, so the ray runs from
 the camera through that point. The physics
-(:mod:`poinsot.physics.pointing`) meets the ray with the ellipsoid of the body as it is turned
-in the frame on screen, and gives the ω of the energy kept there; D follows from it. Within
+(:mod:`poinsot.physics.models.pointing`) meets the ray with the ellipsoid of the body as it is
+turned in the frame on screen, and gives the ω of the energy kept there; D follows from it. Within
 :data:`SNAP_PX` pixels of the separatrix the start is snapped onto it, and the body built from
 it is the exact separatrix (as the D slider's I₂ mark gives).
 
@@ -44,7 +44,7 @@ from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.nodes import Drawing, Ellipsoid
 from poinsot.physics import FreeRigidBody
-from poinsot.physics.pointing import snap_to_separatrix, start_from_ray
+from poinsot.physics.models.pointing import snap_to_separatrix, start_from_ray
 
 #: The pointer snaps onto the separatrix within this many pixels of it (on screen).
 SNAP_PX = 6.0

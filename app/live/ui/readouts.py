@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 
 from poinsot.physics import FreeRigidBody, Regime
-from poinsot.physics.geometric_phase import montgomery_phase
+from poinsot.physics.models.geometric_phase import montgomery_phase
 
 REGIME_TEXT: dict[Regime, str] = {
     Regime.MAJOR_AXIS: "polhode around the major axis",

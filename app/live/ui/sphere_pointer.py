@@ -5,7 +5,7 @@ a click, a tap or a drag on the sphere chooses the body-frame L where the motion
 As on the energy ellipsoid (:mod:`poinsot.app.live.ui.pointer`, whose
 :class:`~poinsot.app.live.ui.pointer.StartPointer` drags and releases here too): the sphere mesh's
 ``on_click`` gives the ray, its ``on_drag`` the pointer on a plane facing the camera (the ray
-runs from the camera through it). The physics (:mod:`poinsot.physics.pointing`) meets the ray
+runs from the camera through it). The physics (:mod:`poinsot.physics.models.pointing`) meets the ray
 with the sphere ``|L| = G`` of the body on screen; ω = I⁻¹L and D follow from the point. Within
 :data:`~poinsot.app.live.ui.pointer.SNAP_PX` pixels of the separatrix the point is snapped onto it
 at |L| kept, and the body built from it is the exact separatrix.
@@ -40,7 +40,7 @@ from poinsot.app.scene.geometry import POLHODE_INFLATE
 from poinsot.app.scenes import colors
 from poinsot.app.scenes.momentum import MomentumPicture
 from poinsot.app.scenes.spec import START_KEY, Value, start_setting
-from poinsot.physics.pointing import (
+from poinsot.physics.models.pointing import (
     momentum_from_ray,
     omega_from_momentum,
     snap_momentum_to_separatrix,
