@@ -22,6 +22,7 @@ import pathlib
 import threading
 import time
 from collections.abc import Callable, Generator, Iterator
+from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 
@@ -147,11 +148,40 @@ def encoder(
 
 
 def rgb_on(rgba: np.ndarray, background: RGB) -> np.ndarray:
-    """An RGBA render laid on an opaque background: (height, width, 3) uint8."""
-    alpha = rgba[..., 3:4].astype(np.float32) / 255.0
-    ground = np.asarray(background, dtype=np.float32)
-    rgb = rgba[..., :3].astype(np.float32) * alpha + ground * (1.0 - alpha)
-    return np.ascontiguousarray(np.clip(np.rint(rgb), 0, 255).astype(np.uint8))
+    """An RGBA render laid on an opaque background: (height, width, 3) uint8, each channel
+    ``(c a + g (255 - a)) / 255`` rounded (Pillow's paste through the alpha mask)."""
+    from PIL import Image
+
+    image = Image.fromarray(np.ascontiguousarray(rgba, dtype=np.uint8), mode="RGBA")
+    ground = Image.new("RGB", image.size, tuple(background))
+    ground.paste(image, mask=image.getchannel("A"))
+    return np.asarray(ground)
+
+
+@contextlib.contextmanager
+def one_behind(
+    frames: Generator[None, np.ndarray, None], background: RGB
+) -> Iterator[Callable[[np.ndarray], None]]:
+    """A function that takes RGBA renders in order and hands them, laid on ``background``, to
+    the encoder ``frames`` on a thread of its own, one render behind: the browser draws the
+    next frame while this one is encoded. A failure of the encoder is raised by the next call,
+    or at the end of the block."""
+    pending: Future[None] | None = None
+
+    def encode(rgba: np.ndarray) -> None:
+        frames.send(rgb_on(rgba, background))
+
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="poinsot-encode") as pool:
+
+        def put(rgba: np.ndarray) -> None:
+            nonlocal pending
+            if pending is not None:
+                pending.result()
+            pending = pool.submit(encode, rgba)
+
+        yield put
+        if pending is not None:
+            pending.result()
 
 
 # -- filming --------------------------------------------------------------------------------
@@ -246,16 +276,19 @@ def film(
     total = clip.frames
     window = (max(16, round(720 * width / height)), 720)
     with headless_chromium(chromium) as browser:
-        stage = open_stage(lambda server: open_window(browser, server, clip.size))
+        stage = open_stage(lambda server: open_window(browser, server, clip.size, 1.0))
         try:
             shots = _first_shot(stage, clip, view, window, fit)
             began = time.perf_counter()
             try:
-                with encoder(out, clip.size, clip.fps) as frames:
+                with (
+                    encoder(out, clip.size, clip.fps) as frames,
+                    one_behind(frames, background) as put,
+                ):
                     for i in range(total):
                         if cancel is not None and cancel.is_set():
                             raise Cancelled(f"cancelled after {i} of {total} frames")
-                        frames.send(rgb_on(shots.shoot(i, clip.time(i)), background))
+                        put(shots.shoot(i, clip.time(i)))
                         if progress is not None:
                             progress(i + 1, total)
             except BaseException:
