@@ -7,6 +7,12 @@ to the frame's time and the browser renders it (viser's ``get_render``, PNG, lai
 background). The stage draws on that browser's own scene, so that a frame's updates and the
 render request after them travel in one queue, in order: every frame shows its own time.
 
+Where a frame's time goes: the software-WebGL draw of the render dominates. The offline page
+draws nothing else (:data:`~poinsot.app.exports.screenshot.OFF_VIEWPORT_CSS`) and draws it at
+the clip's own pixels (pixel ratio 1, fixed: the frames keep one sharpness); laying a render on
+the background and encoding it run on a thread of their own, one frame behind the renders
+(:func:`one_behind`), so that they overlap the browser's next draw.
+
 The encoder is the ffmpeg binary that the ``imageio-ffmpeg`` wheel ships (nothing is downloaded
 at run time, no system ffmpeg is used). MP4: H.264 in yuv420p with the index at the front, which
 PowerPoint, Keynote and every browser play (sides must be even). GIF: one palette made for the
