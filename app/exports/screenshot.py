@@ -109,6 +109,12 @@ EXIT_NO_BROWSER = 3
 #: follows the picture's height (up to 2) so that the labels' textures stay sharp.
 WINDOW_HEIGHT = 720
 MAX_WINDOW_SCALE = 2.0
+#: The offline page draws only the renders asked of it. viser's client draws its live view
+#: while the canvas is in the window's viewport, and a render asked for costs up to three more
+#: live frames (software WebGL: each as dear as the render); moved out of the viewport (the
+#: canvas keeps its size, which sizes the labels), the live view is drawn no more and a render
+#: draws once. The pixels are the same.
+OFF_VIEWPORT_CSS = "body { transform: translateX(-100000px); }"
 #: Probe renders (to wait until the scene is complete, and to measure the framing) have at
 #: most this width.
 PROBE_WIDTH = 480
@@ -262,10 +268,19 @@ def _wait_for_client(server: viser.ViserServer, timeout: float) -> viser.ClientH
 
 
 def open_window(
-    browser: Browser, server: viser.ViserServer, size: tuple[int, int]
+    browser: Browser,
+    server: viser.ViserServer,
+    size: tuple[int, int],
+    pixel_ratio: float | None = None,
 ) -> viser.ClientHandle:
     """Open ``server``'s page in a window of WINDOW_HEIGHT CSS pixels with the picture's
-    aspect; its client once it has connected."""
+    aspect, drawing only the renders asked of it (:data:`OFF_VIEWPORT_CSS`); its client once
+    it has connected.
+
+    Renders are drawn at ``pixel_ratio`` times the picture's pixels (None: the window's scale)
+    and scaled to the picture. It is fixed (viser's ``fixedDpr`` page parameter): viser's
+    client otherwise lowers it while frames are slow, and a software-WebGL browser's always
+    are, so that a clip's later frames came out at 3/4 of its resolution, blurred."""
     width, height = size
     window: ViewportSize = {
         "width": max(16, round(WINDOW_HEIGHT * width / height)),
@@ -273,8 +288,11 @@ def open_window(
     }
     scale = min(MAX_WINDOW_SCALE, max(1.0, height / WINDOW_HEIGHT))
     context = browser.new_context(viewport=window, device_scale_factor=scale)
-    url = f"http://{server.get_host()}:{server.get_port()}"
-    context.new_page().goto(url, timeout=PAGE_TIMEOUT * 1000)
+    ratio = scale if pixel_ratio is None else pixel_ratio
+    url = f"http://{server.get_host()}:{server.get_port()}/?fixedDpr={ratio:g}"
+    page = context.new_page()
+    page.goto(url, timeout=PAGE_TIMEOUT * 1000)
+    page.add_style_tag(content=OFF_VIEWPORT_CSS)
     return _wait_for_client(server, PAGE_TIMEOUT)
 
 

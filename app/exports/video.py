@@ -7,6 +7,12 @@ to the frame's time and the browser renders it (viser's ``get_render``, PNG, lai
 background). The stage draws on that browser's own scene, so that a frame's updates and the
 render request after them travel in one queue, in order: every frame shows its own time.
 
+Where a frame's time goes: the software-WebGL draw of the render dominates. The offline page
+draws nothing else (:data:`~poinsot.app.exports.screenshot.OFF_VIEWPORT_CSS`) and draws it at
+the clip's own pixels (pixel ratio 1, fixed: the frames keep one sharpness); laying a render on
+the background and encoding it run on a thread of their own, one frame behind the renders
+(:func:`one_behind`), so that they overlap the browser's next draw.
+
 The encoder is the ffmpeg binary that the ``imageio-ffmpeg`` wheel ships (nothing is downloaded
 at run time, no system ffmpeg is used). MP4: H.264 in yuv420p with the index at the front, which
 PowerPoint, Keynote and every browser play (sides must be even). GIF: one palette made for the
@@ -22,6 +28,7 @@ import pathlib
 import threading
 import time
 from collections.abc import Callable, Generator, Iterator
+from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 
@@ -147,11 +154,40 @@ def encoder(
 
 
 def rgb_on(rgba: np.ndarray, background: RGB) -> np.ndarray:
-    """An RGBA render laid on an opaque background: (height, width, 3) uint8."""
-    alpha = rgba[..., 3:4].astype(np.float32) / 255.0
-    ground = np.asarray(background, dtype=np.float32)
-    rgb = rgba[..., :3].astype(np.float32) * alpha + ground * (1.0 - alpha)
-    return np.ascontiguousarray(np.clip(np.rint(rgb), 0, 255).astype(np.uint8))
+    """An RGBA render laid on an opaque background: (height, width, 3) uint8, each channel
+    ``(c a + g (255 - a)) / 255`` rounded (Pillow's paste through the alpha mask)."""
+    from PIL import Image
+
+    image = Image.fromarray(np.ascontiguousarray(rgba, dtype=np.uint8), mode="RGBA")
+    ground = Image.new("RGB", image.size, tuple(background))
+    ground.paste(image, mask=image.getchannel("A"))
+    return np.asarray(ground)
+
+
+@contextlib.contextmanager
+def one_behind(
+    frames: Generator[None, np.ndarray, None], background: RGB
+) -> Iterator[Callable[[np.ndarray], None]]:
+    """A function that takes RGBA renders in order and hands them, laid on ``background``, to
+    the encoder ``frames`` on a thread of its own, one render behind: the browser draws the
+    next frame while this one is encoded. A failure of the encoder is raised by the next call,
+    or at the end of the block."""
+    pending: Future[None] | None = None
+
+    def encode(rgba: np.ndarray) -> None:
+        frames.send(rgb_on(rgba, background))
+
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="poinsot-encode") as pool:
+
+        def put(rgba: np.ndarray) -> None:
+            nonlocal pending
+            if pending is not None:
+                pending.result()
+            pending = pool.submit(encode, rgba)
+
+        yield put
+        if pending is not None:
+            pending.result()
 
 
 # -- filming --------------------------------------------------------------------------------
@@ -246,16 +282,19 @@ def film(
     total = clip.frames
     window = (max(16, round(720 * width / height)), 720)
     with headless_chromium(chromium) as browser:
-        stage = open_stage(lambda server: open_window(browser, server, clip.size))
+        stage = open_stage(lambda server: open_window(browser, server, clip.size, 1.0))
         try:
             shots = _first_shot(stage, clip, view, window, fit)
             began = time.perf_counter()
             try:
-                with encoder(out, clip.size, clip.fps) as frames:
+                with (
+                    encoder(out, clip.size, clip.fps) as frames,
+                    one_behind(frames, background) as put,
+                ):
                     for i in range(total):
                         if cancel is not None and cancel.is_set():
                             raise Cancelled(f"cancelled after {i} of {total} frames")
-                        frames.send(rgb_on(shots.shoot(i, clip.time(i)), background))
+                        put(shots.shoot(i, clip.time(i)))
                         if progress is not None:
                             progress(i + 1, total)
             except BaseException:

@@ -1,6 +1,7 @@
 """The video's pieces without a browser: the encoder (imageio-ffmpeg's bundled ffmpeg) writes
 the frames it is given, H.264 yuv420p for MP4 and a looping GIF, read back by imageio and
-Pillow; a render is laid on the theme's background; the clip's bounds (command line and
+Pillow; a render is laid on the theme's background, and renders reach the encoder in order on
+its own thread (a failure there is raised); the clip's bounds (command line and
 browser); a browser view's size brought within the browser's bound."""
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from poinsot.app.exports.video import Clip, check_clip, encoder, rgb_on
+from poinsot.app.exports.video import Clip, check_clip, encoder, one_behind, rgb_on
 from poinsot.app.live.ui.video_export import fit_within
 
 
@@ -57,6 +58,44 @@ def test_a_render_is_laid_on_the_background():
     rgb = rgb_on(rgba, (20, 20, 20))
     assert rgb[0, 0].tolist() == [200, 100, 50] and rgb[0, 1].tolist() == [20, 20, 20]
     assert rgb[1, 0].tolist() == [110, 60, 35]
+
+
+def test_renders_reach_the_encoder_in_order_laid_on_the_background():
+    got: list[np.ndarray] = []
+
+    def sink():
+        while True:
+            got.append((yield))
+
+    frames_in = sink()
+    frames_in.send(None)
+    renders = [np.full((2, 3, 4), (10 * i, 0, 0, 255), np.uint8) for i in range(6)]
+    renders[5][..., 3] = 0  # nothing drawn: the background
+    with one_behind(frames_in, (20, 20, 20)) as put:
+        for rgba in renders:
+            put(rgba)
+    assert [frame[0, 0].tolist() for frame in got] == [
+        [0, 0, 0],
+        [10, 0, 0],
+        [20, 0, 0],
+        [30, 0, 0],
+        [40, 0, 0],
+        [20, 20, 20],
+    ]
+    assert all(frame.shape == (2, 3, 3) for frame in got)
+
+
+def test_an_encoder_failure_is_raised_by_the_next_frame():
+    def broken():
+        yield
+        raise OSError("the encoder is gone")
+
+    frames_in = broken()
+    frames_in.send(None)
+    rgba = np.zeros((2, 2, 4), np.uint8)
+    with pytest.raises(OSError, match="gone"), one_behind(frames_in, (0, 0, 0)) as put:
+        put(rgba)
+        put(rgba)
 
 
 def test_the_clip_s_bounds():
