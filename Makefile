@@ -58,8 +58,11 @@ test: install-test chromium
 	exit $$status
 
 # The inner loop: no browser, no live server, nothing slow (physics, report, the app's logic).
+# These tests compute rather than wait: a worker more than the cores, no more (each worker
+# imports and collects the whole suite before its first test).
+FAST_JOBS ?= 3
 test-fast: install-test
-	$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not browser and not server and not slow"
+	$(PY) -m pytest -n $(FAST_JOBS) --dist loadgroup --no-loadscope-reorder -m "not browser and not server and not slow"
 
 bench: install
 	$(PY) -m poinsot.physics.benchmark
