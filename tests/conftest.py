@@ -95,6 +95,7 @@ BROWSER_GROUPS = {
     "tests/browser/test_video.py": "browser-2",
     "tests/browser/test_video_page.py": "browser-2",
     "tests/browser/test_links_page.py": "browser-2",
+    "tests/browser/test_touch_page.py": "browser-2",
     "tests/browser/test_live_page.py": "browser-3",
     "tests/browser/test_scenes_page.py": "browser-3",
 }
