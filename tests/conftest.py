@@ -92,10 +92,12 @@ BROWSER_GROUPS = {
     "tests/browser/test_exports_page.py": "browser-1",
     "tests/browser/test_strobe_picture.py": "browser-1",
     "tests/browser/test_sphere_pointing.py": "browser-1",
+    "tests/browser/test_uploads_page.py": "browser-1",
     "tests/browser/test_video.py": "browser-2",
     "tests/browser/test_video_page.py": "browser-2",
     "tests/browser/test_links_page.py": "browser-2",
     "tests/browser/test_touch_page.py": "browser-2",
+    "tests/browser/test_challenges_page.py": "browser-2",
     "tests/browser/test_live_page.py": "browser-3",
     "tests/browser/test_scenes_page.py": "browser-3",
 }

@@ -21,10 +21,6 @@ from poinsot.app.scenes.spec import SceneSpec
 pytestmark = pytest.mark.browser
 
 WIDTH, HEIGHT = 1280, 800
-#: The size of the renders compared: the page's aspect, a quarter of its pixels (each render is
-#: a software-WebGL draw and a PNG of the whole picture). At this size the least visible part
-#: still changes 19 times the pixels asked of it, and its colours 5 times MIN_COLOUR_PIXELS.
-RENDER_WIDTH, RENDER_HEIGHT = WIDTH // 2, HEIGHT // 2
 #: A pixel shows a line's colour when its RGB is this close (sum of absolute differences):
 #: loose, because a line seen through a translucent surface (the ellipsoid, Landau's sphere, a
 #: cone) is blended with it; the pixels must also change when the part is hidden (check_parts).
@@ -38,9 +34,7 @@ def render(session) -> np.ndarray:
     once two renders in a row agree (the browser decodes new nodes asynchronously)."""
 
     def once() -> np.ndarray:
-        rgba = session.client.get_render(
-            RENDER_HEIGHT, RENDER_WIDTH, transport_format="png", timeout=60.0
-        )
+        rgba = session.client.get_render(HEIGHT, WIDTH, transport_format="png", timeout=60.0)
         return (rgba[..., :3].astype(np.float64) * (rgba[..., 3:4] / 255.0)).astype(np.int16)
 
     previous = once()
