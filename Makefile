@@ -45,10 +45,12 @@ run: install
 	$(VENV)/bin/poinsot serve --host $(HOST) --port $(PORT)
 
 # The suite on JOBS pytest-xdist workers. tests/conftest.py groups the tests (--dist loadgroup,
-# xdist_group): every real-browser test in one group (one Chromium drawing at a time, started
-# first, as it is the longest), tests/report/ in one, every other module in its own. Then the
-# few `serial` tests, alone (they measure what the machine gives them). Both stages always run.
-JOBS ?= 4
+# xdist_group): the real-browser tests in three groups (three workers, each with its own
+# Chromium, started first, as they are the longest), tests/report/ in one, every other module in
+# its own. Most of a test's time is waiting (on a browser, a server, a child process), so there
+# are more workers than cores. Then the few `serial` tests, alone (they measure what the machine
+# gives them). Both stages always run.
+JOBS ?= 6
 test: install-test chromium
 	status=0; \
 	$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not serial" || status=1; \
@@ -56,8 +58,11 @@ test: install-test chromium
 	exit $$status
 
 # The inner loop: no browser, no live server, nothing slow (physics, report, the app's logic).
+# These tests compute rather than wait: a worker more than the cores, no more (each worker
+# imports and collects the whole suite before its first test).
+FAST_JOBS ?= 3
 test-fast: install-test
-	$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not browser and not server and not slow"
+	$(PY) -m pytest -n $(FAST_JOBS) --dist loadgroup --no-loadscope-reorder -m "not browser and not server and not slow"
 
 bench: install
 	$(PY) -m poinsot.physics.tools.benchmark

@@ -83,20 +83,66 @@ BROWSER_ELSEWHERE = frozenset(
 )
 
 
+#: The real-browser tests in three groups, each on a worker of its own with a Chromium of its
+#: own (software WebGL takes a core while it draws: three draw at once, not more), balanced by
+#: their durations at rest (``--durations=0``: under 300 s each). A browser file that is not
+#: listed joins the last group (with tests/app's browser test and the small browser files).
+BROWSER_GROUPS = {
+    "tests/browser/test_picture_page.py": "browser-1",
+    "tests/browser/test_exports_page.py": "browser-1",
+    "tests/browser/test_strobe_picture.py": "browser-1",
+    "tests/browser/test_sphere_pointing.py": "browser-1",
+    "tests/browser/test_uploads_page.py": "browser-1",
+    "tests/browser/test_video.py": "browser-2",
+    "tests/browser/test_video_page.py": "browser-2",
+    "tests/browser/test_links_page.py": "browser-2",
+    "tests/browser/test_touch_page.py": "browser-2",
+    "tests/browser/test_challenges_page.py": "browser-2",
+    "tests/browser/test_live_page.py": "browser-3",
+    "tests/browser/test_scenes_page.py": "browser-3",
+}
+BROWSER_LAST_GROUP = "browser-3"
+#: Groups that take a minute or more without a browser: they start right after the browser
+#: groups (a long group started last would be the suite's long pole).
+LONG_GROUPS = (
+    "tests/app/test_workers.py",
+    "tests/app/test_load.py",
+    "tests/physics/test_accuracy.py",
+    "report",
+    "tests/physics/test_reference.py",
+    "tests/physics/test_properties.py",
+    "tests/app/test_cli_fit.py",
+    "tests/physics/test_regimes.py",
+    "tests/app/test_server.py",
+)
+
+
 def xdist_group(nodeid: str) -> str:
-    """The worker group of a test (``make test``: pytest-xdist, ``--dist loadgroup``): every
-    real-browser test in one group, so that one worker drives one Chromium at a time (its
-    software rendering takes a core of its own); tests/report/ in one (``quick_report`` and
-    ``small_study`` are built once); every other module in its own (its fixtures are built
-    once). From the node id alone: xdist's controller collects nothing."""
+    """The worker group of a test (``make test``: pytest-xdist, ``--dist loadgroup``): the
+    real-browser tests in the :data:`BROWSER_GROUPS`, so that each Chromium draws for one
+    worker; tests/report/ in one (``quick_report`` and ``small_study`` are built once); every
+    other module in its own (its fixtures are built once). From the node id alone: xdist's
+    controller collects nothing."""
     path = nodeid.split("::")[0]
     if path.startswith("tests/browser/") or nodeid.split("[")[0] in BROWSER_ELSEWHERE:
-        return "browser"
+        return BROWSER_GROUPS.get(path, BROWSER_LAST_GROUP)
     if path.startswith("tests/report/"):
         return "report"
     return path
 
 
+def group_rank(nodeid: str) -> tuple[int, int]:
+    """Where a test's group starts: the browser groups first (the longest), then the
+    :data:`LONG_GROUPS`, then the others in their collection order."""
+    group = xdist_group(nodeid)
+    if group.startswith("browser-"):
+        return (0, int(group.removeprefix("browser-")))
+    if group in LONG_GROUPS:
+        return (1, LONG_GROUPS.index(group))
+    return (2, 0)
+
+
+@pytest.hookimpl(optionalhook=True)  # `-p no:xdist` leaves the hook unknown: no error then
 def pytest_xdist_make_scheduler(config: pytest.Config, log):
     """``--dist loadgroup`` by :func:`xdist_group` (xdist's own reads ``xdist_group`` marks
     through ``item._nodeid``, which pytest 9 no longer has). A worker takes a group whole."""
@@ -112,18 +158,20 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log):
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Mark the tests by what they start; the browser group first (it is the longest: with
-    ``--no-loadscope-reorder`` a worker starts on it at once). The same order in every worker,
-    as xdist requires."""
+    """Mark the tests by what they start; the longest groups first (:func:`group_rank`: with
+    ``--no-loadscope-reorder`` the first workers start on them at once). The same order in every
+    worker, as xdist requires."""
     for item in items:
         fixtures = set(getattr(item, "fixturenames", ()))
         if fixtures & BROWSER_FIXTURES and item.get_closest_marker("browser") is None:
             item.add_marker(pytest.mark.browser)
         if fixtures & SERVER_FIXTURES:
             item.add_marker(pytest.mark.server)
-        if item.get_closest_marker("browser") and xdist_group(item.nodeid) != "browser":
+        if item.get_closest_marker("browser") and not xdist_group(item.nodeid).startswith(
+            "browser-"
+        ):
             raise pytest.UsageError(f"{item.nodeid} drives a browser: add it to BROWSER_ELSEWHERE")
-    items.sort(key=lambda item: xdist_group(item.nodeid) != "browser")
+    items.sort(key=lambda item: group_rank(item.nodeid))
 
 
 # -- servers and probes ------------------------------------------------------------------
