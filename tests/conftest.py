@@ -107,6 +107,7 @@ BROWSER_LAST_GROUP = "browser-3"
 LONG_GROUPS = (
     "tests/app/test_workers.py",
     "tests/app/test_load.py",
+    "tests/app/test_follow.py",
     "tests/physics/test_accuracy.py",
     "report",
     "tests/physics/test_reference.py",
