@@ -509,9 +509,15 @@ def test_projector_mode_folds_the_panels_and_thickens_the_picture(poinsot_app, o
     look = session.scene.look
     assert look is palette.look(True, projector=True)
     assert wait_until(lambda: page.canvas_box()["width"] > 0.85 * 1280, 10), page.canvas_box()
-    page.page.wait_for_timeout(1500)
-    after = hue_mask(page.screenshot_rgb(), look.herpolhode).sum()
-    assert after > 1.6 * before, (before, after)
+    # The thicker lines are drawn once the browser has taken the restyle: wait for it (a busy
+    # software-WebGL page can take seconds), the threshold unchanged.
+    counts: list[int] = []
+
+    def thickened() -> bool:
+        counts.append(int(hue_mask(page.screenshot_rgb(), look.herpolhode).sum()))
+        return counts[-1] > 1.6 * before
+
+    assert wait_until(thickened, 15, poll=0.5), (before, counts)
     assert before_box["width"] < 0.6 * 1280
     # A column opened from its strip shows its text large.
     session.client.gui.main_panel.expand()
