@@ -45,10 +45,10 @@ run: install
 	$(VENV)/bin/poinsot serve --host $(HOST) --port $(PORT)
 
 # The suite on JOBS pytest-xdist workers. tests/conftest.py groups the tests (--dist loadgroup,
-# xdist_group): the real-browser tests in two groups (two workers, each with its own Chromium,
-# started first, as they are the longest), tests/report/ in one, every other module in its own.
-# Most of a test's time is waiting (on a browser, a server, a child process), so there are more
-# workers than cores (six workers beside three Chromiums made the suite slower, not faster). Then the few `serial` tests, alone (they measure what the machine
+# xdist_group): the real-browser tests in one group (one worker with its own Chromium, started
+# first, as it is the longest; more Chromiums on two cores made browser tests flaky),
+# tests/report/ in one, every other module in its own. Most of a test's time is waiting (on a
+# browser, a server, a child process), so there are more workers than cores. Then the few `serial` tests, alone (they measure what the machine
 # gives them). Both stages always run.
 JOBS ?= 4
 test: install-test chromium
