@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 from poinsot.app.arguments import bounded_float, non_negative_float, positive_int
-from poinsot.app.cli_types import preset_type, scene_type, video_file, video_size, view_type
+from poinsot.app.cli_types import add_preset_or_scene, video_file, video_size, view_type
 from poinsot.app.exports.screenshot import (
     EXIT_NO_BROWSER,
     THEME_BACKGROUND,
@@ -37,10 +37,9 @@ from poinsot.app.exports.video import (
     check_clip,
     film,
 )
-from poinsot.app.presets import PRESETS, Preset
+from poinsot.app.presets import Preset
 from poinsot.app.scene.cameras import CAMERA_NAMES, RIDE_ALONG, space_view
 from poinsot.app.scene.view import View
-from poinsot.app.scenes import scene_names
 from poinsot.app.scenes.spec import SceneSpec
 
 PROG = "poinsot video"
@@ -50,21 +49,7 @@ PLAIN_STEPS = (0.25, 0.5, 0.75, 1.0)
 
 def add_video_arguments(parser: argparse.ArgumentParser) -> None:
     """The options of ``poinsot video``."""
-    which = parser.add_mutually_exclusive_group()
-    which.add_argument(
-        "--preset",
-        dest="scene",
-        type=preset_type,
-        default=PRESETS[0].key,
-        metavar="{" + ",".join(p.key for p in PRESETS) + "}",
-        help="preset to film",
-    )
-    which.add_argument(
-        "--scene",
-        type=scene_type,
-        metavar="NAME",
-        help="or a scene: " + ", ".join(scene_names()),
-    )
+    add_preset_or_scene(parser, "scene", "film")
     parser.add_argument(
         "--seconds",
         type=bounded_float(0.0, MAX_SECONDS, open_low=True),

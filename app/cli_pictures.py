@@ -13,11 +13,10 @@ import sys
 
 from poinsot.app.arguments import bounded_float, non_negative_float, output_file
 from poinsot.app.cli_motion import add_strobe_arguments
-from poinsot.app.cli_types import fixed_view_type, preset_type, scene_type, size_type, view_type
+from poinsot.app.cli_types import add_preset_or_scene, fixed_view_type, size_type, view_type
 from poinsot.app.exports.html import HTML_FPS, HTML_MAX_SECONDS
-from poinsot.app.presets import PRESETS, Preset
+from poinsot.app.presets import Preset
 from poinsot.app.scene.cameras import CAMERA_NAMES, RIDE_ALONG
-from poinsot.app.scenes import scene_names
 from poinsot.app.scenes.spec import SceneSpec
 
 
@@ -63,24 +62,7 @@ def export_html(
 
 
 def add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
-    keys = "{" + ",".join(p.key for p in PRESETS) + "}"
-    which = parser.add_mutually_exclusive_group()
-    which.add_argument(
-        "--preset",
-        dest="scene",
-        type=preset_type,
-        default=PRESETS[0].key,
-        metavar=keys,
-        help="preset to draw",
-    )
-    which.add_argument(
-        "--scene",
-        type=scene_type,
-        metavar="NAME",
-        help="a scene by name ("
-        + ", ".join(scene_names())
-        + "), or a preset by key or label, e.g. 'Sphere (a cube)'",
-    )
+    add_preset_or_scene(parser, "scene", "draw")
     parser.add_argument(
         "--time",
         dest="t",
@@ -118,18 +100,7 @@ def add_screenshot_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_export_html_arguments(parser: argparse.ArgumentParser) -> None:
-    keys = "{" + ",".join(p.key for p in PRESETS) + "}"
-    which = parser.add_mutually_exclusive_group()
-    which.add_argument(
-        "--preset", type=preset_type, default=PRESETS[0].key, metavar=keys, help="preset to record"
-    )
-    which.add_argument(
-        "--scene",
-        dest="preset",
-        type=scene_type,
-        metavar="NAME",
-        help="or a scene to record: " + ", ".join(scene_names()),
-    )
+    add_preset_or_scene(parser, "preset", "record")
     parser.add_argument(
         "--seconds",
         type=bounded_float(0.0, HTML_MAX_SECONDS, open_low=True),

@@ -13,9 +13,9 @@ from poinsot.app.exports.screenshot import parse_size, resolve_scene
 from poinsot.app.exports.video import FORMATS as VIDEO_FORMATS
 from poinsot.app.exports.video import MAX_SIZE as VIDEO_MAX_SIZE
 from poinsot.app.live.ui.links import LinkError, parse
-from poinsot.app.presets import Preset, preset_by_key
+from poinsot.app.presets import PRESETS, Preset, preset_by_key
 from poinsot.app.scene.cameras import RIDE_ALONG, canonical
-from poinsot.app.scenes import scene_by_name
+from poinsot.app.scenes import scene_by_name, scene_names
 from poinsot.app.scenes.spec import SceneSpec
 
 
@@ -31,6 +31,29 @@ def scene_type(name: str) -> Preset | SceneSpec:
         return resolve_scene(name)
     except KeyError as exc:
         raise argparse.ArgumentTypeError(exc.args[0]) from exc
+
+
+def add_preset_or_scene(parser: argparse.ArgumentParser, dest: str, verb: str) -> None:
+    """``--preset KEY`` or ``--scene NAME`` (a scene, or a preset by key or label), one of the
+    two, into ``dest`` (the first preset if neither): what an offline command ``verb``s."""
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument(
+        "--preset",
+        dest=dest,
+        type=preset_type,
+        default=PRESETS[0].key,
+        metavar="{" + ",".join(p.key for p in PRESETS) + "}",
+        help=f"preset to {verb}",
+    )
+    which.add_argument(
+        "--scene",
+        dest=dest,
+        type=scene_type,
+        metavar="NAME",
+        help=f"or a scene to {verb} by name ("
+        + ", ".join(scene_names())
+        + "), or a preset by key or label, e.g. 'Sphere (a cube)'",
+    )
 
 
 def scene_only_type(name: str) -> SceneSpec:
