@@ -28,6 +28,7 @@ from typing import Any
 
 import websockets
 
+from poinsot.app.live.hardening.guard import MESSAGE_BURST, MESSAGE_RATE
 from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.load import crafted, procfs
 from poinsot.app.load.children import Child
@@ -40,8 +41,11 @@ PHASE = "hostile"
 #: Each crafted message is sent this many times, each HTTP/1.0 request too.
 ROUNDS = 3
 #: Values no browser sends for a widget (the GUI's crafted inputs).
-#: (Within one client's message burst, with the rest: the budget is the flood phase's matter.)
 JUNK: list[Any] = [math.nan, -math.inf, 1e300, "abc", None, [1, 2]]
+#: The crafted GUI inputs keep within half the message budget (the budget is the flood phase's
+#: matter: a message beyond it is dropped unread, and a dropped 1 MB string would close nothing).
+PACE = MESSAGE_RATE / 2
+FREE = MESSAGE_BURST / 2
 
 
 def _barrage_main(
@@ -88,6 +92,21 @@ class FrameCount:
         return (self.frames - start) / seconds
 
 
+class _Paced:
+    """Sends no faster than the budget refills: the first :data:`FREE` at once, then
+    :data:`PACE` a second."""
+
+    def __init__(self, probe: Probe, outcomes: Counter[str]) -> None:
+        self.probe, self.outcomes = probe, outcomes
+        self._start = time.monotonic()
+
+    def __call__(self, message: Any) -> None:
+        due = self._start + max(0.0, self.outcomes["sent"] - FREE) / PACE
+        time.sleep(max(0.0, due - time.monotonic()))
+        self.probe.send(message)
+        self.outcomes["sent"] += 1
+
+
 def _crafted_gui(port: int, innocent: Probe) -> Counter[str]:
     """A client of its own sends every junk value to every input, values for the innocent
     client's widgets, an upload to a slider, then a 1 MB string (closes it); the outcomes."""
@@ -97,24 +116,22 @@ def _crafted_gui(port: int, innocent: Probe) -> Counter[str]:
             return Counter({"no session": 1})
         own = list(hostile.snapshot()[1])
         slider = own[0] if own else "x"
+        send = _Paced(hostile, outcomes)
         try:
             for uuid in own:
                 for junk in JUNK:
-                    hostile.set_value(uuid, junk)
-                    outcomes["sent"] += 1
+                    send(wire_message("GuiUpdateMessage", uuid, {"value": junk}))
             for uuid in innocent.snapshot()[1]:  # another client's widgets
-                hostile.set_value(uuid, 0.0)
-                outcomes["sent"] += 1
-            start = wire_message("FileTransferStartUpload", slider, "t", "a.stl", "x", 3, 3_000_000)
-            hostile.send(start)
+                send(wire_message("GuiUpdateMessage", uuid, {"value": 0.0}))
+            send(wire_message("FileTransferStartUpload", slider, "t", "a.stl", "x", 3, 3_000_000))
             for k in range(3):
-                hostile.send(wire_message("FileTransferPart", slider, "t", k, b"\0" * 1_000_000))
-            hostile.set_value(slider, "x" * 1_000_000)
-            outcomes["sent"] += 5
+                send(wire_message("FileTransferPart", slider, "t", k, b"\0" * 1_000_000))
+            send(wire_message("GuiUpdateMessage", slider, {"value": "x" * 1_000_000}))
         except websockets.ConnectionClosed:
             outcomes["closed early"] += 1
         closed = hostile.wait_for(lambda p: p.closed, 60)
-        outcomes["closed 1008" if closed and hostile.close_code == 1008 else "not closed"] += 1
+        code = hostile.close_code if closed else None
+        outcomes["closed 1008" if code == 1008 else f"closed {code}" if closed else "open"] += 1
     return outcomes
 
 
@@ -165,8 +182,9 @@ def _outcome_figures(
         value = 1.0 if total and counts[good] == total else 0.0
         figures.append(Figure(PHASE, name, value, text, COMPLETES))
     closed = gui["closed 1008"] == 1
-    text = (
-        f"{gui['sent']} sent; sender closed at the 1 MB string: {closed}; others unhurt: {unhurt}"
+    ends = ", ".join(f"{k} {n}" for k, n in gui.items() if k != "sent")
+    text = f"{gui['sent']} sent ({ends}); sender closed (1008) at the end: {closed}; " + (
+        f"others unhurt: {unhurt}"
     )
     figures.append(Figure(PHASE, "crafted GUI inputs", float(closed and unhurt), text, COMPLETES))
     return figures
