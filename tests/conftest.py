@@ -76,7 +76,7 @@ def chromium_or_fail() -> str:
 #: Fixtures that start a live server or a browser: a test that uses one is marked ``server``
 #: (or ``browser``), which ``make test-fast`` leaves out.
 SERVER_FIXTURES = frozenset({"make_app", "poinsot_app", "make_probe", "probe"})
-BROWSER_FIXTURES = frozenset({"chromium", "open_page"})
+BROWSER_FIXTURES = frozenset({"chromium", "open_page", "open_module_page"})
 #: Real-browser tests outside tests/browser/ (collection fails if one is not listed).
 BROWSER_ELSEWHERE = frozenset(
     {"tests/app/test_ghost.py::test_the_ghost_shows_a_second_ellipsoid_in_the_browser"}
@@ -165,8 +165,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 
 # -- servers and probes ------------------------------------------------------------------
-@pytest.fixture
-def make_app() -> Iterator[Callable[..., PoinsotApp]]:
+@contextlib.contextmanager
+def _app_maker() -> Iterator[Callable[..., PoinsotApp]]:
     apps: list[PoinsotApp] = []
 
     def make(preset: Preset = DEFAULT_PRESET, **kwargs) -> PoinsotApp:
@@ -174,9 +174,26 @@ def make_app() -> Iterator[Callable[..., PoinsotApp]]:
         apps.append(app)
         return app
 
-    yield make
-    for app in apps:
-        app.stop()
+    try:
+        yield make
+    finally:
+        for app in apps:
+            app.stop()
+
+
+@pytest.fixture
+def make_app() -> Iterator[Callable[..., PoinsotApp]]:
+    """Served apps for one test (stopped after it)."""
+    with _app_maker() as make:
+        yield make
+
+
+@pytest.fixture(scope="module")
+def make_module_app() -> Iterator[Callable[..., PoinsotApp]]:
+    """Served apps shared by the tests of one module (stopped after its last test): for tests
+    that each open a page of their own on the same app."""
+    with _app_maker() as make:
+        yield make
 
 
 @pytest.fixture
@@ -386,8 +403,8 @@ HIDE_SOFTWARE_WEBGL_NOTICE_JS = """(() => {
 })();"""
 
 
-@pytest.fixture
-def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
+@contextlib.contextmanager
+def _page_opener(chromium) -> Iterator[Callable[..., BrowserPage]]:
     contexts = []
 
     def open_(url: str, width: int = 1280, height: int = 720, **options) -> BrowserPage:
@@ -410,9 +427,25 @@ def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
         page.locator("canvas").first.wait_for(state="visible", timeout=20000)
         return BrowserPage(page, errors)
 
-    yield open_
-    for context in contexts:
-        context.close()
+    try:
+        yield open_
+    finally:
+        for context in contexts:
+            context.close()
+
+
+@pytest.fixture
+def open_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
+    """Pages for one test (closed after it)."""
+    with _page_opener(chromium) as open_:
+        yield open_
+
+
+@pytest.fixture(scope="module")
+def open_module_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
+    """Pages shared by the tests of one module (closed after its last test)."""
+    with _page_opener(chromium) as open_:
+        yield open_
 
 
 # -- the report's study (one conftest for the whole suite: a second conftest.py in a subfolder
