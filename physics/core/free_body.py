@@ -26,7 +26,6 @@ a ValueError says what is out of range and what to change.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import overload
 
 import numpy as np
@@ -35,11 +34,11 @@ from scipy.spatial.transform import Rotation
 
 from poinsot.physics.core.classification import SortedState, classify
 from poinsot.physics.core.evaluation import Evaluator
-from poinsot.physics.core.exact import ldexp
 from poinsot.physics.core.initial_state import attitude_checked, omega_checked
 from poinsot.physics.core.regime import Regime
 from poinsot.physics.core.relabelling import sorting_map
 from poinsot.physics.core.rotations import rotate, rotate_vector
+from poinsot.physics.core.units import SLOWER, in_units, time_in_units, vector_in_units
 from poinsot.physics.core.validation import (
     IDENTITY_ATTITUDE,
     MAX_POINTS,
@@ -61,11 +60,6 @@ Vector = np.ndarray[tuple[int], np.dtype[np.float64]]
 Stack = np.ndarray[tuple[int, int], np.dtype[np.float64]]
 Array = NDArray[np.float64]
 
-# Rate [1/time] and time are inverse: in a shorter time unit (ms for s) ω0 is a smaller number
-# and a time a larger one.
-_SLOWER = "use a shorter time unit (then ω0 and the rates are smaller numbers, the times larger)"
-_FASTER = "use a longer time unit (then ω0 and the rates are larger numbers, the times smaller)"
-_LARGER = "express the moments or ω0 in larger units"
 _IDENTITY_QUAT = (0.0, 0.0, 0.0, 1.0)
 
 
@@ -224,7 +218,8 @@ class FreeRigidBody:
     def _set_invariants(self, s: SortedState, identity: bool) -> None:
         """D, the invariable plane, 2T and L in the scaled units, read back by exact powers of
         two: they over/underflow only where the physical value itself is out of double range,
-        and an overflowing one raises a ValueError when it is read (see :func:`_in_units`)."""
+        and an overflowing one raises a ValueError when it is read
+        (:func:`~poinsot.physics.core.units.in_units`)."""
         (J1, J2, J3), (w1, w2, w3) = s.J, s.w
         m = (J1 * w1, J2 * w2, J3 * w3)
         G = math.hypot(*m)  # m·m would underflow for a moment ~1e-300
@@ -345,28 +340,28 @@ class FreeRigidBody:
     def plane_distance(self) -> float:
         """``2T/G`` [rad per time unit], the distance of the invariable plane ``x·L = 2T`` from
         the fixed point [FM06 Eq. 7.55]."""
-        return _in_units(
-            self._plane_distance_scaled, self._w_exp, "the distance 2T/|L| of the plane", _SLOWER
+        return in_units(
+            self._plane_distance_scaled, self._w_exp, "the distance 2T/|L| of the plane", SLOWER
         )
 
     @property
     def energy(self) -> float:
         """Kinetic energy ``T = ω·I·ω / 2`` (constant) [moment units × (rad/time)²]."""
         exp2 = self._I_exp + 2 * self._w_exp
-        return _in_units(0.5 * self._two_T_scaled, exp2, "the kinetic energy")
+        return in_units(0.5 * self._two_T_scaled, exp2, "the kinetic energy")
 
     @property
     def angular_momentum(self) -> Vector:
         """(3,) angular momentum ``L = R(0) I ω0`` in the space frame (constant)."""
         exp2 = self._I_exp + self._w_exp
-        return _vector_in_units(self._L_scaled, exp2, "the angular momentum L")
+        return vector_in_units(self._L_scaled, exp2, "the angular momentum L")
 
     @property
     def semi_axes(self) -> Vector:
         """(3,) semi-axes ``sqrt(2T/Ii)`` of the energy ellipsoid ``x·I·x = 2T`` (caller order)
         [rad per time unit]."""
         # From the scaled state (2T/I_i = w_ref² · 2T_s/I_s,i): no underflow at ω ~ 1e-200.
-        return _vector_in_units(
+        return vector_in_units(
             np.sqrt(self._two_T_scaled / np.array(self._inertia_scaled)),
             self._w_exp,
             "the largest semi-axis of the energy ellipsoid",
@@ -375,12 +370,12 @@ class FreeRigidBody:
     @property
     def frequency(self) -> float:
         """λ, the rate of the elliptic argument ``u = u0 + λ t`` [1/time] (0 if uniform)."""
-        return _in_units(self._form.lam, self._w_exp, "the frequency λ", _SLOWER)
+        return in_units(self._form.lam, self._w_exp, "the frequency λ", SLOWER)
 
     @property
     def mean_precession_rate(self) -> float:
         """Mean rate of the precession angle φ about L [rad per time unit]."""
-        return _in_units(self._form.nu, self._w_exp, "the mean precession rate", _SLOWER)
+        return in_units(self._form.nu, self._w_exp, "the mean precession rate", SLOWER)
 
     @property
     def period(self) -> float:
@@ -389,7 +384,7 @@ class FreeRigidBody:
         num, rate = self._form.period_pair
         if rate == 0.0:
             return math.inf
-        return _time_in_units(
+        return time_in_units(
             num / rate, -self._w_exp, "the period of ω", math.log10(num) - math.log10(rate)
         )
 
@@ -400,7 +395,7 @@ class FreeRigidBody:
         if rate == 0.0:
             return 0.0
         nu = self._form.nu
-        return _in_units(
+        return in_units(
             nu * (num / rate),  # dimensionless: no scale
             0,
             "the precession angle per period",
@@ -416,7 +411,7 @@ class FreeRigidBody:
         nu = self._form.nu
         if self._form.period_pair[1] == 0.0 or nu == 0.0:
             return math.inf
-        return _time_in_units(
+        return time_in_units(
             2.0 * math.pi / nu,
             -self._w_exp,
             "the precession period",
@@ -428,58 +423,3 @@ class FreeRigidBody:
             f"FreeRigidBody(inertia={self.inertia.tolist()}, omega0={self.omega0.tolist()}, "
             f"regime={self.regime.value!r})"
         )
-
-
-def _in_units(
-    scaled: float,
-    exp2: int,
-    what: str,
-    advice: str = _LARGER,
-    log10_scaled: Callable[[], float] | None = None,
-    units: str = " in your units",
-) -> float:
-    """``scaled · 2^exp2``, or a ValueError if that overflows.
-
-    The scaled value is exact and finite; only its size in the caller's units may exceed the
-    double range: reading it then raises a ValueError that says so instead of returning inf,
-    while the motion itself, ω(t) and R(t), stays available. ``log10_scaled()`` gives the size
-    of a scaled value that itself overflowed (a period ~1e320 of a spin ~1e-320).
-    """
-    value = ldexp(scaled, exp2)
-    if math.isfinite(value):
-        return value
-    size = math.log10(abs(scaled)) if log10_scaled is None else log10_scaled()
-    raise _too_large(size, exp2, what, advice, units)
-
-
-def _time_in_units(scaled: float, exp2: int, what: str, log10_scaled: float) -> float:
-    """:func:`_in_units` for a period: refused also where it underflows to 0 (a spin ~1e306
-    about a body with moments 1e66 apart turns in 1e-372 time units), since a period of 0
-    would divide by zero wherever it is used."""
-    value = _in_units(scaled, exp2, what, _FASTER, lambda: log10_scaled)
-    if value != 0.0 or scaled == 0.0:
-        return value
-    decades = log10_scaled + exp2 * math.log10(2.0)
-    raise ValueError(
-        f"{what} of this body is about 1e{decades:.0f} in your units, below the smallest "
-        f"double-precision number (5e-324): {_SLOWER} (omega(t) and attitude(t) are still "
-        "available)"
-    )
-
-
-def _vector_in_units(scaled: Array, exp2: int, what: str) -> Vector:
-    """:func:`_in_units` for each entry of a (3,) array."""
-    value = np.array([ldexp(x, exp2) for x in scaled.tolist()])
-    if all(map(math.isfinite, value.tolist())):
-        return value
-    size = math.log10(float(np.max(np.abs(scaled))))
-    raise _too_large(size, exp2, what, _LARGER, " in your units")
-
-
-def _too_large(size: float, exp2: int, what: str, advice: str, units: str) -> ValueError:
-    decades = size + exp2 * math.log10(2.0)
-    return ValueError(
-        f"{what} of this body is about 1e{decades:.0f}{units}, beyond the largest "
-        f"double-precision number (1.8e308): {advice} (omega(t) and attitude(t) are "
-        "still available)"
-    )
