@@ -186,6 +186,16 @@ def test_followers_share_one_build_mirror_what_is_shown_and_cannot_point(poinsot
     # The followers' frames read the same batches: at most one physics call per batch.
     assert shared.sampler.evaluations - evaluations <= 2
 
+    # The lead's new speed: the followers share the motion on the new grid too.
+    _set(lead, "Speed", 0.5)
+    for follower in followers:
+        assert wait_until(lambda f=follower: f.clock.speed == pytest.approx(0.5), 30)
+    assert wait_until(lambda: followers[0].scene.motion is not shared, 30)
+    regridded = followers[0].scene.motion
+    assert wait_until(lambda: all(f.scene.motion is regridded for f in followers), 30)
+    assert regridded is not shared and regridded.body.D == pytest.approx(2.3)
+    assert motions.builds == builds + 2
+
     # The lead's trail length and the elements it hides, on every follower.
     _set(lead, "Trail length", 500)
     _set(lead, "principal axes", False)
