@@ -12,6 +12,7 @@ inflate; viser's own encoding, on its event loop, is not in it (the same for bot
 from __future__ import annotations
 
 import argparse
+import functools
 import statistics
 import threading
 import time
@@ -40,7 +41,7 @@ def _measure(session: Session, rebuilds: int) -> tuple[list[float], list[float]]
         motion = session._shared_motion(params, solid)
         assert motion is not None
         motion.geometry.polhode_segments()  # what the first follower's view makes once
-        motion.memo("readouts", lambda m=motion: readouts.markdown(m.body))
+        motion.memo("readouts", functools.partial(readouts.markdown, motion.body))
         session._desired = params
         start = time.thread_time()
         session._rebuild()
@@ -61,7 +62,12 @@ def main(argv: list[str] | None = None) -> None:
         session = app.wait_for_sessions(1, 30)[0]
         result: list[tuple[list[float], list[float]]] = []
         done = threading.Event()
-        session.post(lambda: (result.append(_measure(session, args.rebuilds)), done.set()))
+
+        def run() -> None:
+            result.append(_measure(session, args.rebuilds))
+            done.set()
+
+        session.post(run)
         if not done.wait(600):
             raise SystemExit("the rebuilds did not end within 10 minutes")
         own, shared = result[0]
