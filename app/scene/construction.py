@@ -43,14 +43,13 @@ from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.geometry import L_OVERSHOOT, Geometry
 from poinsot.app.scene.label_nodes import Pose
 from poinsot.app.scene.labels import Camera, Placement, Steps, finish, lay_out_in_steps
+from poinsot.app.scene.motion import Motion
 from poinsot.app.scene.nodes import Drawing, OmegaArrow, Trace, draw
 from poinsot.app.scene.palette import Look
 from poinsot.app.scene.sampling import FIRST_BATCH, MotionSampler
 from poinsot.app.scene.trail import Trail
 from poinsot.physics import FreeRigidBody
 
-#: Trace points are at most this far apart [display units] (see scene/sampling.py).
-MAX_CHORD = 0.02
 #: After a stall of the frame loop, the grid samples missed are drawn from the exact solution
 #: (one physics call, however many frames were missed), up to this many; after a longer gap
 #: the traces are lifted (a new piece starts, joined to nothing) and this frame draws its last
@@ -98,7 +97,7 @@ class PoinsotScene:
         self._omega_arrow: viser.ArrowsHandle | None = None
         self._body: FreeRigidBody | None = None
         self._geometry: Geometry | None = None
-        self._sampler: MotionSampler | None = None
+        self._motion: Motion | None = None
         self._k_last: int | None = None
         self._frame: Frame | None = None
         self._batch: FrameBatch | None = None
@@ -244,19 +243,21 @@ class PoinsotScene:
         solid: Solid | None,
         t: float = 0.0,
         frame_time: float = 1.0 / 60.0,
+        motion: Motion | None = None,
     ) -> Frame:
         """Show ``body`` (and ``solid``) at time ``t``; ``frame_time`` is the simulation time one
-        frame advances (speed / frame rate). Raises ValueError, with the previous scene
-        untouched, if physics gives anything non-finite."""
-        geometry = Geometry.from_body(body, solid)
-        sampler = MotionSampler.for_body(body, geometry.trace_speed, frame_time, MAX_CHORD, t)
-        k = sampler.index(t)
-        source = sampler.batch(k, k, FIRST_BATCH)  # checked finite by the sampler
-        batch = FrameBatch.convert(source, geometry.scale, sampler.stride)
+        frame advances (speed / frame rate). ``motion``: theirs, prepared already (shared with
+        other views, :class:`~.motion.MotionCache`), else prepared here. Raises ValueError, with
+        the previous scene untouched, if physics gives anything non-finite."""
+        if motion is None:
+            motion = Motion.prepare(body, solid, frame_time, t)
+        geometry = motion.geometry
+        k = motion.sampler.index(t)
+        batch = motion.frames(k, k, FIRST_BATCH)
         with self._atomic():
-            self._body, self._geometry = body, geometry
+            self._body, self._geometry = motion.body, geometry
             self._label_epoch += 1
-            self._sampler, self._batch = sampler, batch
+            self._motion, self._batch = motion, batch
             for element in sorted(self._elements):
                 drawing = self._drawings.get(element) or self._create(element)
                 drawing.fit(geometry)
@@ -271,33 +272,45 @@ class PoinsotScene:
         for trail in self._trails.values():
             trail.clear()
         self._pending.clear()
-        self._body = self._geometry = self._sampler = self._batch = None
+        self._body = self._geometry = self._motion = self._batch = None
         self._k_last, self._frame = None, None
         self._label_epoch += 1
 
     def set_frame_time(self, frame_time: float) -> None:
         """The clock's speed changed: re-grid the motion from the time now shown."""
-        if self._body is None or self._geometry is None or self._frame is None:
+        if self._motion is None or self._frame is None:
             return
-        self._sampler = MotionSampler.for_body(
-            self._body, self._geometry.trace_speed, frame_time, MAX_CHORD, self._frame.t
-        )
+        self._motion, self._batch = self._motion.regridded(frame_time, self._frame.t), None
         self._k_last = 0
+
+    def share(self, motion: Motion) -> None:
+        """Draw the same body from ``motion`` from now on (another grid, shared with other
+        views): the traces go on from the time now shown."""
+        if self._motion is None or self._frame is None:
+            return
+        self._motion, self._batch = motion, None
+        self._body, self._geometry = motion.body, motion.geometry
+        self._k_last = motion.sampler.index(self._frame.t)
+
+    @property
+    def motion(self) -> Motion | None:
+        return self._motion
 
     def shown_time(self, t: float) -> float:
         """The grid time drawn for clock time ``t``."""
-        return self._sampler.time(self._sampler.index(t)) if self._sampler else float(t)
+        sampler = self.sampler
+        return sampler.time(sampler.index(t)) if sampler else float(t)
 
     @property
     def sampler(self) -> MotionSampler | None:
-        return self._sampler
+        return None if self._motion is None else self._motion.sampler
 
     # -- per frame -----------------------------------------------------------------------
     def advance(self, t: float) -> Frame:
         """Pose the body at clock time ``t`` (the grid time just before it) and extend the
         traces with the grid samples since the last frame. Going back in time restarts the
         traces; the same grid time again (paused) costs nothing and sends nothing."""
-        sampler = self._sampler
+        sampler = self.sampler
         if sampler is None or self._geometry is None:
             raise RuntimeError("load() a body before advance()")
         k = sampler.index(float(t))
@@ -322,12 +335,11 @@ class PoinsotScene:
             return self._draw(k_first, k, restart)
 
     def _batch_for(self, k_first: int, k_last: int) -> FrameBatch:
-        sampler, geometry = self._sampler, self._geometry
-        assert sampler is not None and geometry is not None
-        source = sampler.batch(k_first, k_last)  # checked finite once per batch
-        if self._batch is None or self._batch.source is not source:
-            self._batch = FrameBatch.convert(source, geometry.scale, sampler.stride)
-        return self._batch
+        batch = self._batch
+        if batch is None or not (batch.k0 <= k_first and k_last < batch.k0 + len(batch.t)):
+            assert self._motion is not None
+            batch = self._batch = self._motion.frames(k_first, k_last)  # checked finite once
+        return batch
 
     def _draw(self, k_first: int, k: int, restart: bool) -> Frame:
         """Send the pose at grid index ``k`` and queue the trace rows ``k_first..k``: three

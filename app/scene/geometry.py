@@ -88,6 +88,10 @@ class Geometry:
     solid_scale: np.ndarray | None  # node scale (3,) that makes solid_base the displayed solid
     trace_speed: float  # fastest trace point [display units per time unit]
     herpolhode_radius: float = 0.0  # the herpolhode's largest distance from L's axis
+    #: :meth:`polhode_segments`, made once (a shared motion's geometry serves many views).
+    _segments: list[np.ndarray] = dataclasses.field(
+        default_factory=list, init=False, compare=False, repr=False
+    )
 
     @classmethod
     def from_body(cls, body: FreeRigidBody, solid: Solid | None) -> Geometry:
@@ -132,11 +136,13 @@ class Geometry:
     def polhode_segments(self) -> np.ndarray:
         """The whole polhode as line segments (n, 2, 3) float32, closed unless on the
         separatrix."""
-        curve = self.polhode
-        if self.polhode_closed:
-            curve = np.concatenate([curve, curve[:1]])
-        curve = curve.astype(np.float32)
-        return np.stack([curve[:-1], curve[1:]], axis=1)
+        if not self._segments:
+            curve = self.polhode
+            if self.polhode_closed:
+                curve = np.concatenate([curve, curve[:1]])
+            curve = curve.astype(np.float32)
+            self._segments.append(np.stack([curve[:-1], curve[1:]], axis=1))
+        return self._segments[0]
 
     def axis_ends(self) -> np.ndarray:
         """(3, 3): row i is the tip of principal axis i+1 as drawn (past the ellipsoid)."""

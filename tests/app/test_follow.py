@@ -6,11 +6,14 @@ an event the probes receive (a widget's value, a readout's text), never on wall-
 
 from __future__ import annotations
 
+import asyncio
 import multiprocessing
 import re
+import types
 
 import pytest
 
+from poinsot.app.elements import Element
 from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.live.relay import Relay
 from poinsot.app.live.ui import links
@@ -152,6 +155,72 @@ def test_a_follower_cannot_change_its_controls_the_lead_or_another_follower(
     assert all(s.params.D == before for s in poinsot_app.sessions().values())
     assert _value(other, D) == pytest.approx(before)
     assert lead_session.follow.mode == "lead"
+
+
+def test_followers_share_one_build_mirror_what_is_shown_and_cannot_point(poinsot_app, make_probe):
+    """A lead and three followers in one process: the lead's slider move builds its body once
+    for all the followers (not once each), whose frames draw from that one motion; the lead's
+    trail length and hidden elements are mirrored; a follower's click or drag on the
+    ellipsoid is refused and told once, until it explores from here."""
+    lead = _ready(make_probe(poinsot_app))
+    _lead(lead, poinsot_app.follow.code)
+    probes = [_ready(make_probe(poinsot_app)) for _ in range(3)]
+    for probe in probes:
+        _follow(probe)
+    lead_session, *followers = sorted(
+        poinsot_app.sessions().values(), key=lambda s: s.client.client_id
+    )
+    motions = poinsot_app.follow.motions
+    builds = motions.builds
+    _set(lead, D, 2.3)
+    for probe in probes:
+        assert probe.wait_for(lambda p: _value(p, D) == pytest.approx(2.3), 30)
+    assert motions.builds == builds + 1  # one build for the three followers
+    shared = followers[0].scene.motion
+    assert shared is not None and shared.body.D == pytest.approx(2.3)
+    assert all(f.scene.motion is shared and f.body is shared.body for f in followers)
+    assert lead_session.scene.motion is not shared  # the lead's own session builds its own
+    evaluations = shared.sampler.evaluations
+    for follower in followers:
+        after_frames(follower)
+    # The followers' frames read the same batches: at most one physics call per batch.
+    assert shared.sampler.evaluations - evaluations <= 2
+
+    # The lead's new speed: the followers share the motion on the new grid too.
+    _set(lead, "Speed", 0.5)
+    for follower in followers:
+        assert wait_until(lambda f=follower: f.clock.speed == pytest.approx(0.5), 30)
+    assert wait_until(lambda: followers[0].scene.motion is not shared, 30)
+    regridded = followers[0].scene.motion
+    assert wait_until(lambda: all(f.scene.motion is regridded for f in followers), 30)
+    assert regridded is not shared and regridded.body.D == pytest.approx(2.3)
+    assert motions.builds == builds + 2
+
+    # The lead's trail length and the elements it hides, on every follower.
+    _set(lead, "Trail length", 500)
+    _set(lead, "principal axes", False)
+    for probe, follower in zip(probes, followers, strict=True):
+        assert probe.wait_for(lambda p: _value(p, "Trail length") == 500, 30)
+        assert probe.wait_for(lambda p: _value(p, "principal axes") is False, 30)
+        assert follower.scene.trail_points == 500
+        assert not follower.scene.is_visible(Element.AXES)
+
+    # A follower's pointer on the ellipsoid: refused, said once; its own again after Explore.
+    follower, probe = followers[0], probes[0]
+    pointer = follower.pointer
+    down = ((0.0, 0.0, 5.0), (0.0, 0.0, -1.0))  # through the centre: it meets the ellipsoid
+    click = types.SimpleNamespace(client=follower.client, ray_origin=down[0], ray_direction=down[1])
+    drag = types.SimpleNamespace(client=follower.client, phase="update", end_position=(0, 0, 0))
+    asyncio.run(pointer._on_drag(drag))
+    asyncio.run(pointer._on_click(click))
+    assert probe.wait_for(lambda p: _says(p, HELD), 30)
+    after_frames(follower)
+    assert pointer.starts == 0 and pointer.previews == 0 and not follower.clock.paused
+    assert follower.params == followers[1].params
+    _set(probe, "Explore from here")
+    assert probe.wait_for(lambda p: _says(p, "Exploring on your own"), 30)
+    asyncio.run(pointer._on_click(click))
+    assert wait_until(lambda: pointer.starts == 1, 30)
 
 
 def test_a_second_leader_takes_over_and_the_first_is_told(poinsot_app, make_probe):

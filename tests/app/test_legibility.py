@@ -213,8 +213,8 @@ def test_after_a_stall_no_trace_segment_cuts_through_the_body(stall):
     stays on the ellipsoid within the margin it is drawn off it, every herpolhode segment is a
     short chord."""
     from poinsot.app.elements import Element
-    from poinsot.app.scene.construction import MAX_CHORD
     from poinsot.app.scene.geometry import POLHODE_INFLATE
+    from poinsot.app.scene.motion import MAX_CHORD
     from poinsot.app.stage.served import Stage
 
     with Stage.from_preset(preset_by_key("major"), trail_points=6000) as stage:

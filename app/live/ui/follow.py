@@ -27,6 +27,8 @@ import uuid
 from collections.abc import Callable
 from typing import Any
 
+from poinsot.app.scene.motion import MotionCache
+
 #: Wrong codes from one client before its connection is closed.
 MAX_WRONG_CODES = 5
 #: The code's alphabet: no 0/O, 1/l/I to misread from a projector.
@@ -45,8 +47,9 @@ def new_code(length: int = 6) -> str:
 @dataclasses.dataclass(frozen=True)
 class LeadState:
     """What a follower shows: ``query`` (a link's query without t, speed, paused and view),
-    simulation time ``t`` at monotonic time ``at`` [s], ``paused``, ``speed`` and the lead's
-    camera (position, look-at, up: three 3-tuples), or None."""
+    simulation time ``t`` at monotonic time ``at`` [s], ``paused``, ``speed``, the lead's
+    camera (position, look-at, up: three 3-tuples) or None, the traces' length and the
+    elements hidden."""
 
     leader: str
     query: str
@@ -55,6 +58,8 @@ class LeadState:
     paused: bool
     speed: float
     camera: tuple[tuple[float, ...], ...] | None = None
+    trail: int | None = None  # the traces' length [points]
+    hidden: tuple[str, ...] = ()  # the construction's elements the lead hides (their names)
 
     def time(self, now: float) -> float:
         """Simulation time at monotonic time ``now``."""
@@ -86,6 +91,8 @@ class FollowHub:
         self._wrong: dict[int, int] = {}
         #: States delivered to this process (tests, load test).
         self.delivered = 0
+        #: The lead's bodies, built once for the lead and the followers of this process.
+        self.motions = MotionCache()
 
     # -- the lead ------------------------------------------------------------------------
     def claim(self, lead: Any, code: str, client_key: int) -> Claim:

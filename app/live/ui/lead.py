@@ -15,6 +15,7 @@ thread alone applies a state and publishes one.
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 import urllib.parse
@@ -22,9 +23,11 @@ from typing import Any
 
 import viser
 
+from poinsot.app.elements import Element
 from poinsot.app.live.hardening.backlog import close_connection
 from poinsot.app.live.ui import links
 from poinsot.app.live.ui.follow import FollowHub, LeadState
+from poinsot.app.live.ui.playback import clamp_trail
 from poinsot.app.live.ui.widgets import Sent, hold_input, on_user, set_value
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import PRESETS
@@ -41,6 +44,10 @@ HELD = (
     "You follow the lecturer: your controls show the lecturer's values. "
     "Press Explore from here to go on yourself."
 )
+
+
+#: A lead's query parsed once per process, not once per follower (it builds the body to check it).
+_parsed = functools.lru_cache(maxsize=16)(links.parse)
 
 
 def motion_query(query: str) -> str:
@@ -145,12 +152,19 @@ class LeadControls:
         self.session.clock.reset(t)
         self.say(f"Exploring on your own from the lecturer's state at t = {t:.3g}.")
 
-    def _refused(self) -> None:  # viser's loop
-        self.session.post(self._tell_held, "follow-held")
+    def _refused(self, widget: bool) -> None:  # viser's loop
+        self.session.post(
+            self._tell_held if widget else self._tell_pointer,
+            "follow-held" if widget else "pointer",
+        )
 
     def _tell_held(self) -> None:
         self._applied_query = None  # shown again, in case a change got through
         self._sync()
+        self._tell_pointer()
+
+    def _tell_pointer(self) -> None:
+        """A refused pointer changed nothing: the follower is only told (once)."""
         if not self._told:
             self._told = True
             self.say(HELD)
@@ -180,8 +194,9 @@ class LeadControls:
         lo, hi = session.playback.speed_range
         if not math.isclose(clock.speed, state.speed) and lo <= state.speed <= hi:
             clock.speed = state.speed
-            session.scene.set_frame_time(session.frame_time)
+            session.regrid()  # the worker's shared motion on the new grid
         clock.reset(state.time(time.monotonic()))
+        self._mirror_shown(state)
         session.panel.show_playback(clock.speed, clock.paused, session.scene.trail_points)
         if self.camera.value and state.camera and state.camera != self._applied_camera:
             self._applied_camera = state.camera
@@ -191,9 +206,26 @@ class LeadControls:
                 self.client.camera.position = position
                 self.client.camera.look_at = look_at
 
+    def _mirror_shown(self, state: LeadState) -> None:
+        """The lead's trail length and the elements it hides."""
+        session = self.session
+        scene = session.scene
+        if state.trail is not None and state.trail != scene.trail_points:
+            session.playback.set_trail(clamp_trail(state.trail))
+        changed = False
+        for element in Element:
+            visible = element.name not in state.hidden
+            if element not in scene.elements:
+                scene.set_visible(element, visible)  # for when it is drawn (no message)
+            elif scene.is_visible(element) != visible:
+                scene.set_visible(element, visible)
+                changed = True
+        if changed:
+            session.panel.show_visibility(scene.is_visible)
+
     def _open(self, query: str) -> None:
         try:
-            link = links.parse(query)
+            link = _parsed(query)
         except links.LinkError as exc:  # a lead on another version: keep the last state
             self.say(f"The lecturer's state could not be shown ({exc}).")
             return
@@ -218,8 +250,8 @@ class LeadControls:
         if (
             last is None
             or now - last.at >= REPUBLISH
-            or (state.query, state.paused, state.speed, state.camera)
-            != (last.query, last.paused, last.speed, last.camera)
+            or (state.query, state.paused, state.speed, state.camera, state.trail, state.hidden)
+            != (last.query, last.paused, last.speed, last.camera, last.trail, last.hidden)
             or abs(state.t - last.time(now)) > JUMP * max(1.0, abs(state.speed))
         ):
             self._published = state
@@ -227,7 +259,7 @@ class LeadControls:
 
     def _state(self, token: str, now: float) -> LeadState:
         session = self.session
-        clock, frame = session.clock, session.frame
+        clock, frame, scene = session.clock, session.frame, session.scene
         # Paused: the time of the frame on screen, which the followers then show exactly.
         t = frame.t if clock.paused and frame is not None else clock.now()
         return LeadState(
@@ -238,6 +270,8 @@ class LeadControls:
             paused=clock.paused,
             speed=clock.speed,
             camera=_camera(self.client),
+            trail=scene.trail_points,
+            hidden=tuple(e.name for e in sorted(scene.elements) if not scene.is_visible(e)),
         )
 
     def now(self, clock: Any) -> float:

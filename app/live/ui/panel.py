@@ -338,6 +338,12 @@ class ControlPanel:
             if element in elements:
                 set_value(box, visible(element))
 
+    def show_visibility(self, visible: Callable[[Element], bool]) -> None:
+        """Tick the shown elements' boxes as ``visible`` says (the scene's, mirrored)."""
+        for element, box in self._boxes.items():
+            if box.visible:
+                set_value(box, visible(element))
+
     def _visibility_callback(self, element: Element) -> Callable[[Sent], None]:
         return lambda handle: self.actions.set_visible(element, bool(handle.value))
 

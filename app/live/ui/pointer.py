@@ -38,6 +38,7 @@ from numpy.typing import ArrayLike
 
 from poinsot.app.elements import Element
 from poinsot.app.live.ui.clock import SimClock
+from poinsot.app.live.ui.widgets import refuse_held
 from poinsot.app.parameters import Parameters, Vector
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
@@ -127,10 +128,14 @@ class StartPointer(Generic[S]):
         node.on_click(self._on_click)
 
     async def _on_click(self, event: viser.SceneNodePointerEvent) -> None:
+        if refuse_held(event.client):  # a follower's: refused, and told once
+            return
         ray: Ray = (event.ray_origin, event.ray_direction)
         self.session.post(lambda: self.release(ray))
 
     async def _on_drag(self, event: viser.SceneNodeDragEvent) -> None:
+        if refuse_held(event.client):
+            return
         arrived = time.perf_counter()
         x, y, z = (float(v) for v in event.client.camera.position)
         end = event.end_position

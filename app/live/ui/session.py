@@ -18,9 +18,10 @@ from collections.abc import Callable
 
 import viser
 
-from poinsot.app.elements import ALL_ELEMENTS, Control, Element, Plot
+from poinsot.app.elements import ALL_ELEMENTS, Control, Element, Plot, Solid
 from poinsot.app.live.hardening.budget import RebuildGate
 from poinsot.app.live.hardening.pacing import Outbox, Pacer, SessionStats
+from poinsot.app.live.ui import readouts
 from poinsot.app.live.ui.actions import MAX_ACTIONS, ActionQueue
 from poinsot.app.live.ui.clock import SimClock
 from poinsot.app.live.ui.follow import FollowHub
@@ -41,6 +42,7 @@ from poinsot.app.parameters import SPEED_RANGE, Parameters, drawn_solid
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, Preset
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
+from poinsot.app.scene.motion import Motion
 from poinsot.app.scene.view import DEFAULT_VIEW, View, apply_theme
 from poinsot.app.scenes.spec import SceneSpec, Value
 from poinsot.physics import FreeRigidBody
@@ -94,6 +96,7 @@ class Session:
         self._base_inertia = self.params.inertia
         self._dirty = True
         self.body: FreeRigidBody | None = None
+        self._solid: Solid | None = None  # the body's drawn solid
         self.frame: Frame | None = None
         self.status = ""
         self.actions = ActionQueue(max_actions)
@@ -414,17 +417,41 @@ class Session:
     def _load_body(self, params: Parameters) -> None:
         """Build the body of ``params`` (a ValueError keeps the last one), load it at t = 0 and
         mirror it into the panel and the "Motion" window."""
-        body = params.build()
-        self.clock.reset(0.0)
         solid = drawn_solid(params.inertia, self._base, self._base_inertia)
-        frame = self.scene.load(body, solid, frame_time=self.frame_time)
-        self.body, self.params, self.frame = body, params, frame
+        shared = self._shared_motion(params, solid)
+        body = params.build() if shared is None else shared.body
+        self.clock.reset(0.0)
+        frame = self.scene.load(body, solid, frame_time=self.frame_time, motion=shared)
+        self.body, self.params, self.frame, self._solid = body, params, frame, solid
         self.panel.show_parameters(params)
         motion = self.panel.motion
-        motion.show_body(body)
+        text = None if shared is None else shared.memo("readouts", lambda: readouts.markdown(body))
+        motion.show_body(body, text)
         motion.clear_plot()
         motion.record_plot(0.0, frame.omega, frame.wxyz)
         self._set_status("")
+
+    def _shared_motion(self, params: Parameters, solid: Solid | None) -> Motion | None:
+        """While following: the process's one motion of this body, on the grid of this frame
+        time from t = 0 (the first follower to ask builds it); else None."""
+        follow = getattr(self, "follow", None)  # None in the first build, before the folder
+        if follow is None or follow.mode != "follow":
+            return None
+        frame_time = self.frame_time
+        return follow.hub.motions.get(
+            (params, solid, frame_time), lambda: Motion.prepare(params.build(), solid, frame_time)
+        )
+
+    def regrid(self) -> None:
+        """The clock's speed changed (frame thread): the motion on the new grid (a follower's:
+        the process's shared one)."""
+        shared = None
+        if self.showcase is None and self.body is not None:
+            shared = self._shared_motion(self.params, self._solid)
+        if shared is None:
+            self.scene.set_frame_time(self.frame_time)
+        else:
+            self.scene.share(shared)
 
     def _reset(self) -> None:
         self.clock.reset(0.0)

@@ -35,17 +35,27 @@ from poinsot.app import viser_private
 RETIRE_SECONDS = 30.0
 #: Clients whose changes are refused (a follower's: :mod:`.lead`), by ``id()`` of their
 #: handle, each with what to call when one is refused. Set and cleared by :func:`hold_input`.
-_HELD: dict[int, Callable[[], None]] = {}
+_HELD: dict[int, Callable[[bool], None]] = {}
 
 
-def hold_input(client: Any, refused: Callable[[], None] | None) -> None:
+def hold_input(client: Any, refused: Callable[[bool], None] | None) -> None:
     """Refuse ``client``'s changes to every widget but the free ones (:func:`on_user`), each
-    put back to its last value and ``refused()`` called (on viser's loop: it must only post);
-    None accepts them again."""
+    put back to its last value and ``refused(True)`` called (on viser's loop: it must only
+    post), and its pointer on the scene (:func:`refuse_held`); None accepts them again."""
     if refused is None:
         _HELD.pop(id(client), None)
     else:
         _HELD[id(client)] = refused
+
+
+def refuse_held(client: Any) -> bool:
+    """A pointer on the scene (a click or a drag, not a widget): True, and ``refused(False)``
+    called (nothing to put back), if ``client`` is held (:func:`hold_input`)."""
+    held = None if client is None else _HELD.get(id(client))
+    if held is None:
+        return False
+    held(False)
+    return True
 
 
 def _refused(event: viser.GuiEvent[Any], handle: Any, last: Sent) -> bool:
@@ -55,7 +65,7 @@ def _refused(event: viser.GuiEvent[Any], handle: Any, last: Sent) -> bool:
         return False
     if hasattr(handle, "value"):
         handle.value = last.value
-    held()
+    held(True)
     return True
 
 
