@@ -97,6 +97,17 @@ def fraction(text: str) -> float:
     return float(in_bounds(text, float, 0, 1, wanted="give a number between 0 and 1"))
 
 
+def seconds_type(text: str) -> float:
+    """A time in seconds: a finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds")
+    return value
+
+
 def bounded_float(low: float, high: float, *, open_low: bool = False) -> Callable[[str], float]:
     """A converter for a finite number in [low, high] (or (low, high] with ``open_low``)."""
     shown = f"{'(' if open_low else '['}{low:g}, {high:g}]"

@@ -22,6 +22,7 @@ import os
 import sys
 import time
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 from poinsot.app.arguments import (
     OneLineParser,
@@ -31,17 +32,9 @@ from poinsot.app.arguments import (
     positive_int,
     run_guarded,
 )
-from poinsot.app.check_engine import add_check_engine_arguments
-from poinsot.app.cli_fit import add_fit_arguments
-from poinsot.app.cli_motion import add_video_arguments
-from poinsot.app.cli_pictures import add_export_html_arguments, add_screenshot_arguments
-from poinsot.app.cli_types import (
-    link_type,
-    scene_only_type,
-)
-from poinsot.app.presets import PRESETS, preset_by_key
-from poinsot.app.scenes import scene_names
-from poinsot.app.scenes.spec import SceneSpec
+
+if TYPE_CHECKING:
+    from poinsot.app.scenes.spec import SceneSpec
 
 DESCRIPTION = "Poinsot: torque-free rigid-body motion, live in the browser and offline."
 
@@ -75,6 +68,7 @@ def serve(
     a landing port (:mod:`poinsot.app.live.workers`). A port that cannot be served is one
     line and exit status 2."""
     from poinsot.app.live.hardening.network import PortError, board, check_port, port_problem
+    from poinsot.app.presets import preset_by_key
 
     try:
         check_port(host, port)
@@ -130,6 +124,10 @@ def benchmark(clients: list[int], seconds: float, redraws: int, video: bool, dra
 
 # -- the parser -----------------------------------------------------------------------------
 def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
+    from poinsot.app.cli_types import link_type, scene_only_type
+    from poinsot.app.presets import PRESETS
+    from poinsot.app.scenes import scene_names
+
     parser.add_argument(
         "--host",
         default="127.0.0.1",
@@ -217,6 +215,38 @@ def _add_benchmark_arguments(parser: argparse.ArgumentParser) -> None:
     parser.set_defaults(func=benchmark)
 
 
+# The commands declared in their own modules, imported only when their options are declared:
+# `poinsot fit ...` imports neither the scenes nor the exports (see build_parser).
+def _add_screenshot(parser: argparse.ArgumentParser) -> None:
+    from poinsot.app.cli_pictures import add_screenshot_arguments
+
+    add_screenshot_arguments(parser)
+
+
+def _add_export_html(parser: argparse.ArgumentParser) -> None:
+    from poinsot.app.cli_pictures import add_export_html_arguments
+
+    add_export_html_arguments(parser)
+
+
+def _add_video(parser: argparse.ArgumentParser) -> None:
+    from poinsot.app.cli_motion import add_video_arguments
+
+    add_video_arguments(parser)
+
+
+def _add_fit(parser: argparse.ArgumentParser) -> None:
+    from poinsot.app.cli_fit import add_fit_arguments
+
+    add_fit_arguments(parser)
+
+
+def _add_check_engine(parser: argparse.ArgumentParser) -> None:
+    from poinsot.app.check_engine import add_check_engine_arguments
+
+    add_check_engine_arguments(parser)
+
+
 #: Subcommand -> (help, how its options are declared).
 _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] = {
     "serve": ("serve the interactive scene (the default)", _add_serve_arguments),
@@ -224,23 +254,23 @@ _SUBCOMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] =
         "work-precision report: the exact solution beside numerical integrators",
         _add_report_arguments,
     ),
-    "screenshot": ("a PNG of a scene, rendered by headless Chromium", add_screenshot_arguments),
+    "screenshot": ("a PNG of a scene, rendered by headless Chromium", _add_screenshot),
     "export-html": (
         "a standalone animated HTML page that plays from a file",
-        add_export_html_arguments,
+        _add_export_html,
     ),
-    "video": ("an MP4 or GIF of a scene, rendered by headless Chromium", add_video_arguments),
+    "video": ("an MP4 or GIF of a scene, rendered by headless Chromium", _add_video),
     "benchmark": (
         "server time per client-frame, bytes per frame and slider-to-redraw time",
         _add_benchmark_arguments,
     ),
     "fit": (
         "fit the exact free motion to the tosses of a gyroscope recording (phyphox or CSV)",
-        add_fit_arguments,
+        _add_fit,
     ),
     "check-engine": (
         "does a physics engine's log (t, wx, wy, wz[, qw, qx, qy, qz]) move as a free body?",
-        add_check_engine_arguments,
+        _add_check_engine,
     ),
 }
 
@@ -254,19 +284,33 @@ def _add_debug_argument(parser: argparse.ArgumentParser, default: object) -> Non
     )
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of ``poinsot``; given a ``command`` (not serve), only that command's options
+    are declared (the others are listed, empty, and the top level has no serve options), so
+    that running it imports only what it needs."""
     parser = CommandParser(prog="poinsot", description=DESCRIPTION, formatter_class=HelpFormatter)
     _add_debug_argument(parser, False)
-    _add_serve_arguments(parser)  # `poinsot --host ...` is `poinsot serve --host ...`
+    if command is None:
+        _add_serve_arguments(parser)  # `poinsot --host ...` is `poinsot serve --host ...`
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=CommandParser)
     for name, (help_text, add_arguments) in _SUBCOMMANDS.items():
-        command = sub.add_parser(
+        subparser = sub.add_parser(
             name, help=help_text, description=help_text, formatter_class=HelpFormatter
         )
         # `poinsot --debug fit ...` and `poinsot fit --debug ...` both work.
-        _add_debug_argument(command, argparse.SUPPRESS)
-        add_arguments(command)
+        _add_debug_argument(subparser, argparse.SUPPRESS)
+        if command in (None, name):
+            add_arguments(subparser)
     return parser
+
+
+def _command(argv: Sequence[str]) -> str | None:
+    """The command that ``argv`` names first (after ``--debug`` only), if not serve: its options
+    alone need declaring. None for anything else (serve, ``--help``, top-level options)."""
+    words = [word for word in argv if word != "--debug"]
+    if words and words[0] in _SUBCOMMANDS and words[0] != "serve":
+        return words[0]
+    return None
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -282,7 +326,8 @@ def _run(args: argparse.Namespace) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Parse, run the command; a bad argument is one line and exit status 2, an unexpected
     failure one line and exit status 1 (with its traceback under ``--debug``)."""
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(_command(argv)).parse_args(argv)
     prog = f"poinsot {args.command or 'serve'}"
     return run_guarded(prog, lambda: _run(args), debug=args.debug)
 

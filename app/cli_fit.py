@@ -9,8 +9,7 @@ import argparse
 import pathlib
 import sys
 
-from poinsot.app.arguments import input_path, output_file
-from poinsot.app.cli_types import seconds_type
+from poinsot.app.arguments import input_path, output_file, seconds_type
 
 
 def fit(

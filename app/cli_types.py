@@ -5,7 +5,6 @@ commands that declare their options in their own module) takes its types from he
 from __future__ import annotations
 
 import argparse
-import math
 import pathlib
 
 from poinsot.app.arguments import output_file
@@ -61,17 +60,6 @@ def scene_only_type(name: str) -> SceneSpec:
         return scene_by_name(name)
     except KeyError as exc:
         raise argparse.ArgumentTypeError(exc.args[0]) from exc
-
-
-def seconds_type(text: str) -> float:
-    """A time in seconds: a finite number."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a time in seconds")
-    return value
 
 
 def view_type(text: str) -> str:

@@ -20,6 +20,7 @@ import trimesh
 import zstandard
 from PIL import Image
 
+from poinsot.app import cli
 from poinsot.app.exports import glb, run_csv, screenshot
 from poinsot.app.exports import html as html_export
 from poinsot.app.parameters import Parameters
@@ -317,11 +318,15 @@ def test_cli_screenshot_without_chromium_says_how_to_install_it(tmp_path):
     assert not out.exists()
 
 
-def test_cli_screenshot_rejects_bad_arguments(tmp_path):
-    done = run_cli("screenshot", "--scene", "no such scene", "--out", str(tmp_path / "x.png"))
-    assert done.returncode == 2 and "no preset named" in done.stderr
-    done = run_cli("screenshot", "--size", "big", "--out", str(tmp_path / "x.png"))
-    assert done.returncode == 2 and "size must look like" in done.stderr
+def test_cli_screenshot_rejects_bad_arguments(tmp_path, capsys):
+    """Through ``main`` in this process (the test above runs the command as a process)."""
+    for args, message in (
+        (["--scene", "no such scene"], "no preset named"),
+        (["--size", "big"], "size must look like"),
+    ):
+        with pytest.raises(SystemExit) as exit_:
+            cli.main(["screenshot", *args, "--out", str(tmp_path / "x.png")])
+        assert exit_.value.code == 2 and message in capsys.readouterr().err
     assert screenshot.resolve_scene("Sphere (a cube)").key == "sphere"
     assert screenshot.resolve_scene("T_HANDLE").key == "t_handle"
 

@@ -124,9 +124,12 @@ def stop_classroom(room: Classroom) -> None:
             room.process.wait(10)
 
 
-@pytest.fixture
+@pytest.fixture(scope="module")
 def classroom() -> Iterator[Classroom]:
-    room = start_classroom()
+    """One classroom for the module, on all interfaces as a lecturer serves it (so it prints
+    the board too): the tests that leave it as they found it use it first, in file order, and
+    the one that crashes a worker last."""
+    room = start_classroom("--host", "0.0.0.0")
     yield room
     stop_classroom(room)
 
@@ -177,6 +180,15 @@ def test_landing_sends_new_browsers_to_the_least_loaded_worker(classroom: Classr
 
 
 @pytest.mark.slow
+def test_serve_on_all_interfaces_prints_the_board(classroom: Classroom):
+    text = "".join(classroom.stdout)
+    for _, address in network.lan_addresses():
+        assert f"http://{address}:{classroom.port}" in text
+    if network.lan_addresses():
+        assert "█" in text and "Students open" in text
+
+
+@pytest.mark.slow
 def test_a_crashed_worker_is_reported_and_gets_no_new_browsers(classroom: Classroom):
     first, second = classroom.workers()
     browser = Probe(first["port"])  # a browser on the worker that will crash
@@ -220,16 +232,19 @@ def _serve(*args: str) -> subprocess.CompletedProcess[str]:
 
 
 @pytest.mark.parametrize("workers", ["1", "2"])
-def test_a_busy_port_is_one_line_and_exit_2(busy_port: int, workers: str):
-    result = _serve("--port", str(busy_port), "--workers", workers)
-    assert result.returncode == 2
-    assert result.stderr.count("\n") == 1, result.stderr
-    assert f"port {busy_port} " in result.stderr and "busy" in result.stderr
-    assert "running at" not in result.stdout
+def test_a_busy_port_is_one_line_and_exit_2(busy_port: int, workers: str, capsys):
+    """Through ``main`` in this process (the next test runs ``poinsot serve`` as a process)."""
+    status = cli.main(["serve", "--port", str(busy_port), "--workers", workers])
+    out, err = capsys.readouterr()
+    assert status == 2
+    assert err.count("\n") == 1, err
+    assert f"port {busy_port} " in err and "busy" in err
+    assert "running at" not in out
 
 
 def test_a_busy_worker_port_is_one_line_and_exit_2(busy_port: int):
-    """The workers take the ports after the landing's: one of them taken is refused too."""
+    """The workers take the ports after the landing's: one of them taken is refused too (a
+    real ``poinsot serve`` process: one line, no traceback)."""
     result = _serve("--port", str(busy_port - 1), "--workers", "2")
     if f"port {busy_port - 1} " in result.stderr:
         pytest.skip(f"port {busy_port - 1} happens to be busy as well")
@@ -311,19 +326,6 @@ def test_the_board_says_when_the_machine_has_no_address(monkeypatch):
 def test_the_real_interfaces_give_non_loopback_ipv4_addresses():
     for _, address in network.lan_addresses():
         assert socket.inet_aton(address) and not address.startswith("127.")
-
-
-@pytest.mark.slow
-def test_serve_on_all_interfaces_prints_the_board():
-    room = start_classroom("--host", "0.0.0.0")
-    try:
-        text = "".join(room.stdout)
-        for _, address in network.lan_addresses():
-            assert f"http://{address}:{room.port}" in text
-        if network.lan_addresses():
-            assert "█" in text and "Students open" in text
-    finally:
-        stop_classroom(room)
 
 
 # -- the load test through a landing -------------------------------------------------------
