@@ -42,6 +42,7 @@ class Config:
     hostile_quiet_seconds: float = 8.0  # the innocent client's frames before and after it
     followers: tuple[int, ...] = (30, 60)  # the follow phase's sizes, one lead each
     follow_seconds: float = 15.0  # each of its windows (following, then exploring)
+    follow_redraw_timeout: float = 5.0  # a lead's move not on a follower by then is lost [s]
 
     @property
     def lifetime(self) -> float:

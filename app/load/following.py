@@ -27,7 +27,7 @@ from poinsot.app.load import procfs
 from poinsot.app.load.children import Child
 from poinsot.app.load.config import Config, Report, Say, fps_text, warmup
 from poinsot.app.load.figures import Figure, at_least, at_most, info, percentile
-from poinsot.app.load.fleet import REDRAW_TIMEOUT, SCENE_TIMEOUT, SLIDER_LABEL, SLIDER_VALUES
+from poinsot.app.load.fleet import SCENE_TIMEOUT, SLIDER_LABEL, SLIDER_VALUES
 from poinsot.app.load.fleet import _Client as Counter
 from poinsot.app.load.server_process import ServerProcess
 
@@ -68,19 +68,22 @@ def _connect(port: int, code: str, count: int, deadline: float) -> tuple[Probe, 
     return lead, followers
 
 
-def _move(lead: Probe, value: float, counters: list[Counter]) -> list[float]:
-    """The lead moves the slider: each follower's seconds until its redraw (lost: absent)."""
+def _move(lead: Probe, value: float, counters: list[Counter], timeout: float) -> list[float]:
+    """The lead moves the slider: each follower's seconds until its redraw (lost: absent, not
+    redrawn within ``timeout`` seconds)."""
     for c in counters:
         c.redrawn.clear()
     sent = time.perf_counter()
     _press(lead, SLIDER_LABEL, value)
-    end = sent + REDRAW_TIMEOUT
+    end = sent + timeout
     for c in counters:
         c.redrawn.wait(max(0.0, end - time.perf_counter()))
     return [c.last_redraw - sent for c in counters if c.redrawn.is_set()]
 
 
-def _window(lead: Probe, counters: list[Counter], seconds: float, period: float) -> dict:
+def _window(
+    lead: Probe, counters: list[Counter], seconds: float, period: float, timeout: float
+) -> dict:
     poses0 = [c.poses for c in counters]
     start = time.perf_counter()
     latencies: list[float] = []
@@ -88,7 +91,7 @@ def _window(lead: Probe, counters: list[Counter], seconds: float, period: float)
     while time.perf_counter() < start + seconds:
         if period > 0:
             moves += 1
-            latencies += _move(lead, SLIDER_VALUES[moves % 2], counters)
+            latencies += _move(lead, SLIDER_VALUES[moves % 2], counters, timeout)
         time.sleep(max(0.0, min(period or seconds, start + seconds - time.perf_counter())))
     elapsed = time.perf_counter() - start
     fps = [(c.poses - p0) / elapsed for c, p0 in zip(counters, poses0, strict=True)]
@@ -141,8 +144,11 @@ class FollowFleet(Child):
     def __enter__(self) -> FollowFleet:
         return self
 
-    def window(self, seconds: float, period: float) -> dict:
-        result: dict = self.request(("window", seconds, period), seconds + 120.0, "a window")
+    def window(self, seconds: float, period: float, timeout: float) -> dict:
+        """Frames over ``seconds``; every ``period`` (0: never) a lead's move, lost if not
+        redrawn on a follower within ``timeout``."""
+        wait = seconds + 120.0 + (timeout * seconds / period if period else 0.0)
+        result: dict = self.request(("window", seconds, period, timeout), wait, "a window")
         return result
 
     def explore(self) -> bool:
@@ -159,13 +165,15 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         with FollowFleet(server.port, server.code, count, cfg.lifetime) as fleet:
             time.sleep(warmup(cfg.follow_seconds))
             pids = server.worker_pids or [server.pid]
-            following = fleet.window(cfg.follow_seconds, cfg.slider_period)
+            following = fleet.window(
+                cfg.follow_seconds, cfg.slider_period, cfg.follow_redraw_timeout
+            )
             cpu0 = _cpu(pids)
-            still = fleet.window(cfg.follow_seconds, 0.0)
+            still = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu1 = _cpu(pids)
             explored = fleet.explore()
             cpu2 = _cpu(pids)
-            own = fleet.window(cfg.follow_seconds, 0.0)
+            own = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu3 = _cpu(pids)
         costs = (_ms_per_frame(cpu1 - cpu0, still), _ms_per_frame(cpu3 - cpu2, own))
         report.add(*_figures(count, following, own, costs, explored))
