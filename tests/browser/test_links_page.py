@@ -149,9 +149,11 @@ def test_links_through_the_landing_open_on_either_worker(make_app, make_probe, o
         app.landing_port = landing.port
     known: dict[int, set[int]] = {id(a): set() for a in apps}
     used = []
+    page = None
     try:
         for query, check in LINKS.items():
-            page = open_page(f"http://127.0.0.1:{landing.port}/?{query}")
+            link = f"http://127.0.0.1:{landing.port}/?{query}"
+            page = open_page(link) if page is None else reopen(page, link)
             url = urllib.parse.urlsplit(page.page.url)
             assert url.query == query  # the redirect kept the link's state
             app = next(a for a in apps if a.port == url.port)
@@ -162,7 +164,8 @@ def test_links_through_the_landing_open_on_either_worker(make_app, make_probe, o
                 link = copy_link(page, session)
                 assert link.startswith(f"http://127.0.0.1:{landing.port}/?")
             assert page.errors == []
-            page.page.context.close()  # one rendering page at a time (software WebGL is slow)
+            # The next link opens in this page (one rendering page at a time: software WebGL
+            # is slow); its session leaves as the next is redirected.
             make_probe(app)  # holds that worker's load: the next browser goes to the other
             new_session(app, known[id(app)])
     finally:
