@@ -44,7 +44,7 @@ def canvas_pixels(page) -> np.ndarray:
 
 
 def started(app, frames: int = 20):
-    session = session_of(app)
+    session = session_of(app, timeout=60)  # a loaded machine: the page's session comes late
     assert wait_until(lambda: session.stats.frames >= frames, 20), "the scene is not animating"
     return session
 

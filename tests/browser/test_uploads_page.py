@@ -45,7 +45,7 @@ def shared(make_module_app, open_module_page):
 def open_entry(shared, label: str, button: str):
     """The module's page on the preset ``label``, its upload button ``button`` shown."""
     app, page = shared
-    session = session_of(app)
+    session = session_of(app, timeout=60)  # a loaded machine: the page's session comes late
     assert wait_until(lambda: session.stats.frames > 10, 20), "the scene is not animating"
     page.choose("Preset", label)
     assert wait_until(lambda: session.preset.label == label, 10)
