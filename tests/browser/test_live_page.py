@@ -1,7 +1,11 @@
 """The app in a real browser: Debian's Chromium, driven through playwright, rendering viser's
 WebGL client with SwiftShader. Each test drives the page like a user (keyboard on a slider
 thumb, clicks on the dropdown, the buttons and the checkboxes) and checks both what the server
-now holds and what the canvas shows."""
+now holds and what the canvas shows.
+
+The tests share one app and one page, in this order (each leaves the page as it needs the next
+to find it, or says what it changed): a page load and a software-WebGL page's every
+interaction cost seconds, and an open page that animates takes a core."""
 
 from __future__ import annotations
 
@@ -40,7 +44,7 @@ def canvas_pixels(page) -> np.ndarray:
 
 
 def started(app, frames: int = 20):
-    session = session_of(app)
+    session = session_of(app, timeout=60)  # a loaded machine: the page's session comes late
     assert wait_until(lambda: session.stats.frames >= frames, 20), "the scene is not animating"
     return session
 
@@ -50,21 +54,29 @@ def pause(page, session) -> None:
     assert wait_until(lambda: session.clock.paused, 5)
 
 
-def test_page_loads_without_console_errors(poinsot_app, open_page):
-    page = open_page(poinsot_app.url)
-    session = started(poinsot_app, frames=60)
+@pytest.fixture(scope="module")
+def shared(make_module_app, open_module_page):
+    """(app, page, its session): one page on one app for the whole module."""
+    app = make_module_app()
+    page = open_module_page(app.url)
+    return app, page, started(app)
+
+
+def test_page_loads_without_console_errors(shared):
+    app, page, session = shared
+    started(app, frames=60)
     page.page.wait_for_timeout(1000)
     assert page.errors == []
     assert session.stats.errors == 0, session.stats.last_error
     assert page.page.get_by_text("Stable about the major axis").count() >= 1
 
 
-def test_the_omega_plot_draws_its_three_components(poinsot_app, open_page):
+def test_the_omega_plot_draws_its_three_components(shared):
     """The live uPlot of omega_1, omega_2, omega_3 (numeric time axis) shows three curves."""
     from PIL import Image
 
-    page = open_page(poinsot_app.url)
-    started(poinsot_app, frames=30)
+    app, page, _ = shared
+    started(app, frames=30)
     plot = page.page.locator(".uplot-container").first
     plot.wait_for(state="visible", timeout=20000)
     page.page.wait_for_timeout(2500)  # a couple of seconds of samples
@@ -78,9 +90,9 @@ def test_the_omega_plot_draws_its_three_components(poinsot_app, open_page):
     assert page.errors == []
 
 
-def test_canvas_shows_the_ellipsoid(poinsot_app, open_page):
-    page = open_page(poinsot_app.url)
-    session = started(poinsot_app)
+def test_canvas_shows_the_ellipsoid(shared):
+    app, page, _ = shared
+    session = started(app)
     pause(page, session)
     page.page.wait_for_timeout(500)
     shown = canvas_pixels(page)
@@ -93,11 +105,17 @@ def test_canvas_shows_the_ellipsoid(poinsot_app, open_page):
     assert amber_fraction(shown) > 0.02, amber_fraction(shown)
     assert amber_fraction(hidden) < amber_fraction(shown) / 10, amber_fraction(hidden)
     assert page.errors == []
+    # As the next test finds a new page: the ellipsoid shown, "Show" collapsed, playing.
+    page.set_checkbox("energy ellipsoid", True)
+    assert wait_until(lambda: session.scene.is_visible(Element.ELLIPSOID), 20)
+    page.open_folder("Show")
+    page.click_button("Play")
+    assert wait_until(lambda: not session.clock.paused, 20)
 
 
-def test_moving_a_slider_changes_the_scene(poinsot_app, open_page):
-    page = open_page(poinsot_app.url)
-    session = started(poinsot_app)
+def test_moving_a_slider_changes_the_scene(shared):
+    app, page, _ = shared
+    session = started(app)
     pause(page, session)
     page.page.wait_for_timeout(300)
     before_pixels = canvas_pixels(page)
@@ -117,9 +135,10 @@ def test_moving_a_slider_changes_the_scene(poinsot_app, open_page):
     assert page.errors == []
 
 
-def test_choosing_a_preset_changes_the_scene(poinsot_app, open_page):
-    page = open_page(poinsot_app.url)
-    session = started(poinsot_app)
+def test_choosing_a_preset_changes_the_scene(shared):
+    """After the slider's test: from the edited body (paused) to the sphere."""
+    app, page, _ = shared
+    session = started(app)
     page.page.wait_for_timeout(300)
     before = canvas_pixels(page)
     sphere = preset_by_key("sphere")
@@ -145,12 +164,13 @@ def test_choosing_a_preset_changes_the_scene(poinsot_app, open_page):
     assert page.errors == []
 
 
-def test_two_browsers_have_independent_sessions(poinsot_app, open_page):
-    first = open_page(poinsot_app.url)
-    a = started(poinsot_app)
-    second = open_page(poinsot_app.url)
-    assert wait_until(lambda: len(poinsot_app.sessions()) == 2, 10)
-    b = session_of(poinsot_app, 2)
+def test_two_browsers_have_independent_sessions(shared, open_page):
+    """The module's page is the first browser (it chooses a preset: any it showed before is
+    replaced whole); a new page is the second, on the default preset."""
+    app, first, a = shared
+    second = open_page(app.url)
+    assert wait_until(lambda: len(app.sessions()) == 2, 10)
+    b = session_of(app, 2)
     assert a is not b
     assert wait_until(lambda: b.stats.frames > 10, 10)
     first.choose("Preset", preset_by_key("oblate").label)
@@ -165,13 +185,16 @@ def test_two_browsers_have_independent_sessions(poinsot_app, open_page):
     assert first.dropdown_value("Preset") == preset_by_key("oblate").label
     assert a.scene.api is not b.scene.api
     assert first.errors == [] and second.errors == []
+    second.page.context.close()  # the next test counts one session
 
 
-def test_a_real_browser_sends_only_what_the_wire_allows(poinsot_app, open_page):
+def test_a_real_browser_sends_only_what_the_wire_allows(shared):
     """Orbiting, a slider, a dropdown, a hotkey and a resize from Chromium's own viser client:
-    every message passes the guard's allow-list, none is dropped, the session plays on."""
-    page = open_page(poinsot_app.url)
-    session = started(poinsot_app)
+    every message passes the guard's allow-list, none is dropped, the session plays on. Last:
+    it resizes the module's page. (I1 starts at 1: the default preset's, or the disc's that
+    the test before chose.)"""
+    app, page, session = shared
+    assert wait_until(lambda: len(app.sessions()) == 1, 20), "another browser is still here"
     box = page.canvas_box()
     mouse = page.page.mouse
     mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
@@ -186,9 +209,9 @@ def test_a_real_browser_sends_only_what_the_wire_allows(poinsot_app, open_page):
     page.page.set_viewport_size({"width": 1001, "height": 777})
     frames = session.stats.frames
     assert wait_until(lambda: session.stats.frames > frames + 10, 15)
-    guard = poinsot_app.guard
+    guard = app.guard
     assert guard.closed_for_message == 0 and guard.malformed == 0 and guard.dropped == 0
     # A mouse press on the energy ellipsoid (its drag binding: a start is pointed at by hand)
     # makes Chromium note that viser's handler cannot cancel a passive event; nothing else may.
     errors = [e for e in page.errors if e != DRAG_BINDING]
-    assert len(poinsot_app.sessions()) == 1 and errors == []
+    assert list(app.sessions().values()) == [session] and errors == []
