@@ -84,8 +84,10 @@ def add_video_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--out",
         type=video_file,
+        nargs="+",
         required=True,
-        help="output file: .mp4 (H.264, plays in PowerPoint and browsers) or .gif (loops)",
+        help="output file: .mp4 (H.264, plays in PowerPoint and browsers) or .gif (loops); "
+        "several (clip.mp4 clip.gif): the frames are rendered once and encoded into each",
     )
     parser.set_defaults(func=video)
 
@@ -171,7 +173,7 @@ def camera_of(scene: Preset | SceneSpec, view: str) -> View | None:
 
 
 def video(
-    out: pathlib.Path,
+    out: list[pathlib.Path],
     scene: Preset | SceneSpec,
     seconds: float,
     fps: float,
@@ -185,7 +187,8 @@ def video(
     speed = scene.initial_speed() if isinstance(scene, SceneSpec) else scene.speed
     clip = Clip(seconds, fps, size, t0=t0, speed=speed)
     try:
-        check_clip(clip, out.suffix.lower())
+        for path in out:
+            check_clip(clip, path.suffix.lower())
         chromium = find_chromium()
     except ValueError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
@@ -193,9 +196,11 @@ def video(
     except BrowserMissing as exc:
         print(f"{PROG}: {exc}", file=sys.stderr)
         return EXIT_NO_BROWSER
-    out.parent.mkdir(parents=True, exist_ok=True)
+    for path in out:
+        path.parent.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    with sigterm_exits(), progress_bar(clip.frames, f"{scene.key} {out.name}") as progress:
+    label = f"{scene.key} {' '.join(path.name for path in out)}"
+    with sigterm_exits(), progress_bar(clip.frames, label) as progress:
         made = film(
             lambda client_of: open_stage(scene, dark_mode=not light, client_of=client_of),
             clip,
@@ -205,9 +210,11 @@ def video(
             background=THEME_BACKGROUND[not light],
             progress=progress,
         )
-    print(
-        f"wrote {out} ({made.width}x{made.height}, {made.frames} frames at {fps:g} fps, "
-        f"{made.bytes / 1e6:.2f} MB, scene {scene.key}, from t = {t0:g}, view {view}) in "
-        f"{time.perf_counter() - start:.1f} s ({made.seconds_per_frame:.2f} s per frame)"
-    )
+    elapsed = time.perf_counter() - start
+    for path in made.paths:
+        print(
+            f"wrote {path} ({made.width}x{made.height}, {made.frames} frames at {fps:g} fps, "
+            f"{path.stat().st_size / 1e6:.2f} MB, scene {scene.key}, from t = {t0:g}, view "
+            f"{view}) in {elapsed:.1f} s ({made.seconds_per_frame:.2f} s per frame)"
+        )
     return 0

@@ -27,7 +27,7 @@ import math
 import pathlib
 import threading
 import time
-from collections.abc import Callable, Generator, Iterator
+from collections.abc import Callable, Generator, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
@@ -166,16 +166,18 @@ def rgb_on(rgba: np.ndarray, background: RGB) -> np.ndarray:
 
 @contextlib.contextmanager
 def one_behind(
-    frames: Generator[None, np.ndarray, None], background: RGB
+    encoders: Sequence[Generator[None, np.ndarray, None]], background: RGB
 ) -> Iterator[Callable[[np.ndarray], None]]:
     """A function that takes RGBA renders in order and hands them, laid on ``background``, to
-    the encoder ``frames`` on a thread of its own, one render behind: the browser draws the
-    next frame while this one is encoded. A failure of the encoder is raised by the next call,
+    each of the ``encoders`` on a thread of its own, one render behind: the browser draws the
+    next frame while this one is encoded. A failure of an encoder is raised by the next call,
     or at the end of the block."""
     pending: Future[None] | None = None
 
     def encode(rgba: np.ndarray) -> None:
-        frames.send(rgb_on(rgba, background))
+        rgb = rgb_on(rgba, background)
+        for frames in encoders:
+            frames.send(rgb)
 
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="poinsot-encode") as pool:
 
@@ -195,17 +197,19 @@ def one_behind(
 class Filmed:
     """What :func:`film` did (printed by the command, checked by tests and the benchmark)."""
 
-    path: pathlib.Path
+    path: pathlib.Path  # the first output
     frames: int
     width: int
     height: int
-    bytes: int
+    bytes: int  # of the first output
     seconds: float  # wall time of the whole clip, browser start included
     render_seconds: float  # wall time of the frames alone (advance, render, encode)
 
     @property
     def seconds_per_frame(self) -> float:
         return self.render_seconds / self.frames
+
+    paths: tuple[pathlib.Path, ...] = ()  # every output, the first one first
 
 
 @dataclasses.dataclass
@@ -265,7 +269,7 @@ def film(
     open_stage: StageFactory,
     clip: Clip,
     view: View | None,
-    out: pathlib.Path,
+    out: pathlib.Path | Sequence[pathlib.Path],
     *,
     chromium: str,
     background: RGB,
@@ -274,34 +278,57 @@ def film(
     cancel: threading.Event | None = None,
 ) -> Filmed:
     """Film ``clip`` of the stage that ``open_stage`` opens, from ``view`` (None: riding along
-    with the body), into ``out`` (.mp4 or .gif). ``fit``: narrow a fixed view's field of view so
-    that the construction at the start fills the picture. ``progress(done, total)`` is called
-    after each frame; setting ``cancel`` stops at the next frame (Cancelled, no file left)."""
+    with the body), into ``out`` (.mp4 or .gif; several files: each frame is rendered once and
+    encoded into each). ``fit``: narrow a fixed view's field of view so that the construction
+    at the start fills the picture. ``progress(done, total)`` is called after each frame;
+    setting ``cancel`` stops before the browser starts, before the first frame or at the next
+    one (Cancelled, no file left)."""
     start = time.perf_counter()
+    outs = (out,) if isinstance(out, pathlib.Path) else tuple(out)
     width, height = clip.size
-    total = clip.frames
     window = (max(16, round(720 * width / height)), 720)
+    _check(cancel, 0, clip.frames)
     with headless_chromium(chromium) as browser:
         stage = open_stage(lambda server: open_window(browser, server, clip.size, 1.0))
         try:
             shots = _first_shot(stage, clip, view, window, fit)
             began = time.perf_counter()
             try:
-                with (
-                    encoder(out, clip.size, clip.fps) as frames,
-                    one_behind(frames, background) as put,
-                ):
-                    for i in range(total):
-                        if cancel is not None and cancel.is_set():
-                            raise Cancelled(f"cancelled after {i} of {total} frames")
-                        put(shots.shoot(i, clip.time(i)))
-                        if progress is not None:
-                            progress(i + 1, total)
+                _frames(shots, clip, outs, background, progress, cancel)
             except BaseException:
-                out.unlink(missing_ok=True)
+                for path in outs:
+                    path.unlink(missing_ok=True)
                 raise
             rendered = time.perf_counter() - began
         finally:
             stage.stop()
-    size = out.stat().st_size
-    return Filmed(out, total, width, height, size, time.perf_counter() - start, rendered)
+    size = outs[0].stat().st_size
+    return Filmed(
+        outs[0], clip.frames, width, height, size, time.perf_counter() - start, rendered, outs
+    )
+
+
+def _check(cancel: threading.Event | None, done: int, total: int) -> None:
+    """Cancelled if ``cancel`` is set (``done`` of ``total`` frames filmed)."""
+    if cancel is not None and cancel.is_set():
+        raise Cancelled(f"cancelled after {done} of {total} frames")
+
+
+def _frames(
+    shots: _Shots,
+    clip: Clip,
+    outs: tuple[pathlib.Path, ...],
+    background: RGB,
+    progress: Progress | None,
+    cancel: threading.Event | None,
+) -> None:
+    """Render the clip's frames and encode each into every one of ``outs``."""
+    total = clip.frames
+    with contextlib.ExitStack() as stack:
+        encoders = [stack.enter_context(encoder(path, clip.size, clip.fps)) for path in outs]
+        put = stack.enter_context(one_behind(encoders, background))
+        for i in range(total):
+            _check(cancel, i, total)
+            put(shots.shoot(i, clip.time(i)))
+            if progress is not None:
+                progress(i + 1, total)

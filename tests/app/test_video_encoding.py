@@ -60,18 +60,20 @@ def test_a_render_is_laid_on_the_background():
     assert rgb[1, 0].tolist() == [110, 60, 35]
 
 
-def test_renders_reach_the_encoder_in_order_laid_on_the_background():
+def test_renders_reach_each_encoder_in_order_laid_on_the_background():
     got: list[np.ndarray] = []
+    also: list[np.ndarray] = []
 
-    def sink():
+    def sink(into: list[np.ndarray]):
         while True:
-            got.append((yield))
+            into.append((yield))
 
-    frames_in = sink()
+    frames_in, more_in = sink(got), sink(also)
     frames_in.send(None)
+    more_in.send(None)
     renders = [np.full((2, 3, 4), (10 * i, 0, 0, 255), np.uint8) for i in range(6)]
     renders[5][..., 3] = 0  # nothing drawn: the background
-    with one_behind(frames_in, (20, 20, 20)) as put:
+    with one_behind([frames_in, more_in], (20, 20, 20)) as put:
         for rgba in renders:
             put(rgba)
     assert [frame[0, 0].tolist() for frame in got] == [
@@ -83,6 +85,7 @@ def test_renders_reach_the_encoder_in_order_laid_on_the_background():
         [20, 20, 20],
     ]
     assert all(frame.shape == (2, 3, 3) for frame in got)
+    assert [frame.tolist() for frame in also] == [frame.tolist() for frame in got]
 
 
 def test_an_encoder_failure_is_raised_by_the_next_frame():
@@ -93,7 +96,7 @@ def test_an_encoder_failure_is_raised_by_the_next_frame():
     frames_in = broken()
     frames_in.send(None)
     rgba = np.zeros((2, 2, 4), np.uint8)
-    with pytest.raises(OSError, match="gone"), one_behind(frames_in, (0, 0, 0)) as put:
+    with pytest.raises(OSError, match="gone"), one_behind([frames_in], (0, 0, 0)) as put:
         put(rgba)
         put(rgba)
 

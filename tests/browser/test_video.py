@@ -1,9 +1,12 @@
 """``poinsot video`` in a real browser (Debian's Chromium, software WebGL): the MP4 and the GIF
-decode (imageio, through the ffmpeg of imageio-ffmpeg) to the frames asked for, of the size
+of one run (``--out clip.mp4 clip.gif``: the frames rendered once, encoded into each) decode
+(imageio, through the ffmpeg of imageio-ffmpeg) to the frames asked for, of the size
 asked for, each different from the one before (every frame shows its own time); the MP4 is
 H.264 in yuv420p, the GIF loops."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import imageio.v2 as imageio
 import imageio.v3 as iio
@@ -22,17 +25,22 @@ pytestmark = [pytest.mark.browser, pytest.mark.slow]
 MIN_CHANGE = 0.3
 
 
-def run_video(tmp_path, capsys, suffix: str):
+@pytest.fixture(scope="module")
+def filmed(tmp_path_factory) -> dict[str, Path]:
+    """ONE ``poinsot video`` run that writes both files: the frames are rendered once and
+    encoded into each (by suffix: the MP4 and the GIF)."""
     chromium_or_fail()
-    out = tmp_path / f"v{suffix}"
+    folder = tmp_path_factory.mktemp("video")
+    outs = {suffix: folder / f"v{suffix}" for suffix in (".mp4", ".gif")}
     argv = ["video", "--preset", "t_handle", "--seconds", "4", "--fps", "25"]
     # A process of its own, as a lecturer runs it (this one may already drive Chromium through
     # playwright's sync API, which allows one per thread).
-    done = run_command([*argv, "--size", "640x360", "--out", str(out)])
+    done = run_command([*argv, "--size", "640x360", "--out", *map(str, outs.values())])
     assert done.returncode == 0, done.stderr
-    assert f"wrote {out} (640x360, 100 frames at 25 fps" in done.stdout, done.stdout
+    for out in outs.values():
+        assert f"wrote {out} (640x360, 100 frames at 25 fps" in done.stdout, done.stdout
     assert "100/100 frames" in done.stderr  # the progress (plain lines: not a terminal)
-    return out
+    return outs
 
 
 def assert_a_moving_scene(frames: np.ndarray) -> None:
@@ -49,8 +57,8 @@ def assert_a_moving_scene(frames: np.ndarray) -> None:
     assert 0.1 < drawn.mean() < 0.9, drawn.mean()
 
 
-def test_the_mp4_decodes_to_100_frames_of_640x360_that_change(tmp_path, capsys):
-    out = run_video(tmp_path, capsys, ".mp4")
+def test_the_mp4_decodes_to_100_frames_of_640x360_that_change(filmed):
+    out = filmed[".mp4"]
     reader = imageio.get_reader(out, format="FFMPEG")
     meta = reader.get_meta_data()
     # (not list(reader): its length is "inf" until read, and list() would preallocate it)
@@ -61,8 +69,8 @@ def test_the_mp4_decodes_to_100_frames_of_640x360_that_change(tmp_path, capsys):
     assert_a_moving_scene(frames)
 
 
-def test_the_gif_decodes_to_100_frames_of_640x360_that_change_and_loops(tmp_path, capsys):
-    out = run_video(tmp_path, capsys, ".gif")
+def test_the_gif_decodes_to_100_frames_of_640x360_that_change_and_loops(filmed):
+    out = filmed[".gif"]
     with Image.open(out) as image:
         assert image.info.get("loop") == 0  # forever
         assert image.info.get("duration") == 40  # 25 frames per second
