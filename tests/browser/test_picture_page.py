@@ -537,8 +537,10 @@ def test_projector_mode_folds_the_panels_and_thickens_the_picture(pages):
     base_font = page.page.evaluate(root)
     page.set_checkbox("Projector mode", True)
     assert wait_until(lambda: session.lecture.display.style.projector, 10)
+    # The flag is set before the scene is recoloured: wait for the projector's colours.
+    projector_look = palette.look(True, projector=True)
+    assert wait_until(lambda: session.scene.look is projector_look, 20), session.scene.look
     look = session.scene.look
-    assert look is palette.look(True, projector=True)
     assert wait_until(lambda: page.canvas_box()["width"] > 0.85 * 1280, 10), page.canvas_box()
     # The thicker lines are drawn once the browser has taken the restyle: wait for it (a busy
     # software-WebGL page can take seconds), the threshold unchanged.
