@@ -96,6 +96,12 @@ def _add_follow(parser: argparse.ArgumentParser, cfg: Config) -> None:
     parser.add_argument(
         "--follow-seconds", type=positive_float, default=cfg.follow_seconds, help="each window"
     )
+    parser.add_argument(
+        "--follow-redraw-timeout",
+        type=positive_float,
+        default=cfg.follow_redraw_timeout,
+        help="seconds after which a lead's move not yet on a follower counts as lost",
+    )
 
 
 def _options(args: argparse.Namespace) -> tuple[list[str], Config, Bounds]:
