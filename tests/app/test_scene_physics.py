@@ -14,6 +14,7 @@ from scene_probing import (
     arrow_tip,
     number_in,
     plot_data,
+    readout_table,
     rotation,
     segments,
     sent_at,
@@ -279,5 +280,5 @@ def test_explorer_keeps_L_and_crosses_the_separatrix_when_stated(make_app, make_
     for when, family in ((0.5 * theory, "minor-axis family"), (1.3 * theory, "major-axis family")):
         sent_at(session, probe, when)
         assert probe.wait_for(
-            lambda p, f=family: wait_readouts(p, spec.readouts)["family now"][1] == f, 10
-        )
+            lambda p, f=family: wait_readouts(p, spec.readouts)["family now"][1] == f, 30
+        ), (when, readout_table(probe).get("family now"))
