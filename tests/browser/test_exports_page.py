@@ -287,26 +287,15 @@ def download_png(page, button: str = "Screenshot (PNG)") -> tuple[str, Image.Ima
     return download.suggested_filename, Image.open(io.BytesIO(data))
 
 
-@pytest.fixture(scope="module")
-def app(make_module_app):
-    """One served app for the in-app tests."""
-    return make_module_app()
-
-
-@pytest.fixture(scope="module")
-def page(app, open_module_page):
-    """One page on it, shared by the in-app tests in order (screenshots, then keys)."""
-    return open_module_page(app.url, width=960, height=540)
-
-
 def started_session(app):
     session = session_of(app)
     assert wait_until(lambda: session.stats.frames >= 10, 20), "the scene is not animating"
     return session
 
 
-def test_screenshot_button_downloads_pngs_of_the_chosen_size(app, page):
-    session = started_session(app)
+def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_page):
+    page = open_page(poinsot_app.url, width=960, height=540)
+    session = started_session(poinsot_app)
     lecture = lecture_of(session)
     # Current view: the 3D view's size, opaque on the dark theme's background.
     name, image = download_png(page)
@@ -335,8 +324,9 @@ def test_screenshot_button_downloads_pngs_of_the_chosen_size(app, page):
     assert page.errors == []
 
 
-def test_keys_cameras_theme_and_text_size(app, page):
-    session = started_session(app)
+def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
+    page = open_page(poinsot_app.url, width=960, height=540)
+    session = started_session(poinsot_app)
     lecture_of(session)
     camera = session.client.camera
     box = page.canvas_box()
