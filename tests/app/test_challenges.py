@@ -106,7 +106,10 @@ def test_answer_then_play_in_a_session(poinsot_app, probe) -> None:
         assert wait_until(lambda n=n: folder.answered == n, 10)
     right = 1 + sum(c.answer == (False, 0) for c in folder.challenges[1:4])
     assert folder.score == right
-    assert f"Score: **{right} / 4**" in folder.scoreboard.content
+    # The count is taken before the scoreboard is written: wait for the board.
+    assert wait_until(lambda: f"Score: **{right} / 4**" in folder.scoreboard.content, 10), (
+        folder.scoreboard.content
+    )
     probe.set_value(probe.widget(challenges.NEXT)[0], True)
     assert wait_until(lambda: not folder.revealed, 10)
     assert folder.current.kind == "time"

@@ -104,7 +104,8 @@ def test_screenshot_that_never_renders_gives_a_message_not_a_hang(live):
     click(probe, "Screenshot (PNG)")
     assert wait_until(lambda: "Screenshot failed" in lecture.message.content, 30)
     assert "did not return the picture within 1 s" in lecture.message.content  # its timeout
-    assert not lecture.screenshot.disabled
+    # The message is written before the button is enabled again: wait for the button.
+    assert wait_until(lambda: not lecture.screenshot.disabled, 10)
     assert not any(n.endswith(".png") for n in downloads.complete())
     # The panel shows the message too (what the probe, i.e. the browser, received).
     assert probe.wait_for(
