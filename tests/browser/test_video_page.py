@@ -23,30 +23,19 @@ from poinsot.app.presets import preset_by_key
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 
-@pytest.fixture(scope="module")
-def app(make_module_app):
-    """One served app (the T-handle, whose flips the strobe shows) for the module's tests."""
-    return make_module_app(preset_by_key("t_handle"))
-
-
-@pytest.fixture(scope="module")
-def page(app, open_module_page):
-    """One page on it, shared by the tests in order (video, cancel, strobe)."""
-    chromium_or_fail()
-    return open_module_page(app.url, width=960, height=540)
-
-
 def started(app):
     session = session_of(app)
     assert wait_until(lambda: session.stats.frames >= 10, 20), "the scene is not animating"
     return session
 
 
-def test_the_video_button_downloads_an_mp4_of_the_current_view(app, page, tmp_path):
-    session = started(app)
+def test_the_video_button_downloads_an_mp4_of_the_current_view(poinsot_app, open_page, tmp_path):
+    chromium_or_fail()
+    page = open_page(poinsot_app.url, width=960, height=540)
+    session = started(poinsot_app)
     lecture = lecture_of(session)
     page.press_slider("Video length [s]", "Home")  # 1 s
-    assert wait_until(lambda: lecture.video.seconds.value == 1, 30)
+    assert wait_until(lambda: lecture.video.seconds.value == 1, 5)
     t_before = session.clock.now()
     with page.page.expect_download(timeout=300_000) as info:
         page.click_button("Video")
@@ -55,8 +44,8 @@ def test_the_video_button_downloads_an_mp4_of_the_current_view(app, page, tmp_pa
         assert wait_until(lambda: session.stats.frames > frames + 10, 30)
     download = info.value
     name = download.suggested_filename
-    assert re.fullmatch(r"poinsot_t_handle_t\d+\.\d\d\.mp4", name), name
-    assert float(name[len("poinsot_t_handle_t") : -4]) >= round(t_before, 2) - 0.01
+    assert re.fullmatch(r"poinsot_major_t\d+\.\d\d\.mp4", name), name
+    assert float(name[len("poinsot_major_t") : -4]) >= round(t_before, 2) - 0.01
     path = tmp_path / name
     download.save_as(path)
     reader = imageio.get_reader(path, format="FFMPEG")
@@ -76,14 +65,16 @@ def test_the_video_button_downloads_an_mp4_of_the_current_view(app, page, tmp_pa
     assert lecture.video.last_file == name and page.errors == []
 
 
-def test_a_video_can_be_cancelled_and_the_next_one_starts(app, page):
-    session = started(app)
+def test_a_video_can_be_cancelled_and_the_next_one_starts(poinsot_app, open_page):
+    chromium_or_fail()
+    page = open_page(poinsot_app.url, width=960, height=540)
+    session = started(poinsot_app)
     lecture = lecture_of(session)
     video = lecture.video
     downloads: list[object] = []
     page.page.on("download", lambda download: downloads.append(download))
     page.press_slider("Video length [s]", "End")  # 30 s: it will not end by itself soon
-    assert wait_until(lambda: video.seconds.value == 30, 30)
+    assert wait_until(lambda: video.seconds.value == 30, 5)
     page.click_button("Video")
     assert wait_until(lambda: video.progress.visible and video.progress.value > 0, 240), (
         lecture.message.content
@@ -101,20 +92,23 @@ def test_a_video_can_be_cancelled_and_the_next_one_starts(app, page):
     assert page.errors == []
 
 
-def test_the_strobe_toggle_adds_eight_copies_to_the_screenshot(app, page):
+def test_the_strobe_toggle_adds_eight_copies_to_the_screenshot(make_app, open_page):
+    chromium_or_fail()
+    app = make_app(preset_by_key("t_handle"))
+    page = open_page(app.url, width=960, height=540)
     session = started(app)
     lecture = lecture_of(session)
     assert wait_until(lambda: session.clock.now() > 2.0, 60)
     page.choose("Picture size", "1920×1080")  # the 3D view here is narrow: copies of 40 px
     page.set_checkbox("Strobe: 8 copies", True)
-    assert wait_until(lambda: lecture.strobe.value and lecture.size.value == "1920×1080", 30)
+    assert wait_until(lambda: lecture.strobe.value and lecture.size.value == "1920×1080", 5)
     copies = copies_in(screenshot_rgb(page))
     assert len(copies) == 8, copies
     brightness = [v for _, v in copies]
     assert brightness[0] == min(brightness), brightness
     # The copies were there for that picture only: without the toggle, none.
     page.set_checkbox("Strobe: 8 copies", False)
-    assert wait_until(lambda: not lecture.strobe.value, 30)
+    assert wait_until(lambda: not lecture.strobe.value, 5)
     assert copies_in(screenshot_rgb(page)) == []
     assert page.errors == []
 
