@@ -197,7 +197,7 @@ def one_behind(
 class Filmed:
     """What :func:`film` did (printed by the command, checked by tests and the benchmark)."""
 
-    path: pathlib.Path  # the first output
+    paths: tuple[pathlib.Path, ...]  # every output, the first one first
     frames: int
     width: int
     height: int
@@ -209,7 +209,10 @@ class Filmed:
     def seconds_per_frame(self) -> float:
         return self.render_seconds / self.frames
 
-    paths: tuple[pathlib.Path, ...] = ()  # every output, the first one first
+    @property
+    def path(self) -> pathlib.Path:
+        """The first output."""
+        return self.paths[0]
 
 
 @dataclasses.dataclass
@@ -303,9 +306,7 @@ def film(
         finally:
             stage.stop()
     size = outs[0].stat().st_size
-    return Filmed(
-        outs[0], clip.frames, width, height, size, time.perf_counter() - start, rendered, outs
-    )
+    return Filmed(outs, clip.frames, width, height, size, time.perf_counter() - start, rendered)
 
 
 def _check(cancel: threading.Event | None, done: int, total: int) -> None:
