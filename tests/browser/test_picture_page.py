@@ -188,13 +188,19 @@ def canvas_slice(page) -> tuple[np.ndarray, dict]:
     return page.screenshot_rgb(), page.canvas_box()
 
 
+def in_patches(mask: np.ndarray, min_patch: int) -> np.ndarray:
+    """``mask``'s pixels that lie in patches of at least ``min_patch`` pixels (a stray
+    anti-aliased pixel of another line, where two lines cross, is not a curve)."""
+    patches, count = ndimage.label(ndimage.binary_dilation(mask, iterations=2))
+    sizes = ndimage.sum(mask, patches, range(1, count + 1))
+    return mask & np.isin(patches, 1 + np.flatnonzero(sizes >= min_patch))
+
+
 def bounding_box(mask: np.ndarray, min_patch: int = 0) -> tuple[int, int, int, int] | None:
     """The box round ``mask``'s pixels (only those in patches of at least ``min_patch``
-    pixels: a stray anti-aliased pixel of another line is not the curve)."""
+    pixels, when given)."""
     if min_patch:
-        patches, count = ndimage.label(ndimage.binary_dilation(mask, iterations=2))
-        sizes = ndimage.sum(mask, patches, range(1, count + 1))
-        mask = mask & np.isin(patches, 1 + np.flatnonzero(sizes >= min_patch))
+        mask = in_patches(mask, min_patch)
     ys, xs = np.nonzero(mask)
     if len(xs) == 0:
         return None
@@ -580,7 +586,10 @@ def test_two_views_show_the_body_frame_beside_the_space_frame(pages):
         rgb, box = canvas_slice(page)
         x0, x1 = int(box["x"]), int(box["x"] + box["width"])
         left, right = slice(x0, (x0 + x1) // 2), slice((x0 + x1) // 2, x1)
-        herpolhode, polhode = hue_mask(rgb, look.herpolhode), hue_mask(rgb, look.polhode)
+        # Where the body frame's axes cross, their blended pixels can take the herpolhode's
+        # hue: only patches of a line count.
+        herpolhode = in_patches(hue_mask(rgb, look.herpolhode), 30)
+        polhode = hue_mask(rgb, look.polhode)
         # The translucent ellipsoid comes out a dim amber on the dark background.
         ellipsoid = hue_mask(rgb, look.ellipsoid, tolerance=12.0, saturation=0.4, brightness=0.12)
         return (
