@@ -123,6 +123,9 @@ class PartsDrawing:
     def set_visible(self, part: str, visible: bool) -> None:
         self.parts.set_visible(part, visible)
 
+    def is_visible(self, part: str) -> bool:
+        return self.parts.is_visible(part)
+
     def remove(self) -> None:
         self.parts.remove()
 

@@ -91,6 +91,9 @@ class Showcase:
     def set_visible(self, part: str, visible: bool) -> None:
         self.drawing.set_visible(part, visible)
 
+    def is_visible(self, part: str) -> bool:
+        return self.drawing.is_visible(part)
+
     def readouts(self, t: float) -> tuple[Readout, ...]:
         """The model's rows, exactly the ones the spec declares, in its order."""
         if self.model is None:

@@ -25,6 +25,7 @@ from tests.conftest import after_frames, session_of, wait_until
 
 D = "D = |L|²/2T"
 POLHODES = "Scene: the polhode family"
+FAMILY = "polhode family (by kind)"  # one of that scene's parts
 
 
 def _markdown(probe: Probe, prefix: str) -> str:
@@ -93,6 +94,13 @@ def test_followers_on_two_workers_follow_detach_and_keep_the_last_state():
         _set(lead, "Preset", POLHODES)
         for follower in followers:
             assert follower.wait_for(lambda p: _value(p, "Preset") == POLHODES, 60)
+        # The lead hides one of the scene's parts: so does every follower, its checkbox too.
+        assert lead.wait_for(lambda p: p.has_widget(FAMILY), 60)
+        _set(lead, FAMILY, False)
+        for follower in followers:
+            assert follower.wait_for(
+                lambda p: p.has_widget(FAMILY) and _value(p, FAMILY) is False, 30
+            )
         _set(lead, "Pause")
         assert lead.wait_for(lambda p: "_paused_" in _markdown(p, "**t ="), 30)
         paused_at = _markdown(lead, "**t =")

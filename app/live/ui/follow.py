@@ -48,8 +48,8 @@ def new_code(length: int = 6) -> str:
 class LeadState:
     """What a follower shows: ``query`` (a link's query without t, speed, paused and view),
     simulation time ``t`` at monotonic time ``at`` [s], ``paused``, ``speed``, the lead's
-    camera (position, look-at, up: three 3-tuples) or None, the traces' length and the
-    elements hidden."""
+    camera (position, look-at, up: three 3-tuples) or None, the traces' length, the
+    elements hidden and the scene's parts hidden."""
 
     leader: str
     query: str
@@ -60,6 +60,7 @@ class LeadState:
     camera: tuple[tuple[float, ...], ...] | None = None
     trail: int | None = None  # the traces' length [points]
     hidden: tuple[str, ...] = ()  # the construction's elements the lead hides (their names)
+    parts: tuple[str, ...] = ()  # the scene's parts the lead hides (their keys)
 
     def time(self, now: float) -> float:
         """Simulation time at monotonic time ``now``."""

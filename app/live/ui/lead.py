@@ -207,7 +207,7 @@ class LeadControls:
                 self.client.camera.look_at = look_at
 
     def _mirror_shown(self, state: LeadState) -> None:
-        """The lead's trail length and the elements it hides."""
+        """The lead's trail length, the elements it hides and the scene's parts it hides."""
         session = self.session
         scene = session.scene
         if state.trail is not None and state.trail != scene.trail_points:
@@ -222,6 +222,8 @@ class LeadControls:
                 changed = True
         if changed:
             session.panel.show_visibility(scene.is_visible)
+        if session.showcase is not None:
+            session.showcase.show_parts(state.parts)
 
     def _open(self, query: str) -> None:
         try:
@@ -250,8 +252,7 @@ class LeadControls:
         if (
             last is None
             or now - last.at >= REPUBLISH
-            or (state.query, state.paused, state.speed, state.camera, state.trail, state.hidden)
-            != (last.query, last.paused, last.speed, last.camera, last.trail, last.hidden)
+            or _shown(state) != _shown(last)
             or abs(state.t - last.time(now)) > JUMP * max(1.0, abs(state.speed))
         ):
             self._published = state
@@ -272,6 +273,7 @@ class LeadControls:
             camera=_camera(self.client),
             trail=scene.trail_points,
             hidden=tuple(e.name for e in sorted(scene.elements) if not scene.is_visible(e)),
+            parts=() if session.showcase is None else session.showcase.hidden_parts(),
         )
 
     def now(self, clock: Any) -> float:
@@ -288,3 +290,16 @@ class LeadControls:
         self.hub.unwatch(id(self))
         self.hub.forget(id(self.client))
         self.hub.leave(self)
+
+
+def _shown(state: LeadState) -> tuple[Any, ...]:
+    """What a follower shows of a state, its time apart."""
+    return (
+        state.query,
+        state.paused,
+        state.speed,
+        state.camera,
+        state.trail,
+        state.hidden,
+        state.parts,
+    )

@@ -75,6 +75,7 @@ class LiveShowcase:
         self.widgets: list[Removable] = []
         self.plots: dict[str, viser.GuiUplotHandle] = {}
         self.sliders: dict[str, viser.GuiSliderHandle[float]] = {}
+        self.part_boxes: dict[str, viser.GuiCheckboxHandle] = {}
         self._shown: dict[str, int] = {}  # plot key -> samples last sent
         self._last_readout = self._last_plot = -1e9
         self._readout_text = ""
@@ -84,6 +85,7 @@ class LiveShowcase:
                 self.widgets.append(self._add_control(control, float(n)))
             for n, part in enumerate(spec.parts):
                 box = self.gui.add_checkbox(part.label, True, order=100.0 + n)
+                self.part_boxes[part.key] = box
                 self.widgets.append(self._on_user(box, self._part_callback(part.key)))
         self.widgets.append(self.folder)
         with motion.tab:
@@ -205,6 +207,18 @@ class LiveShowcase:
 
     def set_visible(self, part: str, visible: bool) -> None:
         self.showcase.set_visible(part, visible)
+
+    def hidden_parts(self) -> tuple[str, ...]:
+        """The keys of the scene's parts that are hidden, in the spec's order."""
+        return tuple(p.key for p in self.spec.parts if not self.showcase.is_visible(p.key))
+
+    def show_parts(self, hidden: tuple[str, ...]) -> None:
+        """Hide exactly the parts ``hidden`` names (a lead's, on a follower), checkboxes too."""
+        for part in self.spec.parts:
+            visible = part.key not in hidden
+            if self.showcase.is_visible(part.key) != visible:
+                self.showcase.set_visible(part.key, visible)
+                set_value(self.part_boxes[part.key], visible)
 
     def remove(self) -> None:
         """Take the scene's nodes away and retire its widgets."""
