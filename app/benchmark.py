@@ -331,7 +331,8 @@ def video_row() -> str:
     import tempfile
     from pathlib import Path
 
-    from poinsot.app.exports.screenshot import THEME_BACKGROUND, find_chromium, open_stage
+    from poinsot.app.exports.chromium import find_chromium
+    from poinsot.app.exports.screenshot import THEME_BACKGROUND, open_stage
     from poinsot.app.exports.video import Clip, film
     from poinsot.app.presets import preset_by_key
     from poinsot.app.scene.cameras import space_view

@@ -19,14 +19,13 @@ from contextlib import contextmanager
 
 from poinsot.app.arguments import bounded_float, non_negative_float, positive_int
 from poinsot.app.cli_types import add_preset_or_scene, video_file, video_size, view_type
-from poinsot.app.exports.screenshot import (
+from poinsot.app.exports.chromium import (
     EXIT_NO_BROWSER,
-    THEME_BACKGROUND,
     BrowserMissing,
     find_chromium,
-    open_stage,
     sigterm_exits,
 )
+from poinsot.app.exports.screenshot import THEME_BACKGROUND, open_stage
 from poinsot.app.exports.strobe import MAX_COPIES, Strobe
 from poinsot.app.exports.video import (
     DEFAULT_FPS,

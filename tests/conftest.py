@@ -34,7 +34,7 @@ import numpy as np
 import pytest
 
 from poinsot.app.cli import main as cli_main
-from poinsot.app.exports.screenshot import CHROMIUM_ARGS, CHROMIUM_ENV, DEFAULT_CHROMIUM
+from poinsot.app.exports.chromium import CHROMIUM_ARGS, CHROMIUM_ENV, DEFAULT_CHROMIUM
 from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.live.server import PoinsotApp
 from poinsot.app.live.ui.lecture import LectureControls

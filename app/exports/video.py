@@ -8,7 +8,7 @@ background). The stage draws on that browser's own scene, so that a frame's upda
 render request after them travel in one queue, in order: every frame shows its own time.
 
 Where a frame's time goes: the software-WebGL draw of the render dominates. The offline page
-draws nothing else (:data:`~poinsot.app.exports.screenshot.OFF_VIEWPORT_CSS`) and draws it at
+draws nothing else (:data:`~poinsot.app.exports.chromium.OFF_VIEWPORT_CSS`) and draws it at
 the clip's own pixels (pixel ratio 1, fixed: the frames keep one sharpness); laying a render on
 the background and encoding it run on a thread of their own, one frame behind the renders
 (:func:`one_behind`), so that they overlap the browser's next draw.
@@ -32,14 +32,13 @@ from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 
+from poinsot.app.exports.chromium import headless_chromium, open_window
 from poinsot.app.exports.screenshot import (
     RGB,
     RenderCamera,
     camera_wxyz,
     content_extent,
     fitted_fov,
-    headless_chromium,
-    open_window,
 )
 from poinsot.app.scene.cameras import BODY_VIEW, ride_along
 from poinsot.app.scene.view import View

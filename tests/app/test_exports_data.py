@@ -21,7 +21,7 @@ import zstandard
 from PIL import Image
 
 from poinsot.app import cli
-from poinsot.app.exports import glb, run_csv, screenshot
+from poinsot.app.exports import chromium, glb, run_csv, screenshot
 from poinsot.app.exports import html as html_export
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import PRESETS, preset_by_key
@@ -311,9 +311,9 @@ def test_cli_screenshot_without_chromium_says_how_to_install_it(tmp_path):
         "screenshot",
         "--out",
         str(out),
-        env={screenshot.CHROMIUM_ENV: str(tmp_path / "no-chromium")},
+        env={chromium.CHROMIUM_ENV: str(tmp_path / "no-chromium")},
     )
-    assert done.returncode == screenshot.EXIT_NO_BROWSER != 0
+    assert done.returncode == chromium.EXIT_NO_BROWSER != 0
     assert "sudo apt-get install chromium" in done.stderr
     assert not out.exists()
 

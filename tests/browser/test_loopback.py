@@ -1,7 +1,7 @@
 """The project's Chromium reaches nothing past loopback.
 
 Chromium is launched exactly as the screenshot command and the browser tests launch it
-(:data:`poinsot.app.exports.screenshot.CHROMIUM_ARGS`), under ``strace``, and loads the live app
+(:data:`poinsot.app.exports.chromium.CHROMIUM_ARGS`), under ``strace``, and loads the live app
 from a loopback server. Every socket call that names an internet address is then checked: TCP and
 UDP connections and datagrams go to 127.0.0.0/8 only. Chromium's IPv6 route probe (a UDP
 ``connect()`` that only asks the kernel for a route) is allowed, provided that nothing is ever
@@ -18,7 +18,7 @@ import stat
 import pytest
 from conftest import chromium_or_fail, in_ci
 
-from poinsot.app.exports.screenshot import headless_chromium
+from poinsot.app.exports.chromium import headless_chromium
 
 pytestmark = pytest.mark.browser
 

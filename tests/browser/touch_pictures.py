@@ -28,7 +28,7 @@ from conftest import (  # noqa: E402
 )
 from test_touch_page import IPHONE, screen_point  # noqa: E402
 
-from poinsot.app.exports.screenshot import CHROMIUM_ARGS  # noqa: E402
+from poinsot.app.exports.chromium import CHROMIUM_ARGS  # noqa: E402
 from poinsot.app.live.server import PoinsotApp  # noqa: E402
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets"

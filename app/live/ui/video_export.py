@@ -22,7 +22,8 @@ from typing import TYPE_CHECKING
 
 import viser
 
-from poinsot.app.exports.screenshot import THEME_BACKGROUND, filename, find_chromium
+from poinsot.app.exports.chromium import find_chromium
+from poinsot.app.exports.screenshot import THEME_BACKGROUND, filename
 from poinsot.app.exports.video import (
     BROWSER_MAX_SECONDS,
     BROWSER_MAX_SIZE,
