@@ -26,13 +26,8 @@ from poinsot.app.scene import ghost as ghost_module
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.frames import wxyz_from_xyzw
 from poinsot.app.scene.geometry import Geometry
-from poinsot.app.scene.ghost import (
-    DEFAULT_TOLERANCE,
-    Ghost,
-    GhostConfig,
-    GhostErrors,
-    time_scale,
-)
+from poinsot.app.scene.ghost import Ghost, GhostErrors
+from poinsot.app.scene.ghost_setting import DEFAULT_TOLERANCE, GhostConfig, time_scale
 from poinsot.app.scene.sampling import evaluate
 from poinsot.physics.core.rotations import geodesic_angle, rotate_vector
 from poinsot.physics.integrators import METHODS, State

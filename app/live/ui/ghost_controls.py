@@ -29,13 +29,13 @@ from poinsot.app.live.ui.engine_upload import EngineLogUpload
 from poinsot.app.live.ui.widgets import Retirement, Sent, on_user, set_value
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
-from poinsot.app.scene.ghost import (
+from poinsot.app.scene.ghost import Ghost
+from poinsot.app.scene.ghost_setting import (
     DEFAULT_METHOD,
     DEFAULT_TOLERANCE,
     DIVISIONS,
     GAME_STEP_RATES,
     TOLERANCES,
-    Ghost,
     GhostConfig,
     division_label,
     game_step_label,
