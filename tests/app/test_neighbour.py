@@ -13,6 +13,7 @@ from conftest import session_of, wait_until
 from poinsot.app.live.ui import neighbour
 from poinsot.app.presets import preset_by_key
 from poinsot.app.scenes.twins import TWIN_STEP
+from poinsot.physics.core.rotations import geodesic_angle
 
 
 def _choose(probe, option: str) -> None:
@@ -39,8 +40,9 @@ def test_a_neighbour_of_a_stable_preset_is_drawn_at_its_exact_attitude(poinsot_a
     grid = math.floor(t / TWIN_STEP + 1e-9) * TWIN_STEP
     x, y, z, w = body.attitude(grid).as_quat()
     assert folder.frame is not None
-    shown = np.asarray(folder.frame.wxyz)
-    assert 2.0 * math.acos(min(1.0, abs(float(shown @ np.array([w, x, y, z]))))) < 1e-9
+    shown_w, *shown_xyz = np.asarray(folder.frame.wxyz)
+    # The geodesic angle (2 acos |p.q| would give 3e-8 for two equal quaternions' rounding).
+    assert float(geodesic_angle([*shown_xyz, shown_w], [x, y, z, w])) < 1e-9
     _choose(probe, neighbour.OPTIONS[0])
     assert wait_until(lambda: folder.body is None and folder.frame is None, 10)
     assert probe.wait_for(lambda p: f"{neighbour.NODE}/solid" not in p.nodes, 10)
