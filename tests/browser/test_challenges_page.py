@@ -14,7 +14,7 @@ pytestmark = pytest.mark.browser
 
 def test_a_student_answers_a_challenge_and_sees_the_reveal_and_the_score(make_app, open_page):
     app = make_app()
-    page = open_page(app.url, width=1280, height=800)
+    page = open_page(app.url, width=1280, height=800, live_view=False)
     session = session_of(app)
     assert wait_until(lambda: session.stats.frames > 20, 20)
     folder = session.lecture.challenges

@@ -294,7 +294,7 @@ def started_session(app):
 
 
 def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_page):
-    page = open_page(poinsot_app.url, width=960, height=540)
+    page = open_page(poinsot_app.url, width=960, height=540, live_view=False)
     session = started_session(poinsot_app)
     lecture = lecture_of(session)
     # Current view: the 3D view's size, opaque on the dark theme's background.

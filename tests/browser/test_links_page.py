@@ -129,7 +129,7 @@ def reopen(page: BrowserPage, url: str) -> BrowserPage:
 @pytest.mark.parametrize("query", list(LINKS))
 def test_a_link_opens_its_state_and_copy_link_gives_it_back(app, open_page, query):
     known = set(app.sessions())
-    page = open_page(f"{app.url}/?{query}")
+    page = open_page(f"{app.url}/?{query}", live_view=False)
     session = new_session(app, known)
     LINKS[query](page, session)
     link = copy_link(page, session)
@@ -153,7 +153,7 @@ def test_links_through_the_landing_open_on_either_worker(make_app, make_probe, o
     try:
         for query, check in LINKS.items():
             link = f"http://127.0.0.1:{landing.port}/?{query}"
-            page = open_page(link) if page is None else reopen(page, link)
+            page = open_page(link, live_view=False) if page is None else reopen(page, link)
             url = urllib.parse.urlsplit(page.page.url)
             assert url.query == query  # the redirect kept the link's state
             app = next(a for a in apps if a.port == url.port)
@@ -179,7 +179,7 @@ def test_a_link_through_the_readme_s_nginx_opens_its_state(balancer, open_page):
     gives the address the browser sees (nginx's), not the server's behind it."""
     port, apps = balancer
     query = "preset=t_handle&t=12&view=side&paused=1"
-    page = open_page(f"http://127.0.0.1:{port}/?{query}")
+    page = open_page(f"http://127.0.0.1:{port}/?{query}", live_view=False)
     assert wait_until(lambda: sum(len(a.sessions()) for a in apps) == 1, 30)
     session = session_of(next(a for a in apps if a.sessions()))
     check_preset_link(page, session)
@@ -202,7 +202,7 @@ def test_a_bad_link_opens_the_default_scene_and_names_the_parameter(app, open_pa
     page = None
     for query, named in BAD.items():
         url = f"{app.url}/?{query}"
-        page = open_page(url) if page is None else reopen(page, url)
+        page = open_page(url, live_view=False) if page is None else reopen(page, url)
         session = new_session(app, known)
         message = page.page.get_by_text("This link could not be opened")
         assert wait_until(lambda m=message: m.count() == 1, 20), query

@@ -33,17 +33,20 @@ MIN_COLOUR_PIXELS = 12
 MIN_PART_CHANGE = 60 / (WIDTH * HEIGHT)
 
 
+def render_once(session) -> np.ndarray:
+    """The browser's render of its 3D view (no panel, no notice), laid on black, (H, W, 3).
+    It shows every change of the scene's state sent before it (viser applies the client's
+    messages in order, the render request last)."""
+    rgba = session.client.get_render(HEIGHT, WIDTH, transport_format="png", timeout=60.0)
+    return (rgba[..., :3].astype(np.float64) * (rgba[..., 3:4] / 255.0)).astype(np.int16)
+
+
 def render(session) -> np.ndarray:
-    """The browser's render of its 3D view (no panel, no notice), laid on black, (H, W, 3),
-    once two renders in a row agree (the browser decodes new nodes asynchronously)."""
-
-    def once() -> np.ndarray:
-        rgba = session.client.get_render(HEIGHT, WIDTH, transport_format="png", timeout=60.0)
-        return (rgba[..., :3].astype(np.float64) * (rgba[..., 3:4] / 255.0)).astype(np.int16)
-
-    previous = once()
+    """:func:`render_once`, once two renders in a row agree (the browser decodes new nodes,
+    a scene's meshes and labels, asynchronously)."""
+    previous = render_once(session)
     for _ in range(10):
-        current = once()
+        current = render_once(session)
         if np.array_equal(current, previous):
             return current
         previous = current
@@ -64,12 +67,13 @@ def settle(page, session, spec: SceneSpec) -> None:
 
 
 def render_until(session, done, timeout: float = 60.0) -> np.ndarray:
-    """The first settled render for which ``done(picture)`` holds (the page applies a change
-    on its next frames: the event waited for is the picture itself), or the last one."""
+    """The first render for which ``done(picture)`` holds, or the last one. A part shown or
+    hidden is a visibility flag (nothing to decode): the first render after it normally
+    shows it; the event waited for is the picture itself."""
     deadline = time.monotonic() + timeout
-    picture = render(session)
+    picture = render_once(session)
     while not done(picture) and time.monotonic() < deadline:
-        picture = render(session)  # each a round trip to the page: no sleep needed
+        picture = render_once(session)  # each a round trip to the page: no sleep needed
     return picture
 
 
@@ -97,7 +101,7 @@ def test_every_scene_draws_its_parts_distinctly(make_app, open_page):
     pictures: dict[str, np.ndarray] = {}
     for spec in SCENES:
         app = make_app(scene=spec)
-        page = open_page(app.url, width=WIDTH, height=HEIGHT)
+        page = open_page(app.url, width=WIDTH, height=HEIGHT, live_view=False)
         session = session_of(app)
         settle(page, session, spec)
         shown = render(session)
@@ -123,7 +127,7 @@ def test_every_scene_draws_its_parts_distinctly(make_app, open_page):
 
 def test_the_menu_takes_the_browser_to_a_scene_and_back(make_app, open_page):
     app = make_app()
-    page = open_page(app.url, width=WIDTH, height=HEIGHT)
+    page = open_page(app.url, width=WIDTH, height=HEIGHT, live_view=False)
     session = session_of(app)
     assert wait_until(lambda: session.stats.frames > 20, 20)
     spec = scene_by_name("dzhanibekov")

@@ -31,7 +31,7 @@ def started(app):
 
 def test_the_video_button_downloads_an_mp4_of_the_current_view(poinsot_app, open_page, tmp_path):
     chromium_or_fail()
-    page = open_page(poinsot_app.url, width=960, height=540)
+    page = open_page(poinsot_app.url, width=960, height=540, live_view=False)
     session = started(poinsot_app)
     lecture = lecture_of(session)
     page.press_slider("Video length [s]", "Home")  # 1 s
@@ -67,7 +67,7 @@ def test_the_video_button_downloads_an_mp4_of_the_current_view(poinsot_app, open
 
 def test_a_video_can_be_cancelled_and_the_next_one_starts(poinsot_app, open_page):
     chromium_or_fail()
-    page = open_page(poinsot_app.url, width=960, height=540)
+    page = open_page(poinsot_app.url, width=960, height=540, live_view=False)
     session = started(poinsot_app)
     lecture = lecture_of(session)
     video = lecture.video
@@ -95,7 +95,7 @@ def test_a_video_can_be_cancelled_and_the_next_one_starts(poinsot_app, open_page
 def test_the_strobe_toggle_adds_eight_copies_to_the_screenshot(make_app, open_page):
     chromium_or_fail()
     app = make_app(preset_by_key("t_handle"))
-    page = open_page(app.url, width=960, height=540)
+    page = open_page(app.url, width=960, height=540, live_view=False)
     session = started(app)
     lecture = lecture_of(session)
     assert wait_until(lambda: session.clock.now() > 2.0, 60)
