@@ -386,11 +386,21 @@ class BrowserPage:
 
     def set_live_view(self, on: bool) -> None:
         """Draw the live 3D view (on), or only the renders asked of it (off: the view is kept
-        out of the viewport, see :data:`NO_LIVE_VIEW_JS`), until the page is loaded again."""
+        out of the viewport, see :data:`NO_LIVE_VIEW_JS`), until the page is loaded again.
+        Switched on, it returns once the view has drawn two frames in the viewport (a paused
+        scene draws about one a second): the page's pixels are then the scene's now."""
+        drawn = self.frames_drawn()
         flag = "true" if not on else "false"
         assert self.page.evaluate(
             f"() => {{ window.__poinsotParked = {flag}; return window.__poinsotPark(); }}"
         )
+        if on:
+            assert wait_until(lambda: self.frames_drawn() >= drawn + 2, 30), "no frame drawn"
+
+    def frames_drawn(self) -> int:
+        """The frames the page's 3D view has drawn (three.js counts them; viser exposes its
+        renderer's counters for browser tests)."""
+        return int(self.page.evaluate(FRAMES_DRAWN_JS))
 
     def canvas_box(self) -> FloatRect:
         box = self.page.locator("canvas").first.bounding_box()
@@ -419,7 +429,7 @@ HIDE_SOFTWARE_WEBGL_NOTICE_JS = """(() => {
 NO_LIVE_VIEW_JS = """(() => {
   window.__poinsotParked = %s;
   window.__poinsotPark = () => {
-    const canvas = document.querySelector('canvas');
+    const canvas = document.querySelector('canvas[data-engine]');  // three.js's, not an overlay
     let view = canvas ? canvas.parentElement : null;
     while (view && !(view.style.position === 'relative' && view.style.zIndex === '0')) {
       view = view.parentElement;
@@ -431,6 +441,12 @@ NO_LIVE_VIEW_JS = """(() => {
   };
   setInterval(window.__poinsotPark, 100);
 })();"""
+
+
+FRAMES_DRAWN_JS = """() => {
+  const points = window.__viserTestpoints;
+  return points ? points.rendererInfo.render.frame : 0;
+}"""
 
 
 @contextlib.contextmanager

@@ -422,7 +422,7 @@ def test_errors_refuse_non_finite_numbers():
 # -- a real browser ---------------------------------------------------------------------------
 @pytest.mark.browser
 def test_the_ghost_shows_a_second_ellipsoid_in_the_browser(poinsot_app, open_page):
-    page = open_page(poinsot_app.url)
+    page = open_page(poinsot_app.url, live_view=False)  # drawn once paused, below
     session = session_of(poinsot_app)
     assert wait_until(lambda: session.stats.frames > 20, 20)
     session.set_speed(4.0)
@@ -434,6 +434,7 @@ def test_the_ghost_shows_a_second_ellipsoid_in_the_browser(poinsot_app, open_pag
     assert wait_until(lambda: ghost.errors is not None and ghost.errors.attitude > 0.1, 40)
     page.click_button("Pause")
     assert wait_until(lambda: session.clock.paused, 5)
+    page.set_live_view(True)
     page.page.mouse.move(300, 60)  # no tooltip over the scene
     page.page.wait_for_timeout(1500)
     with_ghost = page.screenshot_rgb().astype(int)

@@ -56,9 +56,10 @@ def pause(page, session) -> None:
 
 @pytest.fixture(scope="module")
 def shared(make_module_app, open_module_page):
-    """(app, page, its session): one page on one app for the whole module."""
+    """(app, page, its session): one page on one app for the whole module, drawing no live
+    frames until the first test that reads the 3D view's pixels switches them on."""
     app = make_module_app()
-    page = open_module_page(app.url)
+    page = open_module_page(app.url, live_view=False)
     return app, page, started(app)
 
 
@@ -94,6 +95,7 @@ def test_canvas_shows_the_ellipsoid(shared):
     app, page, _ = shared
     session = started(app)
     pause(page, session)
+    page.set_live_view(True)  # and so it stays for the module's later tests
     page.page.wait_for_timeout(500)
     shown = canvas_pixels(page)
     page.open_folder("Show")  # collapsed by default
@@ -168,7 +170,7 @@ def test_two_browsers_have_independent_sessions(shared, open_page):
     """The module's page is the first browser (it chooses a preset: any it showed before is
     replaced whole); a new page is the second, on the default preset."""
     app, first, a = shared
-    second = open_page(app.url)
+    second = open_page(app.url, live_view=False)
     assert wait_until(lambda: len(app.sessions()) == 2, 10)
     b = session_of(app, 2)
     assert a is not b

@@ -41,7 +41,9 @@ class Pages:
     """The module's pages on its one app, one open at a time (an open page animates, and
     software WebGL draws it on a core): a test asks for a page of a size and address and gets
     the open one if it has them, put back to the first screen's state (the default preset,
-    running at its speed, the default view, dark theme), else a new one (the old closed)."""
+    running at its speed, the default view, dark theme), else a new one (the old closed).
+    A page draws no live frames (see :meth:`BrowserPage.set_live_view`) until a test that
+    reads the 3D view's pixels switches them on."""
 
     def __init__(self, app, open_page) -> None:
         self.app, self.open_page = app, open_page
@@ -56,7 +58,9 @@ class Pages:
         if fresh or key != self.key or self.page is None or self.page.page.is_closed():
             self.close()
             before = set(self.app.sessions())
-            self.page = self.open_page(f"{self.app.url}{query}", width=width, height=height)
+            self.page = self.open_page(
+                f"{self.app.url}{query}", width=width, height=height, live_view=False
+            )
             assert wait_until(lambda: self.newest_id() not in before, 20), "no new session"
             self.session, self.key = session_of(self.app), key
         else:
@@ -87,8 +91,10 @@ class Pages:
         set_theme(page, session, "dark")
         target, camera = VIEWS["default"], session.client.camera
         if not at_view(camera, target):
+            page.set_live_view(True)  # the camera's move to the view is animated frame by frame
             page.click_button("default")
             assert wait_until(lambda: at_view(camera, target), 20)
+        page.set_live_view(False)
 
     def close(self) -> None:
         if self.page is not None:
@@ -296,6 +302,7 @@ def test_the_herpolhode_is_legible_in_the_default_view(pages, size, theme):
     session.set_speed(4.0)  # two periods of ω in about five seconds
     assert wait_until(lambda: session.frame is not None and session.frame.t > 2.2 * 8.921, 30)
     pause(page, session)
+    page.set_live_view(True)
     page.page.wait_for_timeout(1000)
     rgb, box = canvas_slice(page)
     x0, x1 = int(box["x"]), int(box["x"] + box["width"])
@@ -415,6 +422,7 @@ def test_the_sphere_shows_omega_and_L_apart(pages):
     """ω is parallel to L: the thicker ω arrow shows up to the plane round the thinner L, L
     goes on above it, and their labels stand apart."""
     page, session = pages.get(1280, 800)
+    page.set_live_view(True)
     started(session)
     page.choose("Preset", preset_by_key("sphere").label)
     assert wait_until(lambda: session.preset.key == "sphere" and session.body is not None, 10)
@@ -512,7 +520,7 @@ def test_sphere_and_custom_alternate_without_console_errors(pages):
     page, session = pages.get(1280, 800)
     started(session)
     sphere = preset_by_key("sphere")
-    for n in range(8):
+    for n in range(4):  # two rounds of switches by the dropdown, two by the server
         for preset in (sphere, CUSTOM):
             if n % 2:  # the server switches while the page is frozen
                 timer = threading.Timer(0.3, lambda p=preset: session.choose_preset(p))
@@ -534,6 +542,7 @@ def test_sphere_and_custom_alternate_without_console_errors(pages):
 @pytest.mark.serial
 def test_projector_mode_folds_the_panels_and_thickens_the_picture(pages):
     page, session = pages.get(1280, 800)
+    page.set_live_view(True)
     started(session, frames=40)
     pause(page, session)
     page.page.wait_for_timeout(800)
@@ -575,6 +584,7 @@ def test_two_views_show_the_body_frame_beside_the_space_frame(pages):
     """The space frame (left: the herpolhode on the plane) and the body frame (right: the
     ellipsoid with its polhode, no herpolhode), side by side."""
     page, session = pages.get(1280, 800)
+    page.set_live_view(True)
     started(session, frames=40)
     page.set_checkbox("Two views: space | body", True)
     assert wait_until(lambda: session.lecture.display.body_view is not None, 10)
@@ -629,6 +639,7 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     # Two pictures compared pixel by pixel: the canvas's pixel ratio must not change between
     # them (viser lowers it while frames are slow; a URL option of its client holds it).
     page, session = pages.get(1280, 800, "?fixedDpr=1")
+    page.set_live_view(True)
     started(session, frames=40)
     pause(page, session)
     page.click_button(view)

@@ -37,9 +37,10 @@ def choose_file(page, button: str, path) -> None:
 
 @pytest.fixture(scope="module")
 def shared(make_module_app, open_module_page):
-    """(app, page): one page on one app for both uploads (the mesh's after the recording's)."""
+    """(app, page): one page on one app for both uploads (the mesh's after the recording's),
+    drawing no live frames until the mesh's test reads the 3D view's pixels."""
     app = make_module_app()
-    return app, open_module_page(app.url)
+    return app, open_module_page(app.url, live_view=False)
 
 
 def open_entry(shared, label: str, button: str):
@@ -97,6 +98,7 @@ def test_an_uploaded_mesh_becomes_the_body(shared):
     if not session.clock.paused:  # (the module's page: as the test before left it)
         page.click_button("Pause")
     assert wait_until(lambda: session.clock.paused, 5)
+    page.set_live_view(True)
     page.page.wait_for_timeout(500)
     before = page.screenshot_rgb()
     finished = session.uploads.finished
