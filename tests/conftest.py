@@ -84,12 +84,22 @@ BROWSER_ELSEWHERE = frozenset(
 
 
 #: The real-browser tests by group, each group on a worker of its own with a Chromium of its
-#: own. One group today: software WebGL takes a core while it draws, and on this 2-core machine
-#: two Chromiums beside two more workers made timing-sensitive browser tests flaky (a slider's
-#: key presses, a camera's ride-along, a restyle not yet drawn: three full runs, three different
-#: failures), and three beside six workers slowed the whole suite. A browser file that is not
-#: listed joins :data:`BROWSER_LAST_GROUP`; more groups are one entry each here.
-BROWSER_GROUPS: dict[str, str] = {}
+#: own. Two groups of about equal time: a page that draws its live view takes a core of
+#: software WebGL, and with every page drawing two Chromiums beside two more workers made
+#: timing-sensitive browser tests flaky on this 2-core machine; now a page draws only while a
+#: test reads its 3D view (``set_live_view``), and a Chromium is mostly idle. A browser file
+#: that is not listed joins :data:`BROWSER_LAST_GROUP`; more groups are one entry each here.
+BROWSER_GROUPS: dict[str, str] = {
+    path: "browser-0"
+    for path in (
+        "tests/browser/test_picture_page.py",
+        "tests/browser/test_scenes_page.py",
+        "tests/browser/test_touch_page.py",
+        "tests/browser/test_loopback.py",
+        "tests/browser/test_strobe_picture.py",
+        "tests/browser/test_challenges_page.py",
+    )
+}
 BROWSER_LAST_GROUP = "browser-1"
 #: Groups that take a minute or more without a browser: they start right after the browser
 #: groups (a long group started last would be the suite's long pole).

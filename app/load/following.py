@@ -165,9 +165,11 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         with FollowFleet(server.port, server.code, count, cfg.lifetime) as fleet:
             time.sleep(warmup(cfg.follow_seconds))
             pids = server.worker_pids or [server.pid]
+            clients0 = _cpu([fleet.pid])
             following = fleet.window(
                 cfg.follow_seconds, cfg.slider_period, cfg.follow_redraw_timeout
             )
+            clients = (_cpu([fleet.pid]) - clients0) / following["seconds"]
             cpu0 = _cpu(pids)
             still = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu1 = _cpu(pids)
@@ -176,7 +178,7 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
             own = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu3 = _cpu(pids)
         costs = (_ms_per_frame(cpu1 - cpu0, still), _ms_per_frame(cpu3 - cpu2, own))
-        report.add(*_figures(count, following, own, costs, explored))
+        report.add(*_figures(count, following, own, costs, explored, clients))
 
 
 def _ms_per_frame(cpu: float, window: dict) -> float:
@@ -185,8 +187,16 @@ def _ms_per_frame(cpu: float, window: dict) -> float:
 
 
 def _figures(
-    count: int, following: dict, own: dict, costs: tuple[float, float], explored: bool
+    count: int,
+    following: dict,
+    own: dict,
+    costs: tuple[float, float],
+    explored: bool,
+    clients: float,
 ) -> list[Figure]:
+    """The figures of one size; ``clients``: the CPU of the clients' process while following
+    [cores] (near 1, its one interpreter would be the limit of the frame rates, not the
+    server)."""
     fps, latencies = following["fps"], following["latencies"]
     lost = following["moves"] * count - len(latencies)
     p95 = 1e3 * percentile(latencies, 95) if latencies else math.nan
@@ -214,10 +224,12 @@ def _figures(
             "follow",
             f"{name}: server CPU per frame",
             f"{follow_ms:.2f} ms per follower-frame, {own_ms:.2f} ms per session-frame "
-            f"(the same clients after Explore from here, {own_fps_text(own)}; nothing moved)",
+            f"(the same clients after Explore from here, {own_fps_text(own)}; nothing moved); "
+            f"the clients' process {100 * clients:.0f} % of a core while following",
             follower_ms=follow_ms,
             session_ms=own_ms,
             explored=float(explored),
+            clients_cpu=clients,
         ),
     ]
 

@@ -164,6 +164,7 @@ def test_follow_phase_measures_followers_and_their_cost(follow_report):
     assert moves["moves"] >= 2 and moves["lost"] == 0 and moves["redraws"] == 3 * moves["moves"]
     cost = report.figure("follow", "3 followers: server CPU per frame").detail
     assert cost["explored"] == 1.0 and cost["follower_ms"] > 0 and cost["session_ms"] > 0
+    assert cost["clients_cpu"] > 0  # the clients' own process, measured beside the server
 
 
 # -- the goals, judged on the same figures -----------------------------------------------------

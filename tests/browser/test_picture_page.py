@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import colorsys
 import re
+import time
 
 import numpy as np
 import pytest
@@ -655,13 +656,12 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     ), (view, camera_handle.position, camera_handle.look_at)
     lay_out_on_the_frame_thread(session)
     page.page.wait_for_timeout(800)
-    shown = page.screenshot_rgb().astype(int)
+    shown = settled_screenshot(page)
     handles = label_handles(session)
     assert len(handles) == 7
     for handle in handles:
         handle.visible = False
-    page.page.wait_for_timeout(800)
-    hidden = page.screenshot_rgb().astype(int)
+    hidden = settled_screenshot(page, unlike=shown)
     for handle in handles:
         handle.visible = True
     box = page.canvas_box()
@@ -689,6 +689,21 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     labels = np.isin(patches, 1 + np.flatnonzero(sizes > 40))
     assert not labels[cy - 4 : cy + 5, cx - 4 : cx + 5].any(), "a label covers the contact point"
     assert page.errors == []
+
+
+def settled_screenshot(page, unlike: np.ndarray | None = None, timeout: float = 30.0) -> np.ndarray:
+    """The page's pixels once two screenshots in a row agree (and differ from ``unlike``: a
+    change sent to the page has been drawn), as ints."""
+    deadline = time.monotonic() + timeout
+    previous = page.screenshot_rgb().astype(int)
+    while time.monotonic() < deadline:
+        current = page.screenshot_rgb().astype(int)
+        if np.array_equal(current, previous) and (
+            unlike is None or not np.array_equal(current, unlike)
+        ):
+            return current
+        previous = current
+    raise AssertionError("the page's picture did not settle")
 
 
 def handle_world(session, handle) -> np.ndarray:
