@@ -120,10 +120,10 @@ class Session:
         self.playback = Playback(self.clock, self.scene, self.panel.show_playback, self.max_fps)
         # The ghost's controls; the ghost itself when switched on (fitted after each rebuild).
         self.ghost = add_ghost_controls(client, self.scene, self.retirement)
+        self.follow = LeadControls(self, follow if follow is not None else FollowHub())
         self._apply_preset(preset) if scene is None else self._apply_scene(scene)
         self._rebuild()
         self._mount_tools(user_agent)
-        self.follow = LeadControls(self, follow if follow is not None else FollowHub())
 
     def _frame_loop(self) -> FrameLoop:
         return FrameLoop(
@@ -434,8 +434,8 @@ class Session:
     def _shared_motion(self, params: Parameters, solid: Solid | None) -> Motion | None:
         """While following: the process's one motion of this body, on the grid of this frame
         time from t = 0 (the first follower to ask builds it); else None."""
-        follow = getattr(self, "follow", None)  # None in the first build, before the folder
-        if follow is None or follow.mode != "follow":
+        follow = self.follow
+        if follow.mode != "follow":
             return None
         frame_time = self.frame_time
         return follow.hub.motions.get(
