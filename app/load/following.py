@@ -178,7 +178,7 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
             own = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu3 = _cpu(pids)
         costs = (_ms_per_frame(cpu1 - cpu0, still), _ms_per_frame(cpu3 - cpu2, own))
-        report.add(*_figures(count, following, own, costs, explored, clients))
+        report.add(*_figures(count, following, still, own, costs, explored, clients))
 
 
 def _ms_per_frame(cpu: float, window: dict) -> float:
@@ -189,12 +189,15 @@ def _ms_per_frame(cpu: float, window: dict) -> float:
 def _figures(
     count: int,
     following: dict,
+    still: dict,
     own: dict,
     costs: tuple[float, float],
     explored: bool,
     clients: float,
 ) -> list[Figure]:
-    """The figures of one size; ``clients``: the CPU of the clients' process while following
+    """The figures of one size. The frame rates judged are those while the lead moves a
+    slider every period (each move rebuilds every follower's body); ``still``'s, while nothing
+    moves, are shown beside them. ``clients``: the CPU of the clients' process while following
     [cores] (near 1, its one interpreter would be the limit of the frame rates, not the
     server)."""
     fps, latencies = following["fps"], following["latencies"]
@@ -207,7 +210,7 @@ def _figures(
             "follow",
             f"{name}: fps each",
             min(fps) if fps else 0.0,
-            fps_text(fps),
+            f"{fps_text(fps)} (nothing moving: {fps_text(still['fps'])})",
             at_least("min_fps", ">= {:g} fps"),
             {"clients": count, "p50": statistics.median(fps) if fps else 0.0},
         ),

@@ -10,6 +10,7 @@ frame only once it has taken the ones before, so that buffer never grows).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import logging
 import threading
@@ -382,8 +383,13 @@ class Session:
 
     def _rebuild(self) -> None:
         """Build the body for the desired parameters and load it; on a ValueError keep the
-        last valid scene and say why."""
-        with self.budget.rebuild():
+        last valid scene and say why. A session's own rebuild holds the other sessions'
+        frames (:class:`RebuildGate`: the student who moved a slider sees the new body at once);
+        a follower's does not: it mirrors the lead's move, whose rebuild took precedence where
+        the lead is, and a class of followers rebuilding one after the other would hold each
+        other's frames for the whole round."""
+        own = self.follow.mode != "follow"
+        with self.budget.rebuild() if own else contextlib.nullcontext():
             start = time.perf_counter()
             desired = self._desired
             self._dirty = False
