@@ -91,7 +91,10 @@ def test_answer_then_play_in_a_session(poinsot_app, probe) -> None:
     assert wait_until(lambda: folder.axis.value == AXES[axis], 10)
     probe.set_value(probe.widget(challenges.PLAY)[0], True)
     assert wait_until(lambda: folder.revealed, 10)
-    assert "Right!" in folder.reveal.content and first.explanation in folder.reveal.content
+    reveal = folder.reveal
+    assert wait_until(
+        lambda: "Right!" in reveal.content and first.explanation in reveal.content, 30
+    )
     assert folder.score == folder.answered == 1
     assert wait_until(lambda: session.params == first.params, 10)  # its motion plays
     assert not session.clock.paused

@@ -261,8 +261,9 @@ def test_a_non_finite_solution_stops_the_ghost_and_says_why(poinsot_app, probe):
 
     ghost.propagation.advance = broken  # type: ignore[method-assign]
     assert wait_until(lambda: session.ghost.ghost is None, 5)
-    assert "Ghost stopped" in session.ghost.message.content
-    assert "not finite" in session.ghost.message.content
+    message = session.ghost.message  # written as the ghost goes: wait for it
+    assert wait_until(lambda: "Ghost stopped" in message.content, 30), message.content
+    assert "not finite" in message.content
     assert probe.wait_for(lambda p: ghost_nodes(p) == set(), 5)
     assert probe.wait_for(lambda p: p.widget(CHECKBOX)[1].value is False, 5)
     assert recorder.all_finite()

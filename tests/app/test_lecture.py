@@ -79,7 +79,9 @@ def test_csv_button_downloads_the_run_so_far(live):
     omega, _ = session.body.state(run.t)
     assert np.array_equal(run.omega, omega)
     assert run.meta["scene"] == session.preset.key
-    assert "Saved" in lecture_of(session).message.content
+    # The message is written just after the download is sent: wait for it.
+    message = lecture_of(session).message
+    assert wait_until(lambda: "Saved" in message.content, 30), message.content
 
 
 def test_glb_button_downloads_the_current_construction(live):

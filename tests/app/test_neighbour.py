@@ -27,7 +27,8 @@ def test_a_neighbour_of_a_stable_preset_is_drawn_at_its_exact_attitude(poinsot_a
     _choose(probe, "1e-2 rad")
     assert wait_until(lambda: folder.body is not None, 10)
     assert probe.wait_for(lambda p: f"{neighbour.NODE}/solid" in p.nodes, 10)
-    assert "stays close" in folder.readout.content
+    # The readout is written after the body is set: wait for it.
+    assert wait_until(lambda: "stays close" in folder.readout.content, 30), folder.readout.content
     body = folder.body
     w0, w1 = session.body.omega0, body.omega0
     between = math.atan2(np.linalg.norm(np.cross(w0, w1)), float(w0 @ w1))

@@ -309,7 +309,9 @@ def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_p
     rgb = np.asarray(image)
     assert tuple(rgb[0, 0]) == THEME_BACKGROUND[True]
     assert amber_fraction(rgb) > MIN_AMBER
-    assert name in lecture.message.content and page.errors == []
+    # The message is written just after the download is sent: wait for it.
+    assert wait_until(lambda: name in lecture.message.content, 30), lecture.message.content
+    assert page.errors == []
     # 1920×1080, transparent: RGBA, clear where nothing is drawn.
     page.choose("Picture size", "1920×1080")
     page.set_checkbox("Transparent PNG", True)

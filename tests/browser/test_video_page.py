@@ -79,7 +79,8 @@ def test_a_video_can_be_cancelled_and_the_next_one_starts(poinsot_app, open_page
     assert wait_until(lambda: video.progress.visible and video.progress.value > 0, 240), (
         lecture.message.content
     )
-    assert "frame" in lecture.message.content
+    # The progress bar moves just before the message names the frame: wait for it.
+    assert wait_until(lambda: "frame" in lecture.message.content, 30), lecture.message.content
     page.click_button("Cancel video")
     assert wait_until(lambda: video.thread is not None and not video.thread.is_alive(), 60)
     assert lecture.message.content == "Video cancelled."
