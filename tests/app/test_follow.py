@@ -9,6 +9,7 @@ from __future__ import annotations
 import asyncio
 import multiprocessing
 import re
+import threading
 import types
 
 import pytest
@@ -180,9 +181,13 @@ def test_followers_share_one_build_mirror_what_is_shown_and_cannot_point(poinsot
     )
     motions = poinsot_app.follow.motions
     builds = motions.builds
+    gated = _gated_rebuilds(poinsot_app.budget)
     _set(lead, D, 2.3)
     for probe in probes:
         assert probe.wait_for(lambda p: _value(p, D) == pytest.approx(2.3), 30)
+    # Only the lead's own rebuild held the other sessions' frames, not the followers' mirrors.
+    assert wait_until(lambda: lead_session.generation > 0 and gated, 30)
+    assert set(gated) == {lead_session.loop.name}, gated
     assert motions.builds == builds + 1  # one build for the three followers
     shared = followers[0].scene.motion
     assert shared is not None and shared.body.D == pytest.approx(2.3)
@@ -219,16 +224,38 @@ def test_followers_share_one_build_mirror_what_is_shown_and_cannot_point(poinsot
     down = ((0.0, 0.0, 5.0), (0.0, 0.0, -1.0))  # through the centre: it meets the ellipsoid
     click = types.SimpleNamespace(client=follower.client, ray_origin=down[0], ray_direction=down[1])
     drag = types.SimpleNamespace(client=follower.client, phase="update", end_position=(0, 0, 0))
-    asyncio.run(pointer._on_drag(drag))
-    asyncio.run(pointer._on_click(click))
+    _run(pointer._on_drag(drag))
+    _run(pointer._on_click(click))
     assert probe.wait_for(lambda p: _says(p, HELD), 30)
     after_frames(follower)
     assert pointer.starts == 0 and pointer.previews == 0 and not follower.clock.paused
     assert follower.params == followers[1].params
     _set(probe, "Explore from here")
     assert probe.wait_for(lambda p: _says(p, "Exploring on your own"), 30)
-    asyncio.run(pointer._on_click(click))
+    _run(pointer._on_click(click))
     assert wait_until(lambda: pointer.starts == 1, 30)
+
+
+def _run(coroutine) -> None:
+    """Run a pointer's callback to the end on a thread of its own, as viser's loop would (this
+    thread may hold the event loop of a real-browser test that ran before, in this worker)."""
+    thread = threading.Thread(target=asyncio.run, args=(coroutine,))
+    thread.start()
+    thread.join(30)
+    assert not thread.is_alive(), "the pointer's callback did not end"
+
+
+def _gated_rebuilds(gate) -> list[str]:
+    """The frame threads whose rebuilds take ``gate`` from now on (their names, in order)."""
+    names: list[str] = []
+    rebuild = gate.rebuild
+
+    def recorded():
+        names.append(threading.current_thread().name)
+        return rebuild()
+
+    gate.rebuild = recorded
+    return names
 
 
 def test_a_second_leader_takes_over_and_the_first_is_told(poinsot_app, make_probe):

@@ -55,7 +55,7 @@ def live(poinsot_app, make_probe):
     downloads = Downloads(probe)
     assert probe.wait_for(lambda p: p.has_widget("Screenshot (PNG)"), 15), probe.labels()
     session = session_of(poinsot_app)
-    assert wait_until(lambda: session.stats.frames > 5 and session.clock.now() > 0.1, 15)
+    assert wait_until(lambda: session.stats.frames > 5 and session.clock.now() > 0.1, 30)
     return probe, downloads, session
 
 

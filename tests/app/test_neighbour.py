@@ -36,7 +36,7 @@ def test_a_neighbour_of_a_stable_preset_is_drawn_at_its_exact_attitude(poinsot_a
     # posed at its own attitude: the node's pose is the body's at a grid time near the frame
     session.clock.paused = True
     frames = session.stats.frames
-    assert wait_until(lambda: session.stats.frames > frames + 5, 10)
+    assert wait_until(lambda: session.stats.frames > frames + 5, 30)
     t = session.frame.t
     grid = math.floor(t / TWIN_STEP + 1e-9) * TWIN_STEP
     x, y, z, w = body.attitude(grid).as_quat()

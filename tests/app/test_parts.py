@@ -330,7 +330,7 @@ def test_a_rebuild_holds_the_other_sessions_frames_for_a_bounded_time(probe, poi
     session = session_of(poinsot_app)
     budget = poinsot_app.budget
     assert not budget.rebuilding
-    assert wait_until(lambda: session.stats.frames > 5, 10)
+    assert wait_until(lambda: session.stats.frames > 5, 30)
     drawn_at = record_frame_times(session)  # by the frame thread's own clock
     with budget.rebuild():
         assert budget.rebuilding

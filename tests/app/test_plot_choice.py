@@ -69,7 +69,7 @@ def test_an_option_not_offered_changes_nothing(poinsot_app, probe):
     session = session_of(poinsot_app)
     _choose(probe, "the price of tea")
     frames = session.stats.frames
-    assert wait_until(lambda: session.stats.frames > frames + 30, 10)
+    assert wait_until(lambda: session.stats.frames > frames + 30, 30)
     assert _plot(session).title == plots.OMEGA.title
     assert session.panel.motion.choice.wanted is plots.OMEGA
     assert session.stats.errors == 0, session.stats.last_error

@@ -99,7 +99,7 @@ def test_ellipsoid_touches_the_plane_exactly_at_the_tip_of_omega(preset, make_ap
     assert probe.wait_for(lambda p: "/space/body/ellipsoid" in p.nodes, 15)
     session = session_of(app)
     assert Control.PLAYBACK in preset.controls
-    assert wait_until(lambda: session.stats.frames > 5, 10)
+    assert wait_until(lambda: session.stats.frames > 5, 30)
     pause, _ = probe.widget("Pause")
     probe.set_value(pause, True)
     assert wait_until(lambda: session.clock.paused, 5)

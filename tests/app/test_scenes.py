@@ -69,7 +69,7 @@ def common_labels(make_app, make_probe) -> set[str]:
     app = make_app(sphere)
     probe = make_probe(app)
     session = session_of(app)
-    assert wait_until(lambda: session.stats.frames > 3, 15)
+    assert wait_until(lambda: session.stats.frames > 3, 30)
     received = len(probe.batches)
     after_frames(session)  # the panel was built before the first frame; these reached the probe
     assert probe.wait_for(lambda p: len(p.batches) >= received + 5, 15)
@@ -116,7 +116,7 @@ def test_the_menu_switches_scenes_and_presets_exactly(
     app = make_app()
     probe = make_probe(app)
     session = session_of(app)
-    assert wait_until(lambda: session.stats.frames > 3, 15)
+    assert wait_until(lambda: session.stats.frames > 3, 30)
     uuid, _ = probe.widget("Preset")
     for name in ("polhode-family", "gyroscope-torque", "dzhanibekov", "explorer-1"):
         spec = scene_by_name(name)
@@ -196,7 +196,7 @@ def test_per_frame_only_poses_and_trail_increments(name, make_app, make_probe):
     spec = scene_by_name(name)
     _, session, probe = start(make_app, make_probe, spec)
     trails = trails_of(spec)
-    assert wait_until(lambda: session.stats.frames > 30, 10)
+    assert wait_until(lambda: session.stats.frames > 30, 30)
     start_batch, frames = len(probe.batches), session.stats.frames
     after_frames(session, 90)
     assert probe.wait_for(lambda p: len(p.batches) >= start_batch + 45, 10)

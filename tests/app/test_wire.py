@@ -142,7 +142,7 @@ def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(
         target,
     )
     frames = session.stats.frames
-    assert wait_until(lambda: session.stats.frames > frames + 10, 10), "the frames stopped"
+    assert wait_until(lambda: session.stats.frames > frames + 10, 30), "the frames stopped"
     assert session.stats.errors == 0, session.stats.last_error
     assert not sent_nan
     # a value viser could not even convert (a text for a slider) never reaches it
@@ -207,7 +207,7 @@ def test_a_flooding_client_is_cut_off_and_the_others_keep_their_frames(make_app,
     app = make_app()
     make_probe(app)
     quiet_session = session_of(app)
-    assert wait_until(lambda: quiet_session.stats.frames > 30, 15)
+    assert wait_until(lambda: quiet_session.stats.frames > 30, 30)
 
     def frames_in(seconds: float) -> int:
         start = quiet_session.stats.frames

@@ -174,7 +174,7 @@ def test_two_browsers_have_independent_sessions(shared, open_page):
     assert wait_until(lambda: len(app.sessions()) == 2, 10)
     b = session_of(app, 2)
     assert a is not b
-    assert wait_until(lambda: b.stats.frames > 10, 10)
+    assert wait_until(lambda: b.stats.frames > 10, 30)
     first.choose("Preset", preset_by_key("oblate").label)
     assert wait_until(lambda: a.preset.key == "oblate", 10)
     second.press_slider("|ω₀|", "ArrowRight", times=4)
@@ -210,7 +210,7 @@ def test_a_real_browser_sends_only_what_the_wire_allows(shared):
     page.page.keyboard.press("Space")  # a command of the palette
     page.page.set_viewport_size({"width": 1001, "height": 777})
     frames = session.stats.frames
-    assert wait_until(lambda: session.stats.frames > frames + 10, 15)
+    assert wait_until(lambda: session.stats.frames > frames + 10, 30)
     guard = app.guard
     assert guard.closed_for_message == 0 and guard.malformed == 0 and guard.dropped == 0
     # A mouse press on the energy ellipsoid (its drag binding: a start is pointed at by hand)
