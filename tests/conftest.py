@@ -86,8 +86,8 @@ BROWSER_ELSEWHERE = frozenset(
 #: The real-browser tests by group, each group on a worker of its own with a Chromium of its
 #: own. One group: two Chromiums beside two more workers on this 2-core machine made the tests
 #: that type into a slider or click the scene flaky, with every page drawing (session 10) and
-#: again with pages drawing only while read (three failures in one of five full runs: a
-#: slider's arrow keys twice, a click on Landau's sphere), for 407 s instead of 431 s. A browser
+#: again with pages drawing only while read (in two of six full runs: a slider's arrow keys
+#: three times, a click on Landau's sphere once), for 407 s instead of 431 s. A browser
 #: file that is not listed joins :data:`BROWSER_LAST_GROUP`; more groups are one entry each here.
 BROWSER_GROUPS: dict[str, str] = {}
 BROWSER_LAST_GROUP = "browser-1"
