@@ -477,6 +477,9 @@ def _page_opener(chromium) -> Iterator[Callable[..., BrowserPage]]:
         page.on("pageerror", lambda e: errors.append(f"pageerror: {e}"))
         page.goto(url)
         page.locator("canvas").first.wait_for(state="visible", timeout=20000)
+        if not live_view:  # loudly, if viser's page is no longer laid out as assumed
+            parked = "() => window.__poinsotPark()"
+            assert wait_until(lambda: page.evaluate(parked), 20), "the 3D view was not parked"
         return BrowserPage(page, errors)
 
     try:
