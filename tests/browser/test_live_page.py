@@ -128,7 +128,8 @@ def test_moving_a_slider_changes_the_scene(shared):
     assert session.generation > generation
     assert page.slider_value("I₁") == pytest.approx(1.15)
     assert session.preset.key == "custom"  # a hand edit leaves the preset
-    assert page.dropdown_value("Preset") == "Custom (edited)"
+    # the menu's new label is a message of its own, after the session's change
+    assert wait_until(lambda: page.dropdown_value("Preset") == "Custom (edited)", 10)
     assert not np.allclose(session.scene.geometry.semi_axes, before_axes)
     page.page.wait_for_timeout(500)
     after_pixels = canvas_pixels(page)
@@ -183,8 +184,9 @@ def test_two_browsers_have_independent_sessions(shared, open_page):
     assert b.preset.key == "custom" and a.params.omega_norm == preset_by_key("oblate").omega_norm
     assert a.params.inertia == preset_by_key("oblate").inertia
     assert b.params.inertia == DEFAULT_PRESET.inertia
-    assert second.dropdown_value("Preset") == "Custom (edited)"
-    assert first.dropdown_value("Preset") == preset_by_key("oblate").label
+    # the menus' labels are messages of their own, after the sessions' changes
+    assert wait_until(lambda: second.dropdown_value("Preset") == "Custom (edited)", 10)
+    assert wait_until(lambda: first.dropdown_value("Preset") == preset_by_key("oblate").label, 10)
     assert a.scene.api is not b.scene.api
     assert first.errors == [] and second.errors == []
     second.page.context.close()  # the next test counts one session
