@@ -207,5 +207,5 @@ def test_a_bad_link_opens_the_default_scene_and_names_the_parameter(app, open_pa
         status = message.inner_text()
         assert named in status, (query, status)
         assert session.preset is DEFAULT_PRESET and session.showcase is None
-        assert wait_until(lambda: page.dropdown_value("Preset") == DEFAULT_PRESET.label, 10)
+        assert wait_until(lambda p=page: p.dropdown_value("Preset") == DEFAULT_PRESET.label, 10)
         assert session.stats.errors == 0 and page.errors == []
