@@ -3,13 +3,17 @@
 
 from __future__ import annotations
 
+import urllib.parse
+
 import pytest
 
 from poinsot.app import cli
 from poinsot.app.live.hardening import network
+from poinsot.app.live.ui import links
 from poinsot.app.live.ui.links import LinkError, opening, parse
 from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, preset_by_key
-from poinsot.app.scenes import scene_by_name
+from poinsot.app.scenes import SCENES, scene_by_name
+from poinsot.app.scenes.spec import Slider
 
 
 def test_a_preset_at_a_time_from_a_view():
@@ -26,6 +30,26 @@ def test_a_scene_and_its_controls_by_their_keys():
     assert (top["M"], top["spin"]) == (-0.25, 2.0)
     assert parse("scene=long-cylinder&lapse=×10").scene.initial_speed() == 10.0
     assert scene_by_name("dzhanibekov").defaults()["epsilon"] == 1e-3  # the catalogue's kept
+
+
+@pytest.mark.parametrize("spec", SCENES, ids=lambda spec: spec.name)
+def test_every_control_of_every_scene_comes_back_from_its_link(spec):
+    """Copy link's query for each control moved (a slider to its top, a choice to its last
+    option) opens that scene with that control there (the polhode family's D too: a scene's
+    own control, not a body's parameter)."""
+    for control in spec.controls:
+        if isinstance(control, Slider):
+            moved: float | str = control.hi
+        elif control.speed:  # the clock's speed: a link's speed parameter
+            continue
+        else:
+            moved = control.value(control.options[-1])
+        pairs = [("scene", spec.name), *links._settings(spec, {control.key: moved})]
+        opened = parse(urllib.parse.urlencode(pairs, safe=","))
+        assert opened.scene is not None and opened.scene.defaults()[control.key] == moved, (
+            control.key,
+            pairs,
+        )
 
 
 def test_a_body_of_ones_own():

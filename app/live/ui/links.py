@@ -179,7 +179,8 @@ def parse(
             raise LinkError(
                 f"scene={pairs['scene']!r} is not a scene ({', '.join(scene_names())})"
             ) from None
-        if any(k in rest for k in BODY):
+        own = {control.key for control in scene.controls}  # the polhode family's D is its own
+        if any(k in rest and k not in own for k in BODY):
             raise LinkError(f"the scene {scene.name} brings its own body: no I, D, side, pole or w")
         scene = _scene(scene, rest)
     elif "preset" in pairs or rest:
