@@ -11,7 +11,8 @@ lecturer's clock) thus share one physics call per batch.
 
 :class:`MotionCache` (one per server process) gives every session that asks for the same key
 (the body's parameters, its solid and the grid's frame time) the same motion, built by the
-first that asks while the others wait for it: one build per process, not one per session.
+first that asks while the others wait for it: one build per process, not one per session. A
+scene's model (:meth:`~poinsot.app.scenes.runtime.Showcase.load`) is shared the same way.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from __future__ import annotations
 import collections
 import threading
 from collections.abc import Callable, Hashable
-from typing import Any
+from typing import Any, Generic, TypeVar
 
 from poinsot.app.elements import Solid
 from poinsot.app.scene.batch import FrameBatch
@@ -33,6 +34,8 @@ MAX_CHORD = 0.02
 KEPT_BATCHES = 4
 #: Motions a cache keeps (the newest used): a lead's drag of a slider builds one per value.
 KEPT_MOTIONS = 8
+
+T = TypeVar("T")
 
 
 class Motion:
@@ -91,31 +94,31 @@ def _grid(body: FreeRigidBody, geometry: Geometry, frame_time: float, t: float) 
     return MotionSampler.for_body(body, geometry.trace_speed, frame_time, MAX_CHORD, t)
 
 
-class _Pending:
+class _Pending(Generic[T]):
     def __init__(self) -> None:
         self.done = threading.Event()
-        self.motion: Motion | None = None
+        self.motion: T | None = None
         self.error: BaseException | None = None
 
 
 class MotionCache:
-    """Motions by key, each built once (see the module). Thread-safe."""
+    """Motions (or scenes' models) by key, each built once (see the module). Thread-safe."""
 
     def __init__(self, keep: int = KEPT_MOTIONS) -> None:
         self.keep = int(keep)
         self._lock = threading.Lock()
-        self._entries: collections.OrderedDict[Hashable, _Pending] = collections.OrderedDict()
-        #: Motions built so far (tests, load test): one per key, however many sessions ask.
+        self._entries: collections.OrderedDict[Hashable, _Pending[Any]] = collections.OrderedDict()
+        #: Builds so far (tests, load test): one per key, however many sessions ask.
         self.builds = 0
 
-    def get(self, key: Hashable, build: Callable[[], Motion]) -> Motion:
-        """The motion of ``key``: ``build()`` by the first caller, waited for by the others. A
+    def get(self, key: Hashable, build: Callable[[], T]) -> T:
+        """What ``key`` names: ``build()`` by the first caller, waited for by the others. A
         ValueError (no such body) is raised to every caller with its message."""
         with self._lock:
             pending = self._entries.get(key)
             mine = pending is None
             if pending is None:
-                pending = self._entries[key] = _Pending()
+                pending = self._entries[key] = _Pending[Any]()
                 self.builds += 1
                 while len(self._entries) > self.keep:
                     self._entries.popitem(last=False)

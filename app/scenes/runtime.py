@@ -17,6 +17,7 @@ import numpy as np
 
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
+from poinsot.app.scene.motion import Motion, MotionCache
 from poinsot.app.scenes.spec import Canvas, Model, Readout, SceneSpec, Settings, Value
 from poinsot.physics import FreeRigidBody
 
@@ -47,15 +48,32 @@ class Showcase:
         return None if self.model is None else self.model.body
 
     def load(
-        self, settings: Settings | None = None, *, t: float = 0.0, frame_time: float = 1 / 60
+        self,
+        settings: Settings | None = None,
+        *,
+        t: float = 0.0,
+        frame_time: float = 1 / 60,
+        shared: MotionCache | None = None,
     ) -> Frame:
         """Build the model for ``settings`` (default: the current ones) and show it at ``t``.
-        Raises ValueError (from physics or the scene's checks) with the previous scene kept."""
+        ``shared``: the model and its motion come from there, built once for every showcase
+        that asks for the same scene, settings and frame time (a lecturer's followers). Raises
+        ValueError (from physics or the scene's checks) with the previous scene kept."""
         wanted = dict(self.settings if settings is None else settings)
-        model = self.spec.build(wanted)
+        motion = None
+        if shared is None:
+            model = self.spec.build(wanted)
+        else:
+            key = (self.spec.name, tuple(sorted(wanted.items())))
+            model = shared.get(key, lambda: self.spec.build(wanted))
+            if model.body is not None:
+                body, solid = model.body, model.solid
+                motion = shared.get(
+                    (key, frame_time), lambda: Motion.prepare(body, solid, frame_time)
+                )
         previous = self.model
         with self._atomic():
-            frame = self._show(model, t, frame_time)
+            frame = self._show(model, t, frame_time, motion)
             try:
                 self.drawing.fit(model, self.poinsot.geometry)
             except ValueError:
@@ -66,11 +84,15 @@ class Showcase:
             self.frame = self.drawing.advance(t, frame)
         return self.frame
 
-    def _show(self, model: Model, t: float, frame_time: float) -> Frame | None:
+    def _show(
+        self, model: Model, t: float, frame_time: float, motion: Motion | None = None
+    ) -> Frame | None:
         """Load the construction with the model's body (or empty it): nothing is sent if this
         raises."""
         if model.body is not None:
-            return self.poinsot.load(model.body, model.solid, t=t, frame_time=frame_time)
+            return self.poinsot.load(
+                model.body, model.solid, t=t, frame_time=frame_time, motion=motion
+            )
         self.poinsot.unload()
         return None
 

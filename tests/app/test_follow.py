@@ -236,6 +236,48 @@ def test_followers_share_one_build_mirror_what_is_shown_and_cannot_point(poinsot
     assert wait_until(lambda: pointer.starts == 1, 30)
 
 
+def test_followers_share_one_build_of_the_lead_s_scene(poinsot_app, make_probe):
+    """The lead chooses a scene, then moves its D slider: the three followers of the process
+    draw one model and one motion of each (built once, not once each), the lead its own."""
+    lead = _ready(make_probe(poinsot_app))
+    _lead(lead, poinsot_app.follow.code)
+    probes = [_ready(make_probe(poinsot_app)) for _ in range(3)]
+    for probe in probes:
+        _follow(probe)
+    lead_session, *followers = sorted(
+        poinsot_app.sessions().values(), key=lambda s: s.client.client_id
+    )
+    scenes = poinsot_app.follow.scenes
+
+    def shared_once(D_shown: float, builds: int) -> None:
+        for follower in followers:
+            assert wait_until(
+                lambda f=follower: (
+                    f.showcase is not None
+                    and f.showcase.showcase.settings.get("D") == pytest.approx(D_shown, abs=0.01)
+                    and f.showcase.loaded
+                ),
+                60,
+            ), [f.showcase and dict(f.showcase.showcase.settings) for f in followers]
+        model = followers[0].showcase.showcase.model
+        motion = followers[0].scene.motion
+        assert model is not None and motion is not None
+        assert all(f.showcase.showcase.model is model for f in followers)
+        assert all(f.scene.motion is motion for f in followers)
+        assert lead_session.showcase.showcase.model is not model  # the lead builds its own
+        assert scenes.builds == builds + 2  # one model and one motion for three followers
+
+    builds = scenes.builds
+    _set(lead, "Preset", POLHODES)
+    shared_once(1.6, builds)
+    builds = scenes.builds
+    _, widgets = lead.snapshot()  # the scene's D slider (the preset's, hidden, came before it)
+    lead.set_value([u for u, w in widgets.items() if w.props.get("label") == D][-1], 2.2)
+    shared_once(2.2, builds)
+    assert all(f.stats.errors == 0 for f in followers), [f.stats.last_error for f in followers]
+    assert not any(_says(p, "could not be shown") for p in probes)
+
+
 def _run(coroutine) -> None:
     """Run a pointer's callback to the end on a thread of its own, as viser's loop would (this
     thread may hold the event loop of a real-browser test that ran before, in this worker)."""

@@ -94,6 +94,8 @@ class FollowHub:
         self.delivered = 0
         #: The lead's bodies, built once for the lead and the followers of this process.
         self.motions = MotionCache()
+        #: The lead's scenes (their models and motions), built once for this process's followers.
+        self.scenes = MotionCache()
 
     # -- the lead ------------------------------------------------------------------------
     def claim(self, lead: Any, code: str, client_key: int) -> Claim:

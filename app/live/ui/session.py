@@ -415,7 +415,9 @@ class Session:
     def _load_scene(self, showcase: LiveShowcase) -> None:
         """Load the scene's desired settings at t = 0 (ValueError: the last scene is kept)."""
         self.clock.reset(0.0)
-        self.frame = showcase.load(self.frame_time)
+        follow = self.follow  # a follower's scene: the process's one model and motion
+        shared = follow.hub.scenes if follow.mode == "follow" else None
+        self.frame = showcase.load(self.frame_time, shared)
         self.body = showcase.body
         self.panel.motion.clear_plot()
         self._set_status("")

@@ -24,6 +24,7 @@ from poinsot.app.live.ui.widgets import Removable, Retirement, Sent, on_user, se
 from poinsot.app.scene import palette
 from poinsot.app.scene.batch import Frame
 from poinsot.app.scene.construction import PoinsotScene
+from poinsot.app.scene.motion import MotionCache
 from poinsot.app.scenes.runtime import Showcase
 from poinsot.app.scenes.spec import (
     START_KEY,
@@ -163,9 +164,10 @@ class LiveShowcase:
         self.desired[key] = value
         return True
 
-    def load(self, frame_time: float) -> Frame:
-        """Build and show the desired settings at t = 0 (ValueError: the last scene is kept)."""
-        frame = self.showcase.load(self.desired, t=0.0, frame_time=frame_time)
+    def load(self, frame_time: float, shared: MotionCache | None = None) -> Frame:
+        """Build and show the desired settings at t = 0 (ValueError: the last scene is kept);
+        ``shared``: a follower's, the model and motion of the process (:class:`Showcase`)."""
+        frame = self.showcase.load(self.desired, t=0.0, frame_time=frame_time, shared=shared)
         if START_KEY in self.desired:
             self._show_model_values()
         self._shown.clear()
