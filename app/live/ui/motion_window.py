@@ -109,11 +109,10 @@ class MotionWindow:
     def show_readouts(self, text: str) -> None:
         self.readouts.content = text
 
-    def show_body(self, body: FreeRigidBody, text: str | None = None) -> None:
-        """The readouts of ``body`` (``text``, if made already), whose moments and L the plot's
-        angles are read with."""
+    def set_body(self, body: FreeRigidBody) -> None:
+        """The body whose moments and L the plot's angles are read with (its readouts are
+        :meth:`show_readouts`'s)."""
         self.body = body
-        self.show_readouts(readouts.markdown(body) if text is None else text)
 
     def show_time(self, t: float, paused: bool) -> None:
         text = readouts.time_markdown(t, paused)

@@ -433,11 +433,22 @@ class Session:
         self.body, self.params, self.frame, self._solid = body, params, frame, solid
         self.panel.show_parameters(params)
         motion = self.panel.motion
-        text = None if shared is None else shared.memo("readouts", lambda: readouts.markdown(body))
-        motion.show_body(body, text)
+        motion.set_body(body)
         motion.clear_plot()
         motion.record_plot(0.0, frame.omega, frame.wxyz)
         self._set_status("")
+        # The readouts' table just after the new body has gone out (Montgomery's phase is
+        # measured over a period: half a millisecond that the redraw need not wait for).
+        self.post(lambda: self._show_readouts(body, shared), "readouts")
+
+    def _show_readouts(self, body: FreeRigidBody, shared: Motion | None) -> None:
+        if body is not self.body:  # a newer body came meanwhile: its own readouts follow
+            return
+        if shared is None:
+            text = readouts.markdown(body)
+        else:  # a follower's: made once for the followers of the process
+            text = shared.memo("readouts", lambda: readouts.markdown(body))
+        self.panel.motion.show_readouts(text)
 
     def _shared_motion(self, params: Parameters, solid: Solid | None) -> Motion | None:
         """While following: the process's one motion of this body, on the grid of this frame
