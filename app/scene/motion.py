@@ -97,7 +97,7 @@ def _grid(body: FreeRigidBody, geometry: Geometry, frame_time: float, t: float) 
 class _Pending(Generic[T]):
     def __init__(self) -> None:
         self.done = threading.Event()
-        self.motion: T | None = None
+        self.value: T | None = None
         self.error: BaseException | None = None
 
 
@@ -126,7 +126,7 @@ class MotionCache:
                 self._entries.move_to_end(key)
         if mine:
             try:
-                pending.motion = build()
+                pending.value = build()
             except BaseException as exc:
                 pending.error = exc
                 if not isinstance(exc, ValueError):  # not the body's fault: the next one tries
@@ -136,9 +136,9 @@ class MotionCache:
             finally:
                 pending.done.set()
         pending.done.wait()
-        if pending.motion is None:
+        if pending.value is None:
             error = pending.error
             if isinstance(error, ValueError):
                 raise ValueError(str(error))
             raise RuntimeError(f"the shared build failed ({type(error).__name__}: {error})")
-        return pending.motion
+        return pending.value

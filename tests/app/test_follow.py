@@ -11,6 +11,7 @@ import multiprocessing
 import re
 import threading
 import types
+from typing import Any
 
 import pytest
 
@@ -66,6 +67,17 @@ def _lead(probe: Probe, code: str) -> None:
 def _follow(probe: Probe) -> None:
     _set(probe, "Follow the lecturer", True)
     assert probe.wait_for(lambda p: _says(p, "Following the lecturer"), 30)
+
+
+def _class_of_three(app, make_probe) -> tuple[Probe, list[Probe], Any, list[Any]]:
+    """A lead and three followers in ``app``'s process: their probes, then their sessions."""
+    lead = _ready(make_probe(app))
+    _lead(lead, app.follow.code)
+    probes = [_ready(make_probe(app)) for _ in range(3)]
+    for probe in probes:
+        _follow(probe)
+    lead_session, *followers = sorted(app.sessions().values(), key=lambda s: s.client.client_id)
+    return lead, probes, lead_session, followers
 
 
 # -- one lead, three followers, two workers ------------------------------------------------
@@ -171,14 +183,7 @@ def test_followers_share_one_build_mirror_what_is_shown_and_cannot_point(poinsot
     for all the followers (not once each), whose frames draw from that one motion; the lead's
     trail length and hidden elements are mirrored; a follower's click or drag on the
     ellipsoid is refused and told once, until it explores from here."""
-    lead = _ready(make_probe(poinsot_app))
-    _lead(lead, poinsot_app.follow.code)
-    probes = [_ready(make_probe(poinsot_app)) for _ in range(3)]
-    for probe in probes:
-        _follow(probe)
-    lead_session, *followers = sorted(
-        poinsot_app.sessions().values(), key=lambda s: s.client.client_id
-    )
+    lead, probes, lead_session, followers = _class_of_three(poinsot_app, make_probe)
     motions = poinsot_app.follow.motions
     builds = motions.builds
     gated = _gated_rebuilds(poinsot_app.budget)
@@ -239,14 +244,7 @@ def test_followers_share_one_build_mirror_what_is_shown_and_cannot_point(poinsot
 def test_followers_share_one_build_of_the_lead_s_scene(poinsot_app, make_probe):
     """The lead chooses a scene, then moves its D slider: the three followers of the process
     draw one model and one motion of each (built once, not once each), the lead its own."""
-    lead = _ready(make_probe(poinsot_app))
-    _lead(lead, poinsot_app.follow.code)
-    probes = [_ready(make_probe(poinsot_app)) for _ in range(3)]
-    for probe in probes:
-        _follow(probe)
-    lead_session, *followers = sorted(
-        poinsot_app.sessions().values(), key=lambda s: s.client.client_id
-    )
+    lead, probes, lead_session, followers = _class_of_three(poinsot_app, make_probe)
     scenes = poinsot_app.follow.scenes
 
     def shared_once(D_shown: float, builds: int) -> None:
