@@ -72,6 +72,17 @@ def test_page_loads_without_console_errors(shared):
     assert page.page.get_by_text("Stable about the major axis").count() >= 1
 
 
+def test_the_browser_runs_no_web_page_of_its_own_beside_ours(shared):
+    """Chromium's flags leave out its own web pages (the address bar's popup, preloaded for
+    every new page: a renderer and its CPU each)."""
+    _, page, _ = shared
+    browser = page.page.context.browser
+    assert browser is not None
+    targets = browser.new_browser_cdp_session().send("Target.getTargets")["targetInfos"]
+    assert any(t["url"].startswith("http://127.0.0.1") for t in targets), targets
+    assert [t["url"] for t in targets if t["url"].startswith("chrome")] == []
+
+
 def test_the_omega_plot_draws_its_three_components(shared):
     """The live uPlot of omega_1, omega_2, omega_3 (numeric time axis) shows three curves."""
     from PIL import Image
