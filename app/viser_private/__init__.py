@@ -14,12 +14,9 @@ anywhere else in ``app/``.
 
 Inventory (section, private name, what it is used for):
 
-*Handshake*
-  - ``viser.infra._infra`` calls ``websockets.asyncio.server.serve`` (looked up on the module at
-    call time, inside ``WebsockServer.start``, before ``ViserServer()`` returns) with its own
-    ``process_request`` (the page server): :func:`hooked_server` wraps it for the duration of
-    one construction, adding a request check of ours before viser's and a connection class
-    that reads an HTTP/1.0 request line as HTTP/1.1.
+*Handshake* (:mod:`poinsot.app.viser_private.handshake`)
+  - ``websockets.asyncio.server.serve`` as viser's infra calls it: a request check of ours
+    before viser's page server, and HTTP/1.0 read as 1.1 (:func:`hooked_server`).
 
 *Connections*
   - ``ViserServer._websock_server`` (the infra ``WebsockServer``): its public
@@ -73,29 +70,9 @@ Inventory (section, private name, what it is used for):
     viser's client encodes it (:func:`wire_message`, :func:`wire_class`, :func:`encode`): what
     the headless probe and the load test send as a browser would.
 
-*Page* (a page's own address, and the clipboard)
-  - ``ViserServer._websock_server._live_connections[client_id].request``: the websocket
-    handshake of a client (:func:`handshake_origin`). viser keeps the connection to itself; its
-    ``ClientHandle`` exposes no header. Used to tell a web page (it always sends ``Origin``) from
-    a tool (the probe, the load test), which runs no JavaScript.
-  - ``ClientHandle._websock_connection``: ``queue_message``, ``register_handler`` and
-    ``unregister_handler`` of one client's connection, with the message classes
-    ``viser._messages.RunJavascriptMessage``, ``LocalStorageGetItemRequestMessage`` and
-    ``LocalStorageGetItemResponseMessage`` (:func:`page_address`, :func:`copy_to_clipboard`).
-    viser's client connects its websocket to the page's address *without* the query
-    (``getDefaultServerFromUrl`` drops everything after ``?``) and sends nothing of the page's
-    address on connect, so a link's query never reaches the server by a public way. A line of
-    JavaScript run in the page writes ``window.location.href`` to the page's ``localStorage``
-    under a key of this connection alone, and viser's own localStorage request reads it back;
-    :meth:`viser.LocalStorageHandle.get_item` does the same read but blocks a thread, where this
-    awaits on the event loop (a page that never answers holds no thread).
-  - ``"viser-user:"``: the prefix viser's client puts before the keys of its localStorage API
-    (``LOCAL_STORAGE_PREFIX`` in the client's ``MessageHandler.tsx``).
-  - The bottom sheet of a narrow page (the client's ``ControlPanel/BottomPanel.tsx``): a
-    ``position: fixed; bottom: 0`` Mantine ``Paper`` whose bar (``cursor: pointer``,
-    ``height: 3.5em``) toggles it; it is open when it mounts (its state is the page's own,
-    ``useDisclosure(true)``: no message and no GUI handle folds it). :func:`fold_bottom_sheet`
-    taps that bar once, from the page, as a finger would.
+*Page* (:mod:`poinsot.app.viser_private.page`)
+  - A client's websocket handshake (its ``Origin``), JavaScript run in its page, and its
+    localStorage: a page's own address, the clipboard, a narrow page's bottom sheet.
 """
 
 from __future__ import annotations
@@ -103,19 +80,15 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import dataclasses
-import json
-import threading
-import uuid
-from collections.abc import Awaitable, Callable, Iterable, Iterator
+from collections.abc import Awaitable, Callable, Iterable
 from typing import Any
 
 import msgspec
 import viser
-import websockets.asyncio.server
 from viser import _messages
 from websockets.asyncio.server import ServerConnection
-from websockets.http11 import Request, Response
 
+from poinsot.app.viser_private.handshake import Http10Connection, RequestCheck, hooked_server
 from poinsot.app.viser_private.messages import (
     ALLOWED,
     GetRenderResponse,
@@ -124,92 +97,33 @@ from poinsot.app.viser_private.messages import (
     client_message,
     message_type,
 )
+from poinsot.app.viser_private.page import (
+    LOCAL_STORAGE_PREFIX,
+    copy_to_clipboard,
+    fold_bottom_sheet,
+    handshake_origin,
+    page_address,
+)
+from poinsot.app.viser_private.version import VISER_SERIES, ViserChanged
 
-__all__ = ["ALLOWED", "GetRenderResponse", "GuiUpdate", "Refused", "client_message", "message_type"]
-
-#: The viser release series this module was written for.
-VISER_SERIES = "1.1"
-
-
-class ViserChanged(RuntimeError):
-    """A private name or shape this module relies on is not what viser 1.1.x had."""
-
-    def __init__(self, what: str) -> None:
-        super().__init__(
-            f"viser {viser.__version__} is not the viser {VISER_SERIES}.x that "
-            f"poinsot.app.viser_private was written for: {what}"
-        )
-
-
-# -- handshake ---------------------------------------------------------------------------------
-RequestCheck = Callable[[ServerConnection, Request], Response | None]
-_SERVE_LOCK = threading.Lock()
-#: The longest request line read before it is handed on as it is [bytes].
-_REQUEST_LINE_MAX = 8192
-
-
-class Http10Connection(ServerConnection):
-    """A websockets server connection that reads an ``HTTP/1.0`` request line as ``HTTP/1.1``
-    (websockets parses only 1.1 and would drop the request unanswered), so that an HTTP/1.0
-    GET gets viser's page (a 1.1 response with its length, which HTTP/1.0 clients read)."""
-
-    _head: bytes | None = b""
-
-    def data_received(self, data: bytes) -> None:
-        if self._head is not None:
-            self._head += data
-            if b"\n" not in self._head and len(self._head) < _REQUEST_LINE_MAX:
-                return
-            data, self._head = _as_http11(self._head), None
-        super().data_received(data)
-
-
-def _as_http11(head: bytes) -> bytes:
-    line, newline, rest = head.partition(b"\n")
-    crlf = line.endswith(b"\r")
-    bare = line[:-1] if crlf else line
-    if bare.endswith(b" HTTP/1.0"):
-        line = bare[: -len(b"1.0")] + b"1.1" + (b"\r" if crlf else b"")
-    return line + newline + rest
-
-
-@contextlib.contextmanager
-def hooked_server(
-    check: RequestCheck, on_error: Callable[[BaseException], Response]
-) -> Iterator[None]:
-    """Within this block, the one ``viser.ViserServer(...)`` built runs ``check`` on every HTTP
-    request before viser's page server (a response refuses it, None lets it through) and
-    answers with ``on_error(exc)`` when viser's page server raises. Raises :class:`ViserChanged`
-    if the server was built without going through ``websockets.asyncio.server.serve``."""
-    original = websockets.asyncio.server.serve
-    calls: list[int] = []
-
-    def serve(handler: Any, *args: Any, **kwargs: Any) -> Any:
-        page = kwargs.get("process_request")
-
-        def process_request(connection: ServerConnection, request: Request) -> Response | None:
-            refusal = check(connection, request)
-            if refusal is not None or page is None:
-                return refusal
-            try:
-                response: Response | None = page(connection, request)
-            except Exception as exc:  # a request viser's page server cannot take
-                return on_error(exc)
-            return response
-
-        kwargs["process_request"] = process_request
-        kwargs["create_connection"] = Http10Connection
-        calls.append(1)
-        return original(handler, *args, **kwargs)
-
-    with _SERVE_LOCK:
-        websockets.asyncio.server.serve = serve  # type: ignore[misc,assignment]
-        try:
-            yield
-        finally:
-            websockets.asyncio.server.serve = original  # type: ignore[misc]
-    if not calls:
-        raise ViserChanged("ViserServer() no longer calls websockets.asyncio.server.serve")
+__all__ = [
+    "ALLOWED",
+    "LOCAL_STORAGE_PREFIX",
+    "VISER_SERIES",
+    "GetRenderResponse",
+    "GuiUpdate",
+    "Http10Connection",
+    "Refused",
+    "RequestCheck",
+    "ViserChanged",
+    "client_message",
+    "copy_to_clipboard",
+    "fold_bottom_sheet",
+    "handshake_origin",
+    "hooked_server",
+    "message_type",
+    "page_address",
+]
 
 
 # -- connections -------------------------------------------------------------------------------
@@ -338,115 +252,6 @@ def share_enabled(server: viser.ViserServer) -> bool:
     """Would a share request reach a handler?"""
     handlers = infra(server)._incoming_handlers
     return any(handlers.get(message) for message in SHARE_MESSAGES)
-
-
-# -- page ------------------------------------------------------------------------------------
-#: The client's prefix of the keys its localStorage API reads and writes.
-LOCAL_STORAGE_PREFIX = "viser-user:"
-
-
-def handshake_origin(server: viser.ViserServer, client_id: int) -> str | None:
-    """The ``Origin`` header of the client's websocket handshake (None: not a web page, or
-    the connection is gone)."""
-    connection: Any = server._websock_server._live_connections.get(client_id)
-    request = getattr(connection, "request", None)
-    if request is None:
-        return None
-    origin = request.headers.get("Origin")
-    return str(origin) if origin is not None else None
-
-
-def _run_javascript(client: viser.ClientHandle, source: str) -> None:
-    client._websock_connection.queue_message(_messages.RunJavascriptMessage(source=source))
-
-
-async def page_address(client: viser.ClientHandle, timeout: float) -> str | None:
-    """The address of the page of ``client`` (``window.location.href``, its query included),
-    or None if the page does not answer within ``timeout`` seconds or has no localStorage. Run
-    on viser's event loop, outside its connect handler (the answer arrives only once viser
-    reads the connection, after the handler)."""
-    key = f"poinsot-page-{uuid.uuid4().hex}"
-    request_uuid = uuid.uuid4().hex
-    answer: asyncio.Future[str | None] = asyncio.get_running_loop().create_future()
-
-    def got(client_id: int, message: _messages.LocalStorageGetItemResponseMessage) -> None:
-        del client_id
-        if message.request_uuid == request_uuid and not answer.done():
-            answer.set_result(message.value if message.error is None else None)
-
-    connection = client._websock_connection
-    connection.register_handler(_messages.LocalStorageGetItemResponseMessage, got)
-    try:
-        name = json.dumps(LOCAL_STORAGE_PREFIX + key)
-        _run_javascript(
-            client, f"try {{ localStorage.setItem({name}, window.location.href); }} catch (e) {{}}"
-        )
-        connection.queue_message(
-            _messages.LocalStorageGetItemRequestMessage(key=key, request_uuid=request_uuid)
-        )
-        client.flush()
-        return await asyncio.wait_for(answer, timeout)
-    except TimeoutError:
-        return None
-    finally:
-        connection.unregister_handler(_messages.LocalStorageGetItemResponseMessage, got)
-        client.local_storage.remove_item(key)
-
-
-_COPY_JS = """
-const text = %s;
-const fallback = () => {
-  const area = document.createElement("textarea");
-  area.value = text;
-  area.style.position = "fixed";
-  area.style.opacity = "0";
-  document.body.appendChild(area);
-  area.select();
-  try { document.execCommand("copy"); } catch (e) {}
-  area.remove();
-};
-if (navigator.clipboard && window.isSecureContext) {
-  navigator.clipboard.writeText(text).catch(fallback);
-} else {
-  fallback();
-}
-"""
-
-
-_FOLD_SHEET_JS = """
-(() => {
-  if (window.poinsotSheetFolded) return;
-  const until = Date.now() + %d;
-  const fold = () => {
-    const sheet = [...document.querySelectorAll(".mantine-Paper-root")].find(
-      (e) => e.style.position === "fixed" && e.style.bottom === "0px");
-    const bar = sheet && [...sheet.querySelectorAll("div")].find(
-      (e) => e.style.cursor === "pointer" && e.style.height === "3.5em");
-    if (bar && sheet.getBoundingClientRect().height > 1.5 * bar.getBoundingClientRect().height) {
-      window.poinsotSheetFolded = true;
-      bar.click();
-    } else if (Date.now() < until) {
-      setTimeout(fold, 100);
-    }
-  };
-  fold();
-})();
-"""
-
-
-def fold_bottom_sheet(client: viser.ClientHandle, wait_ms: int = 10000) -> None:
-    """Fold the page's bottom sheet (a narrow page's) once, as one tap on its bar does, as soon
-    as it is there and open (looked for during ``wait_ms``; a wide page has none). Its bar then
-    opens and closes it with one tap each, as ever."""
-    _run_javascript(client, _FOLD_SHEET_JS % int(wait_ms))
-    client.flush()
-
-
-def copy_to_clipboard(client: viser.ClientHandle, text: str) -> None:
-    """Ask the page of ``client`` to put ``text`` on the clipboard (the browser may refuse:
-    the caller also shows the text)."""
-    _run_javascript(client, _COPY_JS % json.dumps(text))
-    client.flush()
 
 
 # -- checks --------------------------------------------------------------------------------------
