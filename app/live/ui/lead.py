@@ -19,8 +19,10 @@ import functools
 import math
 import time
 import urllib.parse
-from typing import Any
+from collections.abc import Callable
+from typing import Any, Protocol
 
+import numpy as np
 import viser
 
 from poinsot.app.elements import Element
@@ -30,7 +32,8 @@ from poinsot.app.live.ui.follow import FollowHub, LeadState
 from poinsot.app.live.ui.playback import clamp_trail
 from poinsot.app.live.ui.widgets import Sent, hold_input, on_user, set_value
 from poinsot.app.parameters import Parameters
-from poinsot.app.presets import PRESETS
+from poinsot.app.presets import PRESETS, Preset
+from poinsot.app.scenes.spec import SceneSpec
 
 #: Order of the folder in the main panel (before the ghost's).
 FOLDER_ORDER = 44.0
@@ -63,11 +66,25 @@ def _camera(client: viser.ClientHandle) -> tuple[tuple[float, ...], ...]:
     )
 
 
+class LeadSession(links.LinkSession, Protocol):
+    """What leading and following use of a session: what a link reads and opens, and its
+    client, playback, scene and body choices."""
+
+    client: viser.ClientHandle
+    playback: Any
+
+    def report(self, error: BaseException) -> None: ...
+    def regrid(self) -> None: ...
+    def edit(self, change: Callable[[Parameters], Parameters]) -> None: ...
+    def choose_scene(self, scene: SceneSpec) -> None: ...
+    def choose_preset(self, preset: Preset) -> None: ...
+
+
 class LeadControls:
     """Mounted by the session after its panel; :meth:`on_frame` each frame, :meth:`now` for
     the frame's time, :meth:`close` when the browser leaves."""
 
-    def __init__(self, session: Any, hub: FollowHub, order: float = FOLDER_ORDER) -> None:
+    def __init__(self, session: LeadSession, hub: FollowHub, order: float = FOLDER_ORDER) -> None:
         self.session, self.hub, self.client = session, hub, session.client
         self.mode = "own"  # "lead", "follow" or "own"
         self._published: LeadState | None = None
@@ -200,7 +217,7 @@ class LeadControls:
         session.panel.show_playback(clock.speed, clock.paused, session.scene.trail_points)
         if self.camera.value and state.camera and state.camera != self._applied_camera:
             self._applied_camera = state.camera
-            position, look_at, up = state.camera
+            position, look_at, up = (np.asarray(v, float) for v in state.camera)
             with self.client.atomic():  # the position moves look_at along: look_at after it
                 self.client.camera.up_direction = up
                 self.client.camera.position = position
