@@ -3,7 +3,8 @@ private names (:mod:`poinsot.app.viser_private`, whose docstring has the invento
 
 - :func:`message_buffer`: ``ClientHandle._websock_connection.get_message_buffer()``, the
   client's queue, with its ``message_counter`` (next id), ``generator_cursors`` (client id ->
-  the last id its sender took) and ``message_from_id`` (the messages still queued);
+  the last id its sender took), ``message_from_id`` (the messages still queued) and ``done``
+  (set once the client has left: a message pushed then is never sent, and viser warns);
 - :func:`connection_of`: ``ClientHandle._viser_server._websock_server`` with its
   ``_live_connections`` (client id -> websockets connection) and ``_background_event_loop``.
 
@@ -18,7 +19,7 @@ from typing import Any
 import viser
 
 #: What :func:`message_buffer` needs of viser's buffer.
-BUFFER_FIELDS = ("message_counter", "generator_cursors", "message_from_id")
+BUFFER_FIELDS = ("message_counter", "generator_cursors", "message_from_id", "done")
 
 
 def message_buffer(client: viser.ClientHandle) -> Any:
@@ -55,3 +56,8 @@ def last_taken(buffer: Any, client_id: int) -> int | None:
 def pending(buffer: Any) -> int:
     """Messages in ``buffer`` now (after viser's coalescing of updates)."""
     return len(buffer.message_from_id)
+
+
+def closed(buffer: Any) -> bool:
+    """True once the client of ``buffer`` has left (nothing pushed then is ever sent)."""
+    return bool(buffer.done)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import collections
 import socket
+import warnings
 
 import viser
 from conftest import record_messages, session_of, wait_until
@@ -32,6 +33,11 @@ class FakeOutbox:
 
     def unacknowledged(self) -> int:
         return self.unacked
+
+    left = False
+
+    def closed(self) -> bool:
+        return self.left
 
     def frame(self, pacer: Pacer, messages: int = 4) -> bool:
         """One pass of the frame loop: draw (queue messages) if the pacer allows it."""
@@ -71,6 +77,44 @@ def test_a_client_that_acknowledges_nothing_gets_no_new_frame():
     assert pacer.stats.drawn == 0 and pacer.fps == MIN_FPS
     outbox.unacked = 0
     assert outbox.frame(pacer)
+
+
+def test_a_client_that_left_gets_no_frame():
+    outbox = FakeOutbox()
+    pacer = Pacer(outbox, max_fps=60.0)  # type: ignore[arg-type]
+    assert outbox.frame(pacer)
+    outbox.taken = outbox.queued
+    outbox.left = True
+    assert not any(outbox.frame(pacer) for _ in range(10))
+    assert pacer.stats.drawn == 1
+
+
+def test_a_session_whose_client_left_queues_nothing_before_it_is_closed(poinsot_app, probe):
+    """Between viser's closing a departed client's queue and the server's closing its
+    session, the frame thread goes on: it draws nothing for nobody, and viser has nothing to
+    warn about in the server's terminal."""
+    session = session_of(poinsot_app)
+    close, held = session.close, []
+    session.close = lambda timeout=None: held.append(timeout)  # type: ignore[method-assign]
+    passes = [0]
+    may_draw = session.pacer.may_draw
+
+    def counted() -> bool:
+        passes[0] += 1
+        return may_draw()
+
+    session.pacer.may_draw = counted  # type: ignore[method-assign]
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            probe.close()
+            assert wait_until(lambda: held and session.pacer.outbox.closed(), 20)
+            frames, seen = session.stats.frames, passes[0]
+            assert wait_until(lambda: passes[0] >= seen + 10, 20), "the frame thread stopped"
+            assert session.stats.frames == frames
+        assert [str(w.message) for w in caught if "closed connection" in str(w.message)] == []
+    finally:
+        close(timeout=5.0)
 
 
 def test_a_slow_client_gets_the_frames_it_takes():

@@ -86,6 +86,10 @@ class Outbox:
         taken = None if self._buffer is None else private.last_taken(self._buffer, self.client_id)
         return self.last_queued() if taken is None else taken  # no sender yet: nothing due
 
+    def closed(self) -> bool:
+        """True once the client has left (what is queued then is never sent)."""
+        return self._buffer is not None and private.closed(self._buffer)
+
     def pending(self) -> int:
         """Messages in the client's queue now (after viser's coalescing of updates)."""
         return private.pending(self._buffer) if self._buffer is not None else 0
@@ -156,7 +160,11 @@ class Pacer:
 
     def may_draw(self) -> bool:
         """Before a frame: False (and a lower rate) while the client has too many frames
-        queued; otherwise True (and a higher rate if the client keeps up)."""
+        queued; otherwise True (and a higher rate if the client keeps up). False once the
+        client has left: between viser's closing its queue and the session's close, a frame
+        would be queued for nobody (and viser would warn in the server's terminal)."""
+        if self.outbox.closed():  # the client left; its session is closing
+            return False
         queued = self.in_flight()
         self.stats.max_in_flight = max(self.stats.max_in_flight, queued)
         if queued > self.max_in_flight or self.outbox.unacknowledged() > self.max_unacked:
