@@ -91,8 +91,8 @@ def test_a_client_that_left_gets_no_frame():
 
 def test_a_session_whose_client_left_queues_nothing_before_it_is_closed(poinsot_app, probe):
     """Between viser's closing a departed client's queue and the server's closing its
-    session, the frame thread goes on: it draws nothing for nobody, and viser has nothing to
-    warn about in the server's terminal."""
+    session, the frame thread goes on: it draws nothing and rebuilds nothing for nobody, and
+    viser has nothing to warn about in the server's terminal."""
     session = session_of(poinsot_app)
     close, held = session.close, []
     session.close = lambda timeout=None: held.append(timeout)  # type: ignore[method-assign]
@@ -109,9 +109,12 @@ def test_a_session_whose_client_left_queues_nothing_before_it_is_closed(poinsot_
             warnings.simplefilter("always")
             probe.close()
             assert wait_until(lambda: held and session.pacer.outbox.closed(), 20)
-            frames, seen = session.stats.frames, passes[0]
+            seen = passes[0]  # a whole pass of the frame thread since, its queue drained
+            assert wait_until(lambda: passes[0] >= seen + 2, 20), "the frame thread stopped"
+            frames, rebuilds, seen = session.stats.frames, session.stats.rebuilds, passes[0]
+            session.edit(lambda p: p.with_omega_norm(2.0))  # a last slider move, unsent
             assert wait_until(lambda: passes[0] >= seen + 10, 20), "the frame thread stopped"
-            assert session.stats.frames == frames
+            assert (session.stats.frames, session.stats.rebuilds) == (frames, rebuilds)
         assert [str(w.message) for w in caught if "closed connection" in str(w.message)] == []
     finally:
         close(timeout=5.0)

@@ -242,7 +242,10 @@ class Session:
 
     # -- frame thread --------------------------------------------------------------------
     def _work(self) -> None:
-        """Before each frame: the queued actions, then a rebuild if they asked for one."""
+        """Before each frame: the queued actions, then a rebuild if they asked for one (none
+        once the client has left: what they would send goes to nobody)."""
+        if self.pacer.outbox.closed():
+            return
         self._drain()
         if self._dirty:
             self._rebuild()
