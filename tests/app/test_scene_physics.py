@@ -226,12 +226,16 @@ def test_long_cylinder_progress_along_the_polhode(make_app, make_probe):
         number_in(rows["one circuit, 4K/λ"][0]), rel=1e-2
     )
     # Play from 0 at a time lapse of ×30, so that the polhode's trace grows from the start.
-    session.clock.reset(0.0)
+    # The speed first (it re-grids the motion from the time shown), then the reset, both on
+    # the session's thread in that order (a clock set from here could be re-gridded from a
+    # frame shown before it).
     session.set_speed(30.0)
+    assert wait_until(lambda: session.clock.speed == 30.0, 10)
+    session.reset()
     # The traces restart where the time goes back: drawn at 0 while still paused, they hold
     # the whole way from the start (a first frame drawn only once the clock runs again, late
     # on a busy machine, would start them a few frames on).
-    assert wait_until(lambda: session.clock.speed == 30.0 and session.frame.t < 1e-3 * period, 10)
+    assert wait_until(lambda: session.clock.now() == 0.0 and session.frame.t < 1e-3 * period, 10)
     session.clock.paused = False
     assert wait_until(lambda: session.frame.t > 0.35 * period, 20)
     session.clock.paused = True
