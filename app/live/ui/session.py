@@ -244,20 +244,18 @@ class Session:
     def _work(self) -> None:
         """Before each frame: the queued actions, then a rebuild if they asked for one (none
         once the client has left: what they would send goes to nobody)."""
-        outbox = self.pacer.outbox
-        if outbox.closed():
+        if self.pacer.outbox.closed():
             return
-        with outbox.quiet_if_left():
-            self._drain()
-            if self._dirty:
-                self._rebuild()
+        self._drain()
+        if self._dirty:
+            self._rebuild()
 
     def _frame_if_taken(self, now: float) -> bool:
         """Draw a frame, unless the browser has not yet taken the one before (:class:`Pacer`:
         skipped, the rate lowered). A frame's messages go out at once, in one atomic window."""
         if not self.pacer.may_draw():
             return False
-        with self.pacer.outbox.quiet_if_left(), self.client.atomic():
+        with self.client.atomic():
             self._advance()
             self._refresh(now)
         self.client.flush()  # out now, not at viser's next 1/60 s window
