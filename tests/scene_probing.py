@@ -32,6 +32,9 @@ def start(make_app, make_probe, spec) -> tuple[PoinsotApp, Session, Probe]:
     session = session_of(app)
     assert wait_until(lambda: session.running and session.stats.frames > 3, 20), "no frames"
     assert wait_until(lambda: session.showcase is not None and session.showcase.loaded, 20)
+    # The scene's controls as the probe has them (sent before the frames, read after them).
+    labels = {control.label for control in spec.controls}
+    assert probe.wait_for(lambda p: labels <= set(p.labels()), 20), (labels, probe.labels())
     return app, session, probe
 
 
