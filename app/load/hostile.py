@@ -168,12 +168,12 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
 def _unhurt(session_errors: int, innocent: Probe) -> str:
     """The word "yes" when no session raised and the innocent client, still open, gets 5 more frames
     (within a minute: its reader shares a busy machine); else what went wrong."""
-    frames = innocent.wait_frames(5, 60)
     wrong = [f"{session_errors} session error(s)"] if session_errors else []
-    if innocent.closed:
+    if innocent.closed:  # no frame to wait for
         wrong.append(f"the innocent client was closed ({innocent.close_code})")
-    elif not frames:
-        wrong.append("the innocent client got fewer than 5 frames in 60 s")
+    elif not innocent.wait_frames(5, 60):
+        closed = f", then closed ({innocent.close_code})" if innocent.closed else ""
+        wrong.append(f"the innocent client got fewer than 5 frames in 60 s{closed}")
     return "; ".join(wrong) or "yes"
 
 
