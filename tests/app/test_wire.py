@@ -129,7 +129,12 @@ def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(
     preset_uuid, _ = probe.widget("Preset")
     probe.set_value(preset_uuid, DEFAULT_PRESET.label)
     assert wait_until(lambda: session.params == Parameters.from_preset(DEFAULT_PRESET), 15)
-    d_uuid = handle_id(session.panel.widgets.energy)  # the one shown (others are kept hidden)
+    energy = session.panel.widgets.energy  # the one shown (others are kept hidden)
+    d_uuid = handle_id(energy)
+    # The slider's range is the preset's once the panel has mirrored the new body (just after
+    # the body itself): a value that arrives before is clamped into the junk's range.
+    d_range = pytest.approx(Parameters.from_preset(DEFAULT_PRESET).D_range)
+    assert wait_until(lambda: (energy.min, energy.max) == d_range, 15), (energy.min, energy.max)
     assert probe.wait_for(lambda p: p.widgets[d_uuid].props["max"] > p.widgets[d_uuid].props["min"])
     d = probe.widgets[d_uuid]
     target = round(0.3 * d.props["min"] + 0.7 * d.props["max"], 2)
@@ -291,8 +296,11 @@ def test_a_client_cannot_lengthen_the_trails_beyond_their_cap(poinsot_app, probe
     itself holds its length: tests/app/test_parts.py)."""
     session = session_of(poinsot_app)
     probe.set_value(probe.widget("Trail length")[0], 10**12)
-    assert wait_until(lambda: session.scene.trail_points == TRAIL_RANGE[1], 10)
-    assert all(t.max_points == TRAIL_RANGE[1] for t in session.scene._trails.values())
+    # The scene's length is set first, then each trail's (on the frame thread): wait for all.
+    assert wait_until(lambda: session.scene.trail_points == TRAIL_RANGE[1], 30)
+    assert wait_until(
+        lambda: all(t.max_points == TRAIL_RANGE[1] for t in session.scene._trails.values()), 30
+    ), {e: t.max_points for e, t in session.scene._trails.items()}
 
 
 def test_the_plot_keeps_a_window_of_samples(poinsot_app):
