@@ -26,25 +26,26 @@ from poinsot.app.parameters import drawn_solid
 
 def _measure(session: Session, rebuilds: int) -> tuple[list[float], list[float]]:
     """(own, shared) thread CPU seconds per rebuild (the session's thread)."""
-    base = session._desired
+    build = session.build
+    base = build.desired
     own: list[float] = []
     shared: list[float] = []
     for i in range(rebuilds):
         session.follow.mode = "own"
-        session._desired = base.with_D(2.05 + 0.002 * i)
+        build.desired = base.with_D(2.05 + 0.002 * i)
         start = time.thread_time()
-        session._rebuild()
+        build.rebuild(session.showcase)
         own.append(time.thread_time() - start)
         params = base.with_D(2.25 + 0.002 * i)
         session.follow.mode = "follow"
-        solid = drawn_solid(params.inertia, session._base, session._base_inertia)
-        motion = session._shared_motion(params, solid)
+        solid = drawn_solid(params.inertia, build.base, build.base_inertia)
+        motion = build.shared_motion(params, solid)
         assert motion is not None
         motion.geometry.polhode_segments()  # what the first follower's view makes once
         motion.memo("readouts", functools.partial(readouts.markdown, motion.body))
-        session._desired = params
+        build.desired = params
         start = time.thread_time()
-        session._rebuild()
+        build.rebuild(session.showcase)
         shared.append(time.thread_time() - start)
     session.follow.mode = "own"
     return own, shared

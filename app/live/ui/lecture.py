@@ -64,11 +64,14 @@ class LectureSession(ChallengeSession, Protocol):
 
     client: viser.ClientHandle
     clock: SimClock
-    preset: Preset
-    body: FreeRigidBody | None
-    frame: Frame | None
     scene: PoinsotScene
 
+    @property
+    def preset(self) -> Preset: ...
+    @property
+    def body(self) -> FreeRigidBody | None: ...
+    @property
+    def frame(self) -> Frame | None: ...
     @property
     def panel(self) -> HasMotion: ...
 

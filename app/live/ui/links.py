@@ -264,11 +264,16 @@ class LinkSession(Protocol):
     lecture: Any
     panel: Any
     scene: Any
-    showcase: Any
-    preset: Preset
-    params: Parameters
-    frame: Any
     follow: Any
+
+    @property
+    def showcase(self) -> Any: ...
+    @property
+    def preset(self) -> Preset: ...
+    @property
+    def params(self) -> Parameters: ...
+    @property
+    def frame(self) -> Any: ...
 
     def set_speed(self, speed: float) -> None: ...
     def post(self, action: Any, key: object = None) -> None: ...

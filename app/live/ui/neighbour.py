@@ -48,8 +48,10 @@ FOLDER_ORDER = 96.0
 
 class NeighbourSession(Protocol):
     client: viser.ClientHandle
-    body: FreeRigidBody | None
     scene: PoinsotScene
+
+    @property
+    def body(self) -> FreeRigidBody | None: ...
 
 
 class Neighbour:

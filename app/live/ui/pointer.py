@@ -67,8 +67,10 @@ class BaseSession(Protocol):
 
     client: viser.ClientHandle
     scene: PoinsotScene
-    body: FreeRigidBody | None
     clock: SimClock
+
+    @property
+    def body(self) -> FreeRigidBody | None: ...
 
     def post(self, action: Callable[[], None], key: Hashable | None = None) -> None: ...
 
@@ -76,8 +78,8 @@ class BaseSession(Protocol):
 class PointerSession(BaseSession, Protocol):
     """What the ellipsoid's pointer uses of a session."""
 
-    frame: Frame | None
-
+    @property
+    def frame(self) -> Frame | None: ...
     @property
     def showcase(self) -> object | None: ...
 

@@ -50,7 +50,8 @@ from poinsot.physics.models.pointing import (
 class SphereSession(BaseSession, Protocol):
     """What the sphere's pointer uses of a session."""
 
-    showcase: LiveShowcase | None
+    @property
+    def showcase(self) -> LiveShowcase | None: ...
 
     def post(self, action: Callable[[], None], key: Hashable | None = None) -> None: ...
     def configure_scene(self, key: str, value: Value) -> None: ...
