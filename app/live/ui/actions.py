@@ -63,6 +63,20 @@ class ActionQueue:
             self._queued.clear()
             return actions
 
+    def run(self, report: Callable[[Exception], None]) -> int:
+        """(Frame thread) Run every action queued, oldest first, then those queued meanwhile;
+        one that raises is given to ``report`` and the others still run. Returns how many were
+        refused since the last call (:meth:`refused`); 0 at once if none is queued."""
+        if not len(self._queued):  # the usual frame
+            return 0
+        while actions := self.take():
+            for action in actions:
+                try:
+                    action()
+                except Exception as exc:
+                    report(exc)
+        return self.refused()
+
     def refused(self) -> int:
         """Actions refused since the last call."""
         with self._lock:

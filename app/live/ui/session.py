@@ -298,15 +298,7 @@ class Session:
             self.showcase.refresh(now, self.frame.t)  # its readouts and plots, at their rates
 
     def _drain(self) -> None:
-        if not len(self.actions):  # the usual frame
-            return
-        while actions := self.actions.take():
-            for action in actions:
-                try:
-                    action()
-                except Exception as exc:
-                    self._report(exc)
-        refused = self.actions.refused()
+        refused = self.actions.run(self._report)
         if refused:  # said after the rebuild they ask for (which clears the status line)
             if self.build.dirty:
                 self._rebuild()
