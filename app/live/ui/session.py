@@ -234,15 +234,7 @@ class Session:
         """Show an error raised outside the frame thread (a GUI callback)."""
         self.post(lambda: self._report(error))
 
-    def wait_applied(self, generation: int, timeout: float = 5.0) -> int:
-        """Block (tests, benchmark) until a rebuild after ``generation`` was applied."""
-        return self.build.wait_applied(generation, timeout)
-
-    @property
-    def generation(self) -> int:
-        return self.build.generation
-
-    # -- what is shown (the frame thread's; read by the tools and tests) ----------------
+    # -- what is shown, and its rebuilds (the frame thread's; read by the tools and tests) --
     @property
     def preset(self) -> Preset:
         """The preset shown: a named one, Custom, or a chosen scene's identity."""
@@ -265,6 +257,14 @@ class Session:
     @property
     def frame(self) -> Frame | None:
         return self.build.frame
+
+    def wait_applied(self, generation: int, timeout: float = 5.0) -> int:
+        """Block (tests, benchmark) until a rebuild after ``generation`` was applied."""
+        return self.build.wait_applied(generation, timeout)
+
+    @property
+    def generation(self) -> int:
+        return self.build.generation
 
     # -- frame thread --------------------------------------------------------------------
     def _work(self) -> None:
