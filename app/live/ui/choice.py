@@ -27,7 +27,9 @@ from poinsot.app.scenes.spec import SceneSpec, Value
 
 class Choice:
     """The preset or scene shown; ``resolve`` turns the menu's "Fitted toss" and "Body from a
-    mesh" into the session's own, ``actions`` are what a scene's widgets ask of the session."""
+    mesh" into the session's own, ``actions`` are what a scene's widgets ask of the session.
+    ``menu_count``: the menu's ``count`` read when the change was asked for
+    (:meth:`~.panel.ControlPanel.show_preset`)."""
 
     def __init__(
         self,
@@ -50,6 +52,7 @@ class Choice:
         self.showcase: LiveShowcase | None = None
 
     def apply_preset(self, preset: Preset, menu_count: int | None = None) -> None:
+        """Show ``preset`` (Custom keeps the body asked for; a named one asks for its own)."""
         preset = self._resolve(preset)  # this session's own toss or mesh, if it has one
         self._leave_scene()
         self.preset = preset
@@ -88,6 +91,8 @@ class Choice:
     def edit(
         self, change: Callable[[Parameters], Parameters], menu_count: int | None = None
     ) -> None:
+        """Ask for ``change`` of the parameters asked for; edited by hand, a preset becomes
+        Custom."""
         new = change(self.build.desired)
         if not self.build.want(new):
             return
