@@ -14,6 +14,7 @@ order.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from poinsot.app.scene.frames import rotation_from_wxyz
 from poinsot.app.scene.geometry import triple
@@ -101,9 +102,18 @@ def construction_points(
 ) -> np.ndarray:
     """Points that bound Poinsot's construction in space (display units): the sphere that holds
     the turning ellipsoid (radius 1), the plane's disc at ``plane_height`` and L's tip."""
-    a = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
-    ring = np.stack([np.cos(a), np.sin(a), np.zeros(n)], axis=1)
+    disc = _ring(n) * plane_radius + [0.0, 0.0, plane_height]
+    return np.concatenate([sphere_points((0.0, 0.0, 0.0), 1.0, n), disc, [[0.0, 0.0, arrow_top]]])
+
+
+def sphere_points(centre: ArrayLike, radius: float, n: int = 48) -> np.ndarray:
+    """Points (N, 3) on the sphere of ``radius`` about ``centre``: nine rings of ``n``."""
+    ring = _ring(n)
     u = np.linspace(-1.0, 1.0, 9)
-    sphere = np.concatenate([ring * np.sqrt(1.0 - z * z) + [0.0, 0.0, z] for z in u])
-    disc = ring * plane_radius + [0.0, 0.0, plane_height]
-    return np.concatenate([sphere, disc, [[0.0, 0.0, arrow_top]]])
+    unit = np.concatenate([ring * np.sqrt(1.0 - z * z) + [0.0, 0.0, z] for z in u])
+    return unit * float(radius) + np.asarray(centre, dtype=np.float64)
+
+
+def _ring(n: int) -> np.ndarray:
+    a = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    return np.stack([np.cos(a), np.sin(a), np.zeros(n)], axis=1)

@@ -142,13 +142,17 @@ class Parts:
             self.api.add_icosphere(name, radius=MARKER_RADIUS, color=color, cast_shadow=False),
         )
 
-    def label(self, part: str, name: str, text: str, position: ArrayLike) -> viser.LabelHandle:
+    def label(
+        self, part: str, name: str, text: str, position: ArrayLike, *, centred: bool = False
+    ) -> viser.LabelHandle:
+        """A label whose lower left corner is at ``position`` (its lower middle if ``centred``:
+        a title over a picture, as wide on either side)."""
         return self.keep(
             part,
             self.api.add_label(
                 name,
                 text,
-                anchor="bottom-left",
+                anchor="bottom-center" if centred else "bottom-left",
                 font_screen_scale=1.2,
                 position=triple(position),
             ),

@@ -41,7 +41,7 @@ from poinsot.app.scene.view import View
 from poinsot.app.scenes import colors
 from poinsot.app.scenes.base import TabulatedDrawing, TabulatedModel
 from poinsot.app.scenes.drawing import THIN_ARROW, arrow_points
-from poinsot.app.scenes.momentum import SPHERE_RADIUS, MomentumPicture, momentum_nodes
+from poinsot.app.scenes.momentum import SPHERE_RADIUS, MomentumPicture, extent, momentum_nodes
 from poinsot.app.scenes.spec import (
     Canvas,
     Choice,
@@ -76,6 +76,7 @@ OMEGA_LENGTH = 1.0
 OMEGA_MIN = 0.35
 L_LENGTH = 1.3
 MOMENTUM_OFFSET = (2.9, 0.0, 0.1)
+MOMENTUM_TITLE = "body frame: m(t) on the sphere |m| = |L|"
 MOMENTUM_TURN = math.radians(-40.0)
 ROOT = "/space"
 SATELLITE_NODE = f"{ROOT}/body/satellite"
@@ -216,7 +217,7 @@ class SatelliteDrawing(TabulatedDrawing):
             "momentum",
             MOMENTUM_ROOT,
             MOMENTUM_OFFSET,
-            title="body frame: m(t) on the sphere |m| = |L|",
+            title=MOMENTUM_TITLE,
             family=True,
             trace_points=4000,
             ellipsoid=False,
@@ -310,7 +311,8 @@ SPEC = SceneSpec(
     ),
     build=build,
     draw=SatelliteDrawing,
-    view=View(position=(2.6, -6.0, 2.4), look_at=(1.45, 0.0, 0.1)),
+    view=View(position=(2.95, -7.8, 3.1), look_at=(1.45, 0.0, 0.1)),
+    beside=(extent(MOMENTUM_OFFSET, MOMENTUM_TITLE),),
     speed=2.0,
     picture_time=48.0,
 )

@@ -27,6 +27,23 @@ from poinsot.physics.models.family import PolhodeCurve
 
 #: Radius of the momentum sphere on screen [display units], unless a scene says otherwise.
 SPHERE_RADIUS = 0.8
+#: The picture's title stands this many radii above the sphere's centre, centred over it.
+TITLE_HEIGHT = 1.35
+#: Half the width of a title, in the picture's radii per character: its text is drawn at a
+#: size of its own on the screen, and this is its half-width beside the sphere on a phone held
+#: upright whose view is framed to hold the picture (390 x 844).
+TITLE_REACH_PER_CHARACTER = 0.073
+
+
+def extent(
+    offset: ArrayLike, title: str, radius: float = SPHERE_RADIUS
+) -> tuple[tuple[float, float, float], float]:
+    """The sphere (centre, radius; display units) that holds a picture at ``offset`` and its
+    ``title`` over it: what a framed view keeps in frame (``SceneSpec.beside``)."""
+    reach = max(TITLE_HEIGHT + 0.15, TITLE_REACH_PER_CHARACTER * len(title))
+    return triple(offset), reach * float(radius)
+
+
 #: The body axes reach this far past the sphere.
 AXIS_REACH = 1.25
 #: Widths of the curves [screen px] (the separatrix a little wider: it splits the families).
@@ -150,7 +167,7 @@ class MomentumPicture:
         )
         self.marker = parts.marker(part, f"{root}/m", colors.MOMENTUM)
         self.label = parts.label(
-            part, f"{root}/label", title, (-self.radius, 0.0, 1.35 * self.radius)
+            part, f"{root}/label", title, (0.0, 0.0, TITLE_HEIGHT * self.radius), centred=True
         )
         self.scale = 1.0
 

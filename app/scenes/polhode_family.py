@@ -39,6 +39,7 @@ from poinsot.app.scenes.momentum import (
     KINDS,
     MomentumPicture,
     current_segments,
+    extent,
     family_lines,
     family_segments,
     momentum_nodes,
@@ -82,6 +83,7 @@ D_STEP = 0.005
 #: Landau's picture stands this far to the side (space x, display units).
 LANDAU_OFFSET = (2.75, 0.0, 0.1)
 LANDAU_RADIUS = 0.62
+LANDAU_TITLE = "Landau: |L| = G  ∩  Σ Lᵢ²/Iᵢ = 2T"
 ROOT = "/space"
 FAMILY_ROOT = f"{ROOT}/body/family"
 CURRENT_NODE = f"{ROOT}/body/current_polhode"
@@ -247,7 +249,7 @@ class FamilyDrawing(PartsDrawing):
             "landau",
             LANDAU_ROOT,
             LANDAU_OFFSET,
-            title="Landau: |L| = G  ∩  Σ Lᵢ²/Iᵢ = 2T",
+            title=LANDAU_TITLE,
             current=True,
             radius=LANDAU_RADIUS,
         )
@@ -327,7 +329,8 @@ SPEC = SceneSpec(
     plots=(),
     build=build,
     draw=FamilyDrawing,
-    view=View(position=(2.6, -5.4, 2.6), look_at=(1.35, 0.0, 0.3)),
+    view=View(position=(2.8, -6.2, 2.95), look_at=(1.35, 0.0, 0.3)),
+    beside=(extent(LANDAU_OFFSET, LANDAU_TITLE, LANDAU_RADIUS),),
     speed=1.0,
     trail_points=1600,
     picture_time=6.0,

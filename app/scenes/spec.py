@@ -263,6 +263,10 @@ class SceneSpec:
     build: Callable[[Settings], Model]
     draw: Callable[[Canvas], Drawing]
     view: View = DEFAULT_VIEW
+    #: Pictures drawn beside the construction, each as a sphere that holds it (centre, radius;
+    #: display units): a view framed for a phone's or a tablet's aspect keeps them in frame
+    #: with the construction (:mod:`poinsot.app.live.ui.layout`).
+    beside: tuple[tuple[tuple[float, float, float], float], ...] = ()
     speed: float = 1.0
     speed_range: tuple[float, float] = SPEED_RANGE
     trail_points: int = 1200

@@ -7,10 +7,13 @@ import math
 
 import numpy as np
 import pytest
+from conftest import session_of, wait_until
 
 from poinsot.app.live.ui.layout import compact_aspect, touch_agent
-from poinsot.app.scene.cameras import construction_points, framed
-from poinsot.app.scene.view import DEFAULT_VIEW
+from poinsot.app.presets import DEFAULT_PRESET
+from poinsot.app.scene.cameras import construction_points, framed, sphere_points
+from poinsot.app.scene.view import DEFAULT_VIEW, View
+from poinsot.app.scenes import scene_by_name
 
 
 def _projected(view, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -52,3 +55,53 @@ def test_phones_and_tablets_and_odd_shapes_are_compact_desktops_are_not() -> Non
         assert not compact_aspect(width, height)
     assert compact_aspect(390, 844) and compact_aspect(844, 390)
     assert not compact_aspect(0, 800)
+
+
+def _shown_view(camera) -> View:
+    return View(
+        position=tuple(camera.position),
+        look_at=tuple(camera.look_at),
+        up=tuple(camera.up_direction),
+        fov_degrees=math.degrees(camera.fov),
+    )
+
+
+def _direction(view: View) -> np.ndarray:
+    d = np.subtract(view.look_at, view.position)
+    return d / np.linalg.norm(d)
+
+
+def _in_frame(view: View, points: np.ndarray, aspect: float) -> bool:
+    tx, ty = _projected(view, points)
+    half = math.tan(math.radians(view.fov_degrees) / 2.0)
+    return bool(np.all(np.abs(ty) <= half + 1e-9) and np.all(np.abs(tx) <= half * aspect + 1e-9))
+
+
+@pytest.mark.parametrize("name", ["polhode-family", "explorer-1"])
+def test_a_phone_that_chooses_a_scene_sees_the_picture_drawn_beside_it(make_app, make_probe, name):
+    """A phone held upright (390 x 844) that chooses a scene drawing a picture beside the
+    construction (Landau's sphere, the momentum sphere) gets the camera framed anew, from the
+    scene's own direction, with that picture in frame (the desktop's view left it off screen);
+    back on a preset, the default direction, framed again."""
+    spec = scene_by_name(name)
+    assert spec.beside
+    app = make_app()
+    probe = make_probe(app, size=(390, 844))
+    session = session_of(app)
+    layout = session.layout
+    assert layout is not None
+    assert wait_until(lambda: layout.compact and layout.framings >= 1, 20)
+    framings, aspect = layout.framings, 390 / 844
+    desktop = [sphere_points(c, r) for c, r in spec.beside]
+    assert not all(_in_frame(spec.view, p, aspect) for p in desktop)  # what it fixes
+    probe.set_value(probe.widget("Preset")[0], spec.identity().label)
+    assert wait_until(lambda: session.showcase is not None and layout.framings > framings, 20)
+    view = _shown_view(session.client.camera)
+    assert np.allclose(_direction(view), _direction(spec.view), atol=1e-9)
+    for points in desktop:
+        assert _in_frame(view, points, aspect), spec.beside
+    assert _in_frame(view, construction_points(1.0, 1.75, 1.45), aspect)
+    framings = layout.framings
+    probe.set_value(probe.widget("Preset")[0], DEFAULT_PRESET.label)
+    assert wait_until(lambda: session.showcase is None and layout.framings > framings, 20)
+    assert np.allclose(_direction(_shown_view(session.client.camera)), _direction(DEFAULT_VIEW))

@@ -91,10 +91,13 @@ class Probe:
         *,
         keep_batches: bool = True,
         origin: str | None = None,
+        size: tuple[int, int] = (1280, 720),
     ):
         """``origin``: the ``Origin`` header a browser would send (a page's
-        ``scheme://host:port``); None sends none, as tools that are not browsers do."""
+        ``scheme://host:port``); None sends none, as tools that are not browsers do. ``size``:
+        the picture's width and height it reports [px] (a phone's is narrow)."""
         self.uri = f"ws://{host}:{port}"
+        self.size = size
         self.nodes: dict[str, Node] = {}
         self.widgets: dict[str, Widget] = {}
         self.batches: list[Batch] = []
@@ -147,8 +150,8 @@ class Probe:
                 fov=0.8,
                 near=0.01,
                 far=100.0,
-                image_height=720,
-                image_width=1280,
+                image_height=self.size[1],
+                image_width=self.size[0],
                 look_at=(0.0, 0.0, 0.0),
                 up_direction=(0.0, 0.0, 1.0),
             )

@@ -19,9 +19,11 @@ Compact, the page differs in three ways (once, for that browser only):
 - **The legend in one tap.** The legend is mirrored at the top of the controls (shown on the
   bottom sheet only, where the "What you see" section comes last, folded), in larger text; on
   the rail, "What you see" comes first.
-- **The camera frames the construction** (the turning ellipsoid, the plane's disc, L) for the
-  picture's aspect ratio (:func:`poinsot.app.scene.cameras.framed`), and again when the browser
-  reports another aspect (the phone was turned).
+- **The camera frames the construction** (the turning ellipsoid, the plane's disc, L, and the
+  pictures a scene draws beside it: Landau's sphere, say) for the picture's aspect ratio
+  (:func:`poinsot.app.scene.cameras.framed`), from the direction of the scene's own view; again
+  when the browser reports another aspect (the phone was turned), and when another preset or
+  scene is shown.
 
 Touch needs nothing here: viser's camera turns under one finger and zooms under two, and a tap
 is a click (:mod:`poinsot.app.live.ui.pointer`).
@@ -36,10 +38,12 @@ import re
 from collections.abc import Callable, Hashable
 from typing import Protocol
 
+import numpy as np
 import viser
 
 from poinsot.app.live.ui.motion_window import MotionWindow
-from poinsot.app.scene.cameras import construction_points, framed
+from poinsot.app.live.ui.showcase import LiveShowcase
+from poinsot.app.scene.cameras import construction_points, framed, sphere_points
 from poinsot.app.scene.construction import PoinsotScene
 from poinsot.app.scene.geometry import L_OVERSHOOT, PLANE_RADIUS
 from poinsot.app.scene.view import DEFAULT_VIEW
@@ -90,6 +94,9 @@ class LayoutSession(Protocol):
 
     client: viser.ClientHandle
     scene: PoinsotScene
+
+    @property
+    def showcase(self) -> LiveShowcase | None: ...
 
     def post(self, action: Callable[[], None], key: Hashable | None = None) -> None: ...
 
@@ -157,11 +164,22 @@ class Layout:
         gui.main_panel.minimize()
         fold_bottom_sheet(self.session.client)
 
+    def reframe(self) -> None:
+        """Another preset or scene is shown (its own view just applied): compact, it is framed
+        for the picture's aspect too."""
+        if self.compact and self.size is not None and min(self.size) > 0:
+            self.frame(self.size[0] / self.size[1])
+
     def frame(self, aspect: float) -> None:
-        """Frame the whole construction for a picture ``aspect`` wide."""
+        """Frame the whole construction for a picture ``aspect`` wide, from the direction of the
+        scene's view, with the pictures a scene draws beside it."""
         geometry = self.session.scene.geometry
         h = 1.0 if geometry is None else geometry.plane_height
         top = h + L_OVERSHOOT  # L's tip
-        view = framed(DEFAULT_VIEW, aspect, construction_points(h, PLANE_RADIUS, top))
-        view.apply(self.session.client.camera)
+        points = [construction_points(h, PLANE_RADIUS, top)]
+        showcase = self.session.showcase
+        view = DEFAULT_VIEW if showcase is None else showcase.spec.view
+        if showcase is not None:
+            points += [sphere_points(centre, radius) for centre, radius in showcase.spec.beside]
+        framed(view, aspect, np.concatenate(points)).apply(self.session.client.camera)
         self.framings += 1

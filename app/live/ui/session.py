@@ -95,6 +95,7 @@ class Session:
         self.actions = ActionQueue(max_actions)
         self.loop = self._frame_loop()
         self.sphere_pointer: SpherePointer | None = None  # mounted with the pointer below
+        self.layout: Layout | None = None  # mounted with the tools, after the first body
 
         apply_theme(client)
         view.apply(client.camera)
@@ -188,7 +189,7 @@ class Session:
 
     def choose_preset(self, preset: Preset) -> None:
         count = self.panel.menu.count  # the menu's choices so far (Panel.show_preset)
-        self.post(lambda: self.choice.apply_preset(preset, count))
+        self.post(lambda: self._apply_preset(preset, count))
 
     @functools.cached_property
     def uploads(self) -> UploadControls:
@@ -333,10 +334,17 @@ class Session:
         self.status = message
         self.panel.show_status(message)
 
+    def _apply_preset(self, preset: Preset, menu_count: int | None = None) -> None:
+        self.choice.apply_preset(preset, menu_count)
+        if self.layout is not None:  # a phone's view framed for its aspect
+            self.layout.reframe()
+
     def _apply_scene(self, scene: SceneSpec, menu_count: int | None = None) -> None:
         self.choice.apply_scene(scene, menu_count)
         if self.sphere_pointer is not None:
             self.sphere_pointer.bind()
+        if self.layout is not None:
+            self.layout.reframe()
 
     def _rebuild(self) -> None:
         self.build.rebuild(self.showcase)
