@@ -3,8 +3,9 @@ private names (:mod:`poinsot.app.viser_private`, whose docstring has the invento
 
 - :func:`message_buffer`: ``ClientHandle._websock_connection.get_message_buffer()``, the
   client's queue, with its ``message_counter`` (next id), ``generator_cursors`` (client id ->
-  the last id its sender took), ``message_from_id`` (the messages still queued) and ``done``
-  (set once the client has left: a message pushed then is never sent, and viser warns);
+  the last id its sender took), ``message_from_id`` (the messages still queued), ``done``
+  (set once the client has left: a message pushed then is never sent, and viser warns) and
+  ``sanctioned_dead_writes()`` (pushes within it are dropped without the warning);
 - :func:`connection_of`: ``ClientHandle._viser_server._websock_server`` with its
   ``_live_connections`` (client id -> websockets connection) and ``_background_event_loop``.
 
@@ -14,12 +15,19 @@ backlog watch sees nothing: the behaviour before either); the test of each pins 
 
 from __future__ import annotations
 
+from contextlib import AbstractContextManager
 from typing import Any
 
 import viser
 
 #: What :func:`message_buffer` needs of viser's buffer.
-BUFFER_FIELDS = ("message_counter", "generator_cursors", "message_from_id", "done")
+BUFFER_FIELDS = (
+    "message_counter",
+    "generator_cursors",
+    "message_from_id",
+    "done",
+    "sanctioned_dead_writes",
+)
 
 
 def message_buffer(client: viser.ClientHandle) -> Any:
@@ -61,3 +69,9 @@ def pending(buffer: Any) -> int:
 def closed(buffer: Any) -> bool:
     """True once the client of ``buffer`` has left (nothing pushed then is ever sent)."""
     return bool(buffer.done)
+
+
+def quiet_if_closed(buffer: Any) -> AbstractContextManager[None]:
+    """Pushes to ``buffer`` within this block, if its client has left meanwhile, are dropped
+    without viser's warning (a frame begun just before the client left)."""
+    return buffer.sanctioned_dead_writes()

@@ -92,7 +92,8 @@ def test_a_client_that_left_gets_no_frame():
 def test_a_session_whose_client_left_queues_nothing_before_it_is_closed(poinsot_app, probe):
     """Between viser's closing a departed client's queue and the server's closing its
     session, the frame thread goes on: it draws nothing and rebuilds nothing for nobody, and
-    viser has nothing to warn about in the server's terminal."""
+    viser has nothing to warn about in the server's terminal (nor for a frame begun just
+    before the client left)."""
     session = session_of(poinsot_app)
     close, held = session.close, []
     session.close = lambda timeout=None: held.append(timeout)  # type: ignore[method-assign]
@@ -116,6 +117,15 @@ def test_a_session_whose_client_left_queues_nothing_before_it_is_closed(poinsot_
             assert wait_until(lambda: passes[0] >= seen + 10, 20), "the frame thread stopped"
             assert (session.stats.frames, session.stats.rebuilds) == (frames, rebuilds)
         assert [str(w.message) for w in caught if "closed connection" in str(w.message)] == []
+        # A frame begun just before the client left: its messages are dropped quietly; the
+        # same message outside that block is what viser warns of.
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            with session.pacer.outbox.quiet_if_left():
+                session.client.gui.add_markdown("for nobody")
+            assert not [w for w in caught if "closed connection" in str(w.message)]
+            session.client.gui.add_markdown("for nobody, and said")
+            assert [w for w in caught if "closed connection" in str(w.message)]
     finally:
         close(timeout=5.0)
 

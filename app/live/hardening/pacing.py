@@ -31,6 +31,7 @@ once: on this 2-core machine, 15 browsers per process at 44 fps each answered a 
 from __future__ import annotations
 
 import collections
+import contextlib
 import dataclasses
 import fcntl
 import struct
@@ -89,6 +90,14 @@ class Outbox:
     def closed(self) -> bool:
         """True once the client has left (what is queued then is never sent)."""
         return self._buffer is not None and private.closed(self._buffer)
+
+    def quiet_if_left(self) -> contextlib.AbstractContextManager[None]:
+        """A frame's or an action's messages within this block, if the client leaves while it
+        runs, are dropped without viser's warning (the session is closing: the next pass of
+        its frame thread sees :meth:`closed`)."""
+        if self._buffer is None:
+            return contextlib.nullcontext()
+        return private.quiet_if_closed(self._buffer)
 
     def pending(self) -> int:
         """Messages in the client's queue now (after viser's coalescing of updates)."""

@@ -271,18 +271,20 @@ class Session:
     def _work(self) -> None:
         """Before each frame: the queued actions, then a rebuild if they asked for one (none
         once the client has left: what they would send goes to nobody)."""
-        if self.pacer.outbox.closed():
+        outbox = self.pacer.outbox
+        if outbox.closed():
             return
-        self._drain()
-        if self.build.dirty:
-            self._rebuild()
+        with outbox.quiet_if_left():
+            self._drain()
+            if self.build.dirty:
+                self._rebuild()
 
     def _frame_if_taken(self, now: float) -> bool:
         """Draw a frame, unless the browser has not yet taken the one before (:class:`Pacer`:
         skipped, the rate lowered). A frame's messages go out at once, in one atomic window."""
         if not self.pacer.may_draw():
             return False
-        with self.client.atomic():
+        with self.pacer.outbox.quiet_if_left(), self.client.atomic():
             self._advance()
             self._refresh(now)
         self.client.flush()  # out now, not at viser's next 1/60 s window
