@@ -56,8 +56,9 @@ Inventory (section, private name, what it is used for):
 
 *Transport* (:mod:`poinsot.app.viser_private.transport`)
   - ``ClientHandle._websock_connection.get_message_buffer()`` with its ``message_counter``,
-    ``generator_cursors`` and ``message_from_id``: how far a client's send queue was taken (the
-    pacer).
+    ``generator_cursors``, ``message_from_id``, ``done`` and ``sanctioned_dead_writes()``: how
+    far a client's send queue was taken (the pacer), whether its client has left, and viser's
+    scope for benign writes to a departed client's queue (a frame begun just before it left).
   - ``ClientHandle._viser_server._websock_server`` with ``_live_connections`` and
     ``_background_event_loop``: a client's socket and its loop (the pacer's unacknowledged
     bytes, the backlog watch).
