@@ -23,6 +23,7 @@ from poinsot.app.live.ui.session import MAX_FPS, Session
 from poinsot.app.presets import DEFAULT_PRESET, Preset
 from poinsot.app.scenes.spec import SceneSpec
 from poinsot.app.viser_private import handshake_origin, page_address
+from poinsot.app.viser_private import transport as private_transport
 
 log = logging.getLogger(__name__)
 
@@ -121,6 +122,7 @@ class PoinsotApp:
             return list(self._sessions.values())
 
     async def _on_connect(self, client: viser.ClientHandle) -> None:
+        private_transport.senders_woken_on_their_loop(client)  # before the session pushes
         if handshake_origin(self.server, client.client_id) is None:  # a tool: no page, no link
             self._build(client, None)
             return

@@ -58,7 +58,10 @@ Inventory (section, private name, what it is used for):
   - ``ClientHandle._websock_connection.get_message_buffer()`` with its ``message_counter``,
     ``generator_cursors``, ``message_from_id``, ``done`` and ``sanctioned_dead_writes()``: how
     far a client's send queue was taken (the pacer), whether its client has left, and viser's
-    scope for benign writes to a departed client's queue (a frame begun just before it left).
+    scope for benign writes to a departed client's queue (a frame begun just before it left);
+    its ``message_event`` and ``event_loop``, and the broadcast queue's
+    (``ViserServer._websock_server.get_message_buffer()``): the event is made one that only
+    its loop sets (viser also sets it from the pushing thread, a race with the sender's wait).
   - ``ClientHandle._viser_server._websock_server`` with ``_live_connections`` and
     ``_background_event_loop``: a client's socket and its loop (the pacer's unacknowledged
     bytes, the backlog watch).

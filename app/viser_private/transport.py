@@ -7,7 +7,10 @@ private names (:mod:`poinsot.app.viser_private`, whose docstring has the invento
   (set once the client has left: a message pushed then is never sent, and viser warns) and
   ``sanctioned_dead_writes()`` (pushes within it are dropped without the warning);
 - :func:`connection_of`: ``ClientHandle._viser_server._websock_server`` with its
-  ``_live_connections`` (client id -> websockets connection) and ``_background_event_loop``.
+  ``_live_connections`` (client id -> websockets connection) and ``_background_event_loop``;
+- :func:`set_on_its_loop_only`: a buffer's ``message_event`` (an ``asyncio.Event``) and
+  ``event_loop``, the event made one that only its loop sets (:class:`_SetOnItsLoop`: viser
+  also sets it from the pushing thread, which races with the sender's wait);
 
 Both answer None rather than raise when a name has moved (the pacer then never skips, and the
 backlog watch sees nothing: the behaviour before either); the test of each pins the names.
@@ -15,6 +18,7 @@ backlog watch sees nothing: the behaviour before either); the test of each pins 
 
 from __future__ import annotations
 
+import asyncio
 from contextlib import AbstractContextManager
 from typing import Any
 
@@ -75,3 +79,50 @@ def quiet_if_closed(buffer: Any) -> AbstractContextManager[None]:
     """Pushes to ``buffer`` within this block, if its client has left meanwhile, are dropped
     without viser's warning (a frame begun just before the client left)."""
     return buffer.sanctioned_dead_writes()
+
+
+class _SetOnItsLoop(asyncio.Event):
+    """A send queue's message event, set only on the queue's own event loop. viser's buffer sets
+    its event where a message is pushed, any thread, and again on its loop
+    (``call_soon_threadsafe``, at once or when an atomic block ends), which is what wakes the
+    queue's sender. The set from another thread walks the event's waiters while the loop may be
+    adding or removing the sender's: "deque mutated during iteration", raised into the thread
+    that pushed (a session being built, a frame). Here that set does nothing; the loop's wakes."""
+
+    owner: asyncio.AbstractEventLoop | None = None
+
+    def set(self) -> None:
+        try:
+            running = asyncio.get_running_loop()
+        except RuntimeError:  # not on a loop: another thread
+            return
+        if running is self.owner:
+            super().set()
+
+
+def set_on_its_loop_only(buffer: Any) -> bool:
+    """Make ``buffer``'s ``message_event`` (an ``asyncio.Event``, woken on ``event_loop``) a
+    :class:`_SetOnItsLoop`, in place (the sender waiting on it keeps waiting on it). False if
+    viser's buffer no longer has them (nothing changed then)."""
+    event = getattr(buffer, "message_event", None)
+    loop = getattr(buffer, "event_loop", None)
+    if not isinstance(event, asyncio.Event) or not isinstance(loop, asyncio.AbstractEventLoop):
+        return False
+    if not isinstance(event, _SetOnItsLoop):
+        event.__class__ = _SetOnItsLoop
+    assert isinstance(event, _SetOnItsLoop)
+    event.owner = loop
+    return True
+
+
+def senders_woken_on_their_loop(client: viser.ClientHandle) -> bool:
+    """The client's send queue's event set on its loop only (:func:`set_on_its_loop_only`)."""
+    buffer = message_buffer(client)
+    return buffer is not None and set_on_its_loop_only(buffer)
+
+
+def broadcasts_woken_on_their_loop(server: viser.ViserServer) -> bool:
+    """The server's broadcast queue's event set on its loop only (:func:`set_on_its_loop_only`):
+    ``ViserServer._websock_server.get_message_buffer()``."""
+    getter = getattr(getattr(server, "_websock_server", None), "get_message_buffer", None)
+    return getter is not None and set_on_its_loop_only(getter())

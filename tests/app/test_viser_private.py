@@ -7,6 +7,7 @@ which one the adapter was written for (:class:`~poinsot.app.viser_private.ViserC
 from __future__ import annotations
 
 import asyncio
+import collections
 import dataclasses
 import inspect
 import threading
@@ -166,6 +167,62 @@ def test_a_client_s_queue_and_socket_are_where_viser_put_them(poinsot_app, probe
     assert isinstance(connection, websockets.asyncio.server.ServerConnection), WRITTEN_FOR
     assert isinstance(loop, asyncio.AbstractEventLoop) and loop.is_running(), WRITTEN_FOR
     assert connection is viser_private.live_connection(poinsot_app.server, client.client_id)
+
+
+class _Walked(collections.deque):
+    """An event's waiters that record each walk through them (from which thread)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.walked_from: list[int] = []
+
+    def __iter__(self):
+        self.walked_from.append(threading.get_ident())
+        return super().__iter__()
+
+
+def test_a_send_queue_is_woken_on_its_loop_only(poinsot_app, probe):
+    """viser sets a send queue's event from the thread that pushes a message, walking the
+    sender's waiters while its loop may change them ("deque mutated during iteration" in a
+    session being built); here only the loop sets it. Every client's queue and the broadcast
+    queue have the event; set from another thread it is untouched, on its loop it wakes."""
+    session = session_of(poinsot_app)
+    buffers = [
+        private_transport.message_buffer(session.client),
+        viser_private.infra(poinsot_app.server).get_message_buffer(),
+    ]
+    for buffer in buffers:
+        event, loop = buffer.message_event, buffer.event_loop
+        assert isinstance(event, asyncio.Event), WRITTEN_FOR
+        assert isinstance(loop, asyncio.AbstractEventLoop) and loop.is_running(), WRITTEN_FOR
+        assert isinstance(event, private_transport._SetOnItsLoop) and event.owner is loop
+    # The behaviour, on an event of its own: a plain asyncio.Event set from another thread
+    # walks its waiters there; the queue's does not, and its own loop's set wakes the waiter.
+    loop = asyncio.new_event_loop()
+    thread = threading.Thread(target=loop.run_forever, daemon=True)
+    thread.start()
+    try:
+        for kind in (asyncio.Event, private_transport._SetOnItsLoop):
+            event = kind()
+            if isinstance(event, private_transport._SetOnItsLoop):
+                event.owner = loop
+            event._waiters = waiters = _Walked()
+            waiting = asyncio.run_coroutine_threadsafe(event.wait(), loop)
+            assert wait_until(lambda w=waiters: len(w) == 1, 10)
+            event.set()  # from this thread, as viser's push does
+            foreign = [t for t in waiters.walked_from if t != thread.ident]
+            if kind is asyncio.Event:  # what the race comes from
+                assert foreign
+                loop.call_soon_threadsafe(lambda: None)  # its waiter's wake-up, left unheard
+                assert waiting.result(10) is True
+                continue
+            assert not foreign and not event.is_set() and not waiting.done()
+            loop.call_soon_threadsafe(event.set)  # viser's wake-up on the loop
+            assert waiting.result(10) is True and event.is_set()
+    finally:
+        loop.call_soon_threadsafe(loop.stop)
+        thread.join(10)
+        loop.close()
 
 
 # -- GUI -----------------------------------------------------------------------------------------

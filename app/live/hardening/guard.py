@@ -44,6 +44,7 @@ from websockets.http11 import Request, Response
 
 from poinsot.app import viser_private
 from poinsot.app.live.hardening.budget import MessageBudget
+from poinsot.app.viser_private import transport as private_transport
 
 #: Messages a second one client may send, sustained, and in one burst (a browser sends a few
 #: dozen a second at most: camera moves while orbiting, a dragged slider, upload parts).
@@ -225,11 +226,14 @@ def guarded_viser(
     host: str, port: int, *, verbose: bool = False, allow_origins: Iterable[str] = ()
 ) -> tuple[viser.ViserServer, HandshakeGate]:
     """A viser server whose handshakes pass :class:`HandshakeGate` and whose share tunnel is
-    off (its handlers removed; the wire refuses the messages too)."""
+    off (its handlers removed; the wire refuses the messages too). Its broadcast queue is woken
+    on viser's loop only, as each client's is once connected (the server's connect handler):
+    :func:`poinsot.app.viser_private.transport.set_on_its_loop_only`."""
     gate = HandshakeGate(host, allow_origins)
     with viser_private.hooked_server(gate.check, gate.error):
         server = viser.ViserServer(host=host, port=port, verbose=verbose)
     viser_private.disable_share(server)
+    private_transport.broadcasts_woken_on_their_loop(server)
     return server, gate
 
 
