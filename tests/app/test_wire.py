@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pytest
 import websockets
-from conftest import session_of, wait_until
+from conftest import after_frames, session_of, wait_until
 from uploading import MESH
 from viser import _messages
 
@@ -295,6 +295,9 @@ def test_a_client_cannot_lengthen_the_trails_beyond_their_cap(poinsot_app, probe
     """The trail length a client sends is clamped to the slider's top (the ring of chunks
     itself holds its length: tests/app/test_parts.py)."""
     session = session_of(poinsot_app)
+    # Once the new session has settled: a value that comes while the server shows the panel's
+    # playback values again (at start) was overwritten by them before its callback read it.
+    after_frames(session, 30)
     probe.set_value(probe.widget("Trail length")[0], 10**12)
     # The scene's length is set first, then each trail's (on the frame thread): wait for all.
     assert wait_until(lambda: session.scene.trail_points == TRAIL_RANGE[1], 30)
