@@ -189,6 +189,7 @@ def test_a_number_beyond_the_range_is_clamped_and_shown_clamped(poinsot_app, pro
 def test_a_gui_update_naming_another_property_is_dropped(poinsot_app, probe):
     """A browser sends only values; viser would set any attribute named (the callbacks)."""
     session = session_of(poinsot_app)
+    after_frames(session, 30)  # settled: the panel's playback values are not shown again
     uuid, widget = probe.widget("Speed")
     probe.send(_messages.GuiUpdateMessage(uuid, {"max": 1e300, "update_cb": []}))
     assert wait_until(lambda: poinsot_app.guard.malformed == 1, 10)
