@@ -13,6 +13,7 @@ import numpy as np
 from conftest import session_of, wait_until
 from scipy.spatial.transform import Rotation
 
+from poinsot.app.elements import Element
 from poinsot.app.live.hardening.probe import Node, Probe
 from poinsot.app.live.server import PoinsotApp
 from poinsot.app.live.ui.session import Session
@@ -87,6 +88,25 @@ def trail_points(nodes: dict[str, Node], group: str) -> np.ndarray:
     parts = [segments(node) for _, node in chunks]
     segs = np.concatenate(parts)
     return np.concatenate([segs[:, 0], segs[-1:, 1]])
+
+
+def drawn_traces(session: Session, probe: Probe) -> dict[str, np.ndarray]:
+    """Every trace of the scene as sent (by group name), once all the points the session has
+    drawn have reached the probe: the traces are sent every few frames, and paused, the last
+    points go out with the next frame drawn (for traces not yet trimmed to their length)."""
+    assert wait_until(lambda: session.scene.traces_complete, 10), "the traces were not all sent"
+    drawn = {
+        trail.group.name: len(trail.points())
+        for element in Element
+        if (trail := session.scene.trail(element)) is not None
+    }
+
+    def arrived(p: Probe) -> bool:
+        return all(len(trail_points(p.nodes, name)) == n for name, n in drawn.items())
+
+    assert probe.wait_for(arrived, 10), f"the traces never arrived in full: {drawn}"
+    nodes, _ = probe.snapshot()
+    return {name: trail_points(nodes, name) for name in drawn}
 
 
 def scene_node_names(probe: Probe, trails: tuple[str, ...]) -> set[str]:

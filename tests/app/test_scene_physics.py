@@ -12,6 +12,7 @@ import pytest
 from conftest import wait_until
 from scene_probing import (
     arrow_tip,
+    drawn_traces,
     number_in,
     plot_data,
     readout_table,
@@ -246,12 +247,16 @@ def test_long_cylinder_progress_along_the_polhode(make_app, make_probe):
         lambda p: wait_readouts(p, spec.readouts)["travelled along the polhode"][0] == expected, 10
     )
     _, nodes = sent_at(session, probe, session.frame.t)
-    trace = trail_points(nodes, "/space/body/polhode")
+    traces = drawn_traces(session, probe)
+    trace = traces["/space/body/polhode"]
     full = segments(nodes["/space/body/polhode_full"])
     chord = lambda seg: float(np.sum(np.linalg.norm(seg[:, 1] - seg[:, 0], axis=1)))  # noqa: E731
     travelled = float(np.sum(np.linalg.norm(np.diff(trace, axis=0), axis=1))) / chord(full)
-    assert travelled == pytest.approx(number_in(expected) / 100.0, abs=0.01)
-    herpolhode = trail_points(nodes, "/space/herpolhode")
+    assert travelled == pytest.approx(number_in(expected) / 100.0, abs=0.01), (
+        len(trace),
+        trace[:2],
+    )
+    herpolhode = traces["/space/herpolhode"]
     ratio = np.max(np.hypot(herpolhode[:, 0], herpolhode[:, 1])) / np.max(
         np.hypot(full[:, 0, 1], full[:, 0, 2])
     )
