@@ -58,11 +58,31 @@ def changed(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.mean(np.abs(a - b).sum(axis=2) > 40))
 
 
-def settle(page, session, spec: SceneSpec) -> None:
-    """Let the scene play a moment (its traces grow), then pause it (``render`` then waits
-    until two pictures in a row agree: the pause has reached the page)."""
-    assert wait_until(lambda: session.showcase is not None and session.showcase.loaded, 20)
-    assert wait_until(lambda: session.stats.frames > 60, 30), "the scene is not animating"
+def show(page, session, spec: SceneSpec, before: SceneSpec | None) -> None:
+    """The scene on the page (chosen from the menu's session, after the first) once its
+    controls and parts' checkboxes are there and those of the scene ``before`` are gone; played
+    a moment (its traces grow), then paused (``render`` then waits until two pictures in a
+    row agree: the pause has reached the page)."""
+    if before is not None:
+        session.choose_scene(spec)
+    assert wait_until(
+        lambda: (
+            session.showcase is not None
+            and session.showcase.spec is spec
+            and session.showcase.loaded
+        ),
+        20,
+    )
+    labels = {c.label for c in spec.controls} | {p.label for p in spec.parts}
+    old = set() if before is None else {c.label for c in before.controls}
+    old |= set() if before is None else {p.label for p in before.parts}
+    for label in labels:
+        assert wait_until(lambda la=label: page.control_count(la) == 1, 20), (spec.name, label)
+    for label in old - labels:
+        assert wait_until(lambda la=label: page.control_count(la) == 0, 20), (spec.name, label)
+    session.clock.paused = False
+    frames = session.stats.frames
+    assert wait_until(lambda: session.stats.frames > frames + 60, 30), "not animating"
     session.clock.paused = True
 
 
@@ -98,12 +118,15 @@ def check_parts(page, session, spec: SceneSpec, shown: np.ndarray) -> None:
 
 
 def test_every_scene_draws_its_parts_distinctly(make_app, open_page):
+    """Each scene in turn on one page, the first served as the page opens, the others chosen
+    from the menu (each after the one before: nothing of it may remain)."""
     pictures: dict[str, np.ndarray] = {}
+    app = make_app(scene=SCENES[0])
+    page = open_page(app.url, width=WIDTH, height=HEIGHT, live_view=False)
+    session = session_of(app)
+    before: SceneSpec | None = None
     for spec in SCENES:
-        app = make_app(scene=spec)
-        page = open_page(app.url, width=WIDTH, height=HEIGHT, live_view=False)
-        session = session_of(app)
-        settle(page, session, spec)
+        show(page, session, spec, before)
         shown = render(session)
         drawn = np.abs(shown - shown[0, 0]).sum(axis=2) > 30
         assert drawn.mean() > 0.03, (spec.name, drawn.mean())  # not blank
@@ -117,8 +140,7 @@ def test_every_scene_draws_its_parts_distinctly(make_app, open_page):
         assert page.errors == [], (spec.name, page.errors)
         assert session.stats.errors == 0, session.stats.last_error
         pictures[spec.name] = shown
-        page.page.context.close()  # one rendering page at a time (software WebGL is slow)
-        app.stop()
+        before = spec
     names = list(pictures)
     for i, a in enumerate(names):
         for b in names[i + 1 :]:
