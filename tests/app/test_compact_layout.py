@@ -94,6 +94,8 @@ def test_a_phone_that_chooses_a_scene_sees_the_picture_drawn_beside_it(make_app,
     framings, aspect = layout.framings, 390 / 844
     desktop = [sphere_points(c, r) for c, r in spec.beside]
     assert not all(_in_frame(spec.view, p, aspect) for p in desktop)  # what it fixes
+    # The session frames the camera on its thread; the panel may not have reached the probe.
+    assert probe.wait_for(lambda p: p.has_widget("Preset"), 20)
     probe.set_value(probe.widget("Preset")[0], spec.identity().label)
     assert wait_until(lambda: session.showcase is not None and layout.framings > framings, 20)
     view = _shown_view(session.client.camera)
