@@ -422,3 +422,50 @@ def test_clients_that_leave_during_connect_leave_no_session(poinsot_app):
         60,
     ), (len(poinsot_app.sessions()), poinsot_app.pending_departures(), _session_threads())
     assert poinsot_app.server.get_clients() == {}
+
+
+def test_a_body_built_for_an_older_value_leaves_the_slider_where_the_browser_moved_it(
+    poinsot_app, probe
+):
+    """Two values of |ω₀| from the browser, the second arriving while the body of the first is
+    being built: the built body does not put the slider back to the first (the user's next
+    key would step from there); the second is applied, and the slider keeps it."""
+    import threading
+
+    session = session_of(poinsot_app)
+    uuid, widget = probe.widget("|ω₀|")
+    first, second = float(widget.value) + 0.05, float(widget.value) + 0.1
+    sent_back: list[float] = []
+
+    def listen(message, _arrival) -> None:
+        updates = message.get("updates", {})
+        if message["type"] == "GuiUpdateMessage" and message["uuid"] == uuid:
+            if "value" in updates:
+                sent_back.append(float(updates["value"]))
+
+    probe.add_listener(listen)
+    panel = session.panel
+    show = panel.show_parameters
+    building, release = threading.Event(), threading.Event()
+    shown: list[float] = []  # the slider's value once the first value's body is shown
+
+    def held(params) -> None:  # the body of the first value, built: its sliders not yet shown
+        building.set()
+        release.wait(30)
+        show(params)
+        shown.append(float(panel.widgets.omega_norm.value))
+
+    panel.show_parameters = held  # type: ignore[method-assign]
+    probe.set_value(uuid, first)
+    assert building.wait(20), "the first value's body was never built"
+    panel.show_parameters = show  # type: ignore[method-assign]
+    probe.set_value(uuid, second)
+    slider = panel.widgets.omega_norm
+    assert slider is not None
+    assert wait_until(lambda: slider.value == pytest.approx(second), 10)  # it has arrived
+    release.set()
+    assert wait_until(lambda: session.params.omega_norm == pytest.approx(second), 10)
+    after_frames(session, 5)
+    assert slider.value == pytest.approx(second)
+    assert shown == [pytest.approx(second)]
+    assert not any(v == pytest.approx(first) for v in sent_back), sent_back

@@ -63,6 +63,10 @@ class BodyControls:
         callback)``: listen to the browser's changes only (:func:`~.widgets.on_user`)."""
         self.gui, self.edit, self.widgets = gui, edit, widgets
         self.folder, self.on_user = folder, on_user
+        #: Per slider: the browser's values (their count as they arrived), and the count of
+        #: the last one applied to the parameters asked for (:meth:`_edit`, :meth:`_mirror`).
+        self._sent: dict[str, Sent] = {}
+        self._applied: dict[str, tuple[Sent, int]] = {}
 
     def build_inertia(self, params: Parameters) -> list[Removable]:
         sliders = []
@@ -85,7 +89,7 @@ class BodyControls:
     def _inertia_callback(self, index: int) -> Callable[[Sent], None]:
         def callback(handle: Sent) -> None:
             value = float(handle.value)
-            self.edit(lambda p: p.with_inertia(index, value))
+            self._edit(f"I{index}", handle, lambda p: p.with_inertia(index, value))
 
         return callback
 
@@ -105,7 +109,7 @@ class BodyControls:
 
         def move(handle: Sent) -> None:
             value = float(handle.value)
-            self.edit(lambda p: p.with_D(value, snap=D_STEP / 2))
+            self._edit("D", handle, lambda p: p.with_D(value, snap=D_STEP / 2))
 
         self.widgets.energy = self.on_user(slider, move)
         return [slider]
@@ -139,7 +143,7 @@ class BodyControls:
 
         def move(handle: Sent) -> None:
             value = float(handle.value)
-            self.edit(lambda p: p.with_omega_norm(value))
+            self._edit("omega", handle, lambda p: p.with_omega_norm(value))
 
         self.widgets.omega_norm = self.on_user(slider, move)
         return [slider]
@@ -148,18 +152,45 @@ class BodyControls:
         """Mirror parameters into the sliders (and the D slider's range and marks)."""
         w = self.widgets
         lo, hi = slider_range(INERTIA_RANGE, params.inertia)
-        for slider, moment in zip(w.inertia, params.inertia, strict=False):
+        for i, (slider, moment) in enumerate(zip(w.inertia, params.inertia, strict=False)):
             if (slider.min, slider.max) != (lo, hi):
                 slider.min, slider.max = lo, hi
-            set_value(slider, float(moment))
+            self._mirror(f"I{i}", slider, float(moment))
         if w.energy is not None:
             w.energy.min, w.energy.max = params.D_range
             set_marks(w.energy, energy_marks(params))
-            set_value(w.energy, float(params.D))
+            self._mirror("D", w.energy, float(params.D))
         if w.side is not None and w.side.visible != params.has_separatrix:
             w.side.visible = params.has_separatrix  # a symmetric body has no separatrix
         if w.omega_norm is not None:
             lo, hi = slider_range(OMEGA_NORM_RANGE, (params.omega_norm,))
             if (w.omega_norm.min, w.omega_norm.max) != (lo, hi):
                 w.omega_norm.min, w.omega_norm.max = lo, hi
-            set_value(w.omega_norm, float(params.omega_norm))
+            self._mirror("omega", w.omega_norm, float(params.omega_norm))
+
+    # -- a slider moved in the browser, and the body shown ----------------------------------
+    def _edit(self, key: str, sent: Sent, change: Callable[[Parameters], Parameters]) -> None:
+        """Queue ``change``, the browser's value of slider ``key`` as it arrived (viser's event
+        loop: ``sent.count`` counts it); applied, it is the last of that slider's values the
+        parameters hold."""
+        count = sent.count
+        self._sent[key] = sent
+
+        def apply(params: Parameters) -> Parameters:
+            new = change(params)
+            self._applied[key] = (sent, count)
+            return new
+
+        self.edit(apply)
+
+    def _mirror(self, key: str, slider: Any, value: float) -> None:
+        """Show ``value`` in slider ``key``, unless the browser has sent it a newer value that
+        the parameters do not hold yet: a body built for an older value (keys pressed faster
+        than the body is rebuilt) would put the thumb back under the user's hand, and the next
+        key would step from there. The newer value is shown once applied (snapped if need be)."""
+        sent = self._sent.get(key)
+        if sent is not None:
+            applied_sent, applied = self._applied.get(key, (sent, 0))
+            if sent.count > (applied if applied_sent is sent else 0):
+                return
+        set_value(slider, value)
