@@ -31,12 +31,6 @@ log = logging.getLogger(__name__)
 PAGE_TIMEOUT = 10.0
 
 
-def _log_failure(future: Future[None]) -> None:
-    exc = future.exception() if not future.cancelled() else None
-    if exc is not None:
-        log.error("a session could not be built", exc_info=exc)
-
-
 class PoinsotApp:
     """Serve the Poinsot scene: each connecting browser gets its own session."""
 
@@ -68,7 +62,7 @@ class PoinsotApp:
         #: The lecturer code, the lead and its followers (:mod:`.ui.follow`).
         self.follow = follow if follow is not None else FollowHub()
         self.max_fps = max_fps
-        self._lock = threading.Lock()
+        self._lock, self._stopping = threading.Lock(), threading.Event()  # set by stop()
         self._sessions: dict[int, Session] = {}
         # Clients whose disconnect arrived while their session was still being built: viser runs
         # sync callbacks on a thread pool, so the disconnect handler may run before (or while)
@@ -137,11 +131,20 @@ class PoinsotApp:
 
     def _build(self, client: viser.ClientHandle, address: str | None) -> None:
         # Not awaited: viser goes on with the socket. A failure is logged, as viser's would be.
-        self.pool.submit(self._connect, client, address).add_done_callback(_log_failure)
+        self.pool.submit(self._connect, client, address).add_done_callback(self._log_failure)
 
     async def _on_disconnect(self, client: viser.ClientHandle) -> None:
         self._disconnect(client)
         self.memory.departed()
+
+    def _log_failure(self, future: Future[None]) -> None:
+        """A session's build that raised: an error, unless the server was stopping (the build
+        then meets a closed event loop, and nobody is left to serve)."""
+        exc = future.exception() if not future.cancelled() else None
+        if exc is not None and self._stopping.is_set():
+            log.debug("a session being built as the server stopped: %r", exc)
+        elif exc is not None:
+            log.error("a session could not be built", exc_info=exc)
 
     def _connect(self, client: viser.ClientHandle, address: str | None = None) -> None:
         """Build the session outside the lock (30-300 ms), then register and start it under
@@ -152,6 +155,8 @@ class PoinsotApp:
                 self._departed.discard(client.client_id)
                 self.discarded += 1
                 return
+        if self._stopping.is_set():
+            return
         link = links.opening(address, self.preset, self.scene, (self.port, self.landing_port))
         session = Session(
             client,
@@ -164,7 +169,9 @@ class PoinsotApp:
         )
         links.apply(session, link)
         with self._connected:
-            if client.client_id in self._departed:
+            if self._stopping.is_set():
+                left = True
+            elif client.client_id in self._departed:
                 self._departed.discard(client.client_id)
                 self.discarded += 1
                 left = True
@@ -198,6 +205,7 @@ class PoinsotApp:
             return len(self._departed)
 
     def stop(self) -> None:
+        self._stopping.set()
         self.backlog.stop()
         self.memory.stop()
         for session in self.sessions().values():

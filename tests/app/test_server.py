@@ -469,3 +469,41 @@ def test_a_body_built_for_an_older_value_leaves_the_slider_where_the_browser_mov
     assert slider.value == pytest.approx(second)
     assert shown == [pytest.approx(second)]
     assert not any(v == pytest.approx(first) for v in sent_back), sent_back
+
+
+def test_a_session_still_being_built_when_the_server_stops_logs_no_error(
+    make_app, make_probe, caplog, monkeypatch
+):
+    """A browser connects, and the server stops while its session is being built: the build
+    meets viser's closed event loop, and nothing is logged as an error; no session starts."""
+    import logging
+    import threading
+
+    from poinsot.app.live import server as server_module
+
+    caplog.set_level(logging.DEBUG, logger=server_module.__name__)
+    app = make_app()
+    opening = server_module.links.opening
+    building, release, done = threading.Event(), threading.Event(), threading.Event()
+
+    def held(*args, **kwargs):
+        building.set()
+        release.wait(30)
+        return opening(*args, **kwargs)
+
+    log_failure = app._log_failure
+
+    def logged(future) -> None:  # the build's end, on the pool's thread
+        log_failure(future)
+        done.set()
+
+    monkeypatch.setattr(server_module.links, "opening", held)
+    monkeypatch.setattr(app, "_log_failure", logged)
+    make_probe(app)
+    assert building.wait(20), "no session was being built"
+    app.stop()
+    release.set()
+    assert done.wait(20), "the build never ended"
+    errors = [r for r in caplog.records if r.levelno >= logging.ERROR]
+    assert errors == [], [r.getMessage() for r in errors]
+    assert app.sessions() == {}
