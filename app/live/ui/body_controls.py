@@ -3,8 +3,9 @@ parameter D with its marks, the side of the separatrix and the pole, and |ω₀|
 
 Each control edits the session's desired :class:`~poinsot.app.parameters.Parameters` through
 ``edit`` (it only queues), and :meth:`BodyControls.show` mirrors a built body's parameters back
-into the sliders (ranges, marks, values). The panel (:mod:`.panel`) declares which of these
-groups a preset shows.
+into the sliders (ranges, marks, values), but no value into a slider whose newer value from the
+browser is still on its way to the parameters (:meth:`~.widgets.Sent.newer_than`). The panel
+(:mod:`.panel`) declares which of these groups a preset shows.
 """
 
 from __future__ import annotations
@@ -191,6 +192,6 @@ class BodyControls:
         sent = self._sent.get(key)
         if sent is not None:
             applied_sent, applied = self._applied.get(key, (sent, 0))
-            if sent.count > (applied if applied_sent is sent else 0):
+            if sent.newer_than(applied if applied_sent is sent else 0):
                 return
         set_value(slider, value)
