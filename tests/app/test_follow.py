@@ -393,3 +393,26 @@ def test_a_dead_lead_worker_leaves_its_followers_the_last_state():
         assert hub.gone == ENDED and hub.state == state and hub.now() == 1.5
     finally:
         relay.stop()
+
+
+def test_a_playing_lead_publishes_its_clock_at_the_state_s_own_instant(poinsot_app, make_probe):
+    """A follower extrapolates the lead's time from a state's ``t`` and ``at``: they must be
+    the lead's clock at ``at`` exactly, else every state looks like a jump of the lead's to
+    the next frame, and is published again at once (followers resynchronised every frame)."""
+    lead = _ready(make_probe(poinsot_app))
+    session = session_of(poinsot_app)
+    hub = session.follow.hub
+    published: list[LeadState] = []
+    publish = hub.publish
+
+    def recorded(controls: Any, state: LeadState) -> bool:
+        published.append(state)
+        return publish(controls, state)
+
+    hub.publish = recorded  # type: ignore[method-assign]
+    _lead(lead, poinsot_app.follow.code)
+    assert wait_until(lambda: len(published) >= 4, 30)
+    clock = session.clock
+    playing = [s for s in published if not s.paused and s.speed == clock.speed]
+    assert len(playing) >= 3
+    assert [s.t for s in playing] == pytest.approx([clock.at(s.at) for s in playing], abs=1e-12)

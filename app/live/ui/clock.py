@@ -24,6 +24,13 @@ class SimClock:
         with self._lock:
             return self._now_locked()
 
+    def at(self, wall: float) -> float:
+        """Simulation time at monotonic time ``wall`` (the clock's own monotonic clock)."""
+        with self._lock:
+            if self._paused:
+                return self._t_anchor
+            return self._t_anchor + self._speed * (wall - self._wall_anchor)
+
     def _now_locked(self) -> float:
         if self._paused:
             return self._t_anchor

@@ -279,7 +279,9 @@ class LeadControls:
         session = self.session
         clock, frame, scene = session.clock, session.frame, session.scene
         # Paused: the time of the frame on screen, which the followers then show exactly.
-        t = frame.t if clock.paused and frame is not None else clock.now()
+        # Playing: the time at ``now``, the state's own instant (read a little later, the
+        # clock's time would look like a jump of the lead's and be published again at once).
+        t = frame.t if clock.paused and frame is not None else clock.at(now)
         return LeadState(
             leader=token,
             query=motion_query(links.query_of(session)),
