@@ -10,7 +10,14 @@ import warnings
 import viser
 from conftest import record_messages, session_of, wait_until
 
-from poinsot.app.live.hardening.pacing import MAX_IN_FLIGHT, MAX_UNACKED, MIN_FPS, Pacer
+from poinsot.app.live.hardening.pacing import (
+    MAX_IN_FLIGHT,
+    MAX_UNACKED,
+    MIN_FPS,
+    RETRY,
+    Pacer,
+)
+from poinsot.app.live.ui.frame_loop import next_due
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import DEFAULT_PRESET
 from poinsot.app.scene.construction import TRAIL_EVERY, PoinsotScene
@@ -223,3 +230,35 @@ def test_a_stalled_client_gets_fewer_frames_and_a_bounded_queue(poinsot_app, mak
     assert slow_session.pacer.stats.skipped > skipped  # its loop goes on, skipping
     assert slow_session.pacer.fps < slow_session.max_fps
     assert most_pending <= 16 * (MAX_IN_FLIGHT + 1)  # a few frames' messages, never more
+
+
+def test_a_frame_taken_just_late_is_retried_soon_and_the_rate_kept():
+    """The frame before not yet taken when the next is due: the next is retried after a
+    fraction (RETRY) of a frame, at the same rate; not taken by then either, the rate halves."""
+    outbox = FakeOutbox()
+    pacer = Pacer(outbox, max_fps=32.0)  # type: ignore[arg-type]
+    assert outbox.frame(pacer)
+    assert pacer.interval == 1.0 / 32.0
+    assert not outbox.frame(pacer)  # not taken yet
+    assert pacer.fps == 32.0 and pacer.interval == RETRY / 32.0
+    outbox.taken = outbox.queued  # taken meanwhile: the retry draws, on the usual interval
+    assert outbox.frame(pacer)
+    assert pacer.fps == 32.0 and pacer.interval == 1.0 / 32.0
+    assert not outbox.frame(pacer)
+    assert not outbox.frame(pacer)  # not taken by the retry either: the client is behind
+    assert pacer.fps == 16.0 and pacer.interval == 1.0 / 16.0
+    assert pacer.stats.skipped == 3 and pacer.stats.drawn == 2
+
+
+def test_frames_are_due_on_a_cadence_and_never_in_a_burst():
+    step = 0.03
+    assert next_due(1.0, 1.0, step) == 1.0 + step  # on time
+    assert next_due(1.0, 1.01, step) == 1.0 + step  # late: the next one is sooner
+    assert next_due(1.0, 1.02, step) == 1.02 + 0.5 * step  # but half a step after it
+    assert next_due(1.0, 1.05, step) == 1.05 + step  # a whole step late: from now
+    due, drawn = 0.0, []
+    for now in (0.0, 0.041, 0.061, 0.09, 0.12):  # the second frame 11 ms late
+        if now >= due:
+            drawn.append(now)
+            due = next_due(due, now, step)
+    assert drawn == [0.0, 0.041, 0.061, 0.09, 0.12]  # five frames in 0.12 s, as at 1/step

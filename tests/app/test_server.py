@@ -174,17 +174,18 @@ def test_per_frame_only_poses_and_trail_increments_are_sent(poinsot_app, probe):
 
 
 def test_the_loop_runs_at_most_60_hz(poinsot_app, probe):
-    """The frame thread draws a frame only once its interval (1/60 s at most, by the pacer)
-    has passed since the frame before, by its own clock: the gaps between the times it hands
-    to the frames it draws are never shorter (a loaded machine only makes them longer; the
-    rate itself is ``poinsot benchmark``'s "frames per second per client"). And it animates:
-    60 more frames arrive."""
+    """Frames are due on a cadence of the pacer's interval (1/60 s at most), by the frame
+    thread's own clock: 60 frames span more than 59 intervals, and a frame drawn late is
+    followed by one at least half an interval later, never by a burst (a loaded machine only
+    makes the gaps longer; the rate itself is ``poinsot benchmark``'s "frames per second per
+    client"). And it animates: 60 more frames arrive."""
     session = session_of(poinsot_app)
     drawn_at = record_frame_times(session)
     assert wait_until(lambda: len(drawn_at) > 60, 30), len(drawn_at)
     assert session.pacer.interval >= 1.0 / MAX_FPS
-    gaps = np.diff(drawn_at[:60])
-    assert gaps.min() >= (1.0 / MAX_FPS) * (1 - 1e-9), gaps.min()
+    gaps = np.diff(drawn_at[:61])
+    assert gaps.sum() > 59 / MAX_FPS, gaps.sum()
+    assert gaps.min() >= (0.5 / MAX_FPS) * (1 - 1e-9), gaps.min()
 
 
 def test_the_loop_stops_when_the_client_leaves(poinsot_app, make_probe):

@@ -1,6 +1,8 @@
 """One session's frame thread: it wakes at its client's frame time (or when an action is
 posted), runs the session's queued work, and draws a frame if the browser has taken the one
-before (:class:`~..hardening.pacing.Pacer`).
+before (:class:`~..hardening.pacing.Pacer`). Frames are due on a cadence (:func:`next_due`): a
+frame drawn late shortens the wait for the next, so that the rate is the pacer's, not the
+pacer's less the frames' own delays.
 
 While another session rebuilds, a due frame waits for that rebuild to end
 (:meth:`~..hardening.budget.RebuildGate.hold` wakes it) for at most :data:`HOLD_SECONDS`, so that a
@@ -19,6 +21,17 @@ from poinsot.app.live.hardening.pacing import Pacer, SessionStats
 #: While another session rebuilds, a due frame is held until the rebuild ends, for at most
 #: HOLD_SECONDS [s].
 HOLD_SECONDS = 0.05
+
+
+def next_due(due: float, now: float, step: float) -> float:
+    """When the frame after one due at ``due`` and drawn at ``now`` is due, ``step`` [s]
+    apart: on the cadence (a frame drawn a little late, after a rebuild or a wait for the
+    interpreter, is followed by one a little early, so the rate holds), but never sooner than
+    half a step after it, and from ``now`` if it was a whole step late (never a burst of
+    frames to catch up). Always at least ``step`` after ``due``."""
+    if now - due >= step:
+        return now + step
+    return max(due + step, now + 0.5 * step)
 
 
 class FrameLoop:
@@ -89,7 +102,11 @@ class FrameLoop:
                 elif now >= next_frame:
                     held = False
                     drawn = self._draw(now)
-                    next_frame = due = now + self.pacer.interval
+                    step = self.pacer.interval
+                    if drawn:
+                        next_frame = due = next_due(due, now, step)
+                    else:  # not taken yet: the pacer's retry, or its slower poll
+                        next_frame = now + step
             except Exception as exc:  # the loop must survive anything; the user sees it
                 self._report(exc)
                 next_frame = time.monotonic() + 1.0 / self.max_fps
