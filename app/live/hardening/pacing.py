@@ -58,9 +58,12 @@ MIN_FPS = 2.0
 RAISE = 1.25
 #: A first skip is retried after this fraction of the client's frame interval.
 RETRY = 0.25
-#: Frames a second one process shares among its browsers [frames/s], and the least each gets.
+#: Frames a second one process shares among its browsers [frames/s], and the least each gets:
+#: a smooth 30 with room for the frames a slider move costs (a class of 30 followers per
+#: process lose about two each while their bodies are rebuilt; at 32 a lecturer moving a
+#: slider every second left the slowest of 60 followers at 28-29 frames a second).
 PROCESS_FRAMES = 540.0
-SHARED_MIN_FPS = 32.0
+SHARED_MIN_FPS = 35.0
 
 
 def frame_share(max_fps: float, browsers: int) -> float:
