@@ -92,11 +92,10 @@ class _SetOnItsLoop(asyncio.Event):
     owner: asyncio.AbstractEventLoop | None = None
 
     def set(self) -> None:
-        try:
-            running = asyncio.get_running_loop()
-        except RuntimeError:  # not on a loop: another thread
-            return
-        if running is self.owner:
+        # asyncio's own test of the running loop (None on another thread), without the
+        # exception of get_running_loop(): this runs for every message pushed.
+        running = asyncio._get_running_loop()
+        if running is not None and running is self.owner:
             super().set()
 
 

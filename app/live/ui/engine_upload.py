@@ -55,7 +55,7 @@ class EngineLogUpload:
         )
         self.answer = gui.add_markdown("", order=order + 0.2)
         self._lock = threading.Lock()
-        self._text = ""
+        self._text = self._shown = ""
         self._ticket = 0
         #: Logs judged or refused; tests wait on it.
         self.finished = 0
@@ -92,10 +92,11 @@ class EngineLogUpload:
             self.finished += 1
 
     def on_frame(self) -> None:
-        """The frame thread: mirror the latest answer into the panel."""
-        with self._lock:
-            text = self._text
-        if self.answer.content != text:
+        """The frame thread: mirror the latest answer into the panel (the usual frame: one
+        comparison; the answer is a new string whenever it changes)."""
+        text = self._text  # one reference, read whole
+        if text is not self._shown:
+            self._shown = text
             self.answer.content = text
 
 
