@@ -14,7 +14,6 @@ from poinsot.app.live.hardening.pacing import (
     MAX_IN_FLIGHT,
     MAX_UNACKED,
     MIN_FPS,
-    RETRY,
     Pacer,
 )
 from poinsot.app.live.ui.frame_loop import next_due
@@ -230,24 +229,6 @@ def test_a_stalled_client_gets_fewer_frames_and_a_bounded_queue(poinsot_app, mak
     assert slow_session.pacer.stats.skipped > skipped  # its loop goes on, skipping
     assert slow_session.pacer.fps < slow_session.max_fps
     assert most_pending <= 16 * (MAX_IN_FLIGHT + 1)  # a few frames' messages, never more
-
-
-def test_a_frame_taken_just_late_is_retried_soon_and_the_rate_kept():
-    """The frame before not yet taken when the next is due: the next is retried after a
-    fraction (RETRY) of a frame, at the same rate; not taken by then either, the rate halves."""
-    outbox = FakeOutbox()
-    pacer = Pacer(outbox, max_fps=32.0)  # type: ignore[arg-type]
-    assert outbox.frame(pacer)
-    assert pacer.interval == 1.0 / 32.0
-    assert not outbox.frame(pacer)  # not taken yet
-    assert pacer.fps == 32.0 and pacer.interval == RETRY / 32.0
-    outbox.taken = outbox.queued  # taken meanwhile: the retry draws, on the usual interval
-    assert outbox.frame(pacer)
-    assert pacer.fps == 32.0 and pacer.interval == 1.0 / 32.0
-    assert not outbox.frame(pacer)
-    assert not outbox.frame(pacer)  # not taken by the retry either: the client is behind
-    assert pacer.fps == 16.0 and pacer.interval == 1.0 / 16.0
-    assert pacer.stats.skipped == 3 and pacer.stats.drawn == 2
 
 
 def test_frames_are_due_on_a_cadence_and_never_in_a_burst():

@@ -16,10 +16,10 @@ client (the transport's buffer plus the socket's ``SIOCOUTQ``).
 last message id (:meth:`Pacer.sent`); before the next it asks how many frames are still
 queued (:meth:`Pacer.may_draw`): with more than MAX_IN_FLIGHT, or more than MAX_UNACKED bytes
 not acknowledged, the frame is skipped (the time
-shown jumps forward at the next one; the traces are filled from the exact solution). A first
-skip is retried a fraction of a frame later (:data:`RETRY`: the frame before is usually only
-just late, taken a few milliseconds after the next was due); a second in a row halves the
-client's rate. A frame taken on time lets the rate climb back to ``max_fps``. A
+shown jumps forward at the next one; the traces are filled from the exact solution) and the
+client's rate is halved (retrying a quarter of a frame later instead, without halving, kept
+the event loop of a crowded process busier: ten browsers' slider-to-redraw p95 rose by half);
+a frame taken on time lets the rate climb back to ``max_fps``. A
 client that reads nothing gets no new frames, so its queue holds at most MAX_IN_FLIGHT + 1 frames
 however long it stalls, while the other sessions (each its own thread and queue) go on.
 
@@ -54,10 +54,8 @@ MAX_IN_FLIGHT = 0
 MAX_UNACKED = 32 * 1024
 #: The slowest rate a stalled client is polled at [frames per second]: it costs one check.
 MIN_FPS = 2.0
-#: A frame taken on time raises the rate by this factor (a second skip in a row halves it).
+#: A frame taken on time raises the rate by this factor (a skip halves it).
 RAISE = 1.25
-#: A first skip is retried after this fraction of the client's frame interval.
-RETRY = 0.25
 #: Frames a second one process shares among its browsers [frames/s], and the least each gets:
 #: a smooth 30 with room for the frames a slider move costs (a class of 30 followers per
 #: process lose about two each while their bodies are rebuilt; at 32 a lecturer moving a
@@ -161,13 +159,11 @@ class Pacer:
         self.fps = self.max_fps
         self.stats = PacerStats()
         self._marks: collections.deque[int] = collections.deque()
-        self._skips = 0  # skips in a row since the last frame drawn
 
     @property
     def interval(self) -> float:
-        """Seconds to the next attempt: a frame at the client's current rate, or a first
-        skip's retry (:data:`RETRY`)."""
-        return (RETRY if self._skips == 1 else 1.0) / self.fps
+        """Seconds to the next frame at the client's current rate."""
+        return 1.0 / self.fps
 
     def in_flight(self) -> int:
         """Frames drawn whose messages the client has not all taken yet."""
@@ -187,12 +183,9 @@ class Pacer:
         queued = self.in_flight()
         self.stats.max_in_flight = max(self.stats.max_in_flight, queued)
         if queued > self.max_in_flight or self.outbox.unacknowledged() > self.max_unacked:
-            self._skips += 1
-            if self._skips > 1:  # not taken by the retry either: the client is behind
-                self.fps = max(self.min_fps, 0.5 * self.fps)
+            self.fps = max(self.min_fps, 0.5 * self.fps)
             self.stats.skipped += 1
             return False
-        self._skips = 0
         if queued <= 1:
             self.fps = min(self.max_fps, RAISE * self.fps)
         return True

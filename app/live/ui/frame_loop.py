@@ -105,7 +105,7 @@ class FrameLoop:
                     step = self.pacer.interval
                     if drawn:
                         next_frame = due = next_due(due, now, step)
-                    else:  # not taken yet: the pacer's retry, or its slower poll
+                    else:  # not taken yet: polled again at the pacer's lowered rate
                         next_frame = now + step
             except Exception as exc:  # the loop must survive anything; the user sees it
                 self._report(exc)
