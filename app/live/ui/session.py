@@ -271,8 +271,6 @@ class Session:
     def _work(self) -> None:
         """Before each frame: the queued actions, then a rebuild if they asked for one (none
         once the client has left: what they would send goes to nobody)."""
-        if not len(self.actions) and not self.build.dirty:
-            return  # the usual frame: nothing queued
         outbox = self.pacer.outbox
         if outbox.closed():
             return
