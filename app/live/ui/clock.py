@@ -27,14 +27,15 @@ class SimClock:
     def at(self, wall: float) -> float:
         """Simulation time at monotonic time ``wall`` (the clock's own monotonic clock)."""
         with self._lock:
-            if self._paused:
-                return self._t_anchor
-            return self._t_anchor + self._speed * (wall - self._wall_anchor)
+            return self._at_locked(wall)
 
     def _now_locked(self) -> float:
+        return self._at_locked(self._monotonic())
+
+    def _at_locked(self, wall: float) -> float:
         if self._paused:
             return self._t_anchor
-        return self._t_anchor + self._speed * (self._monotonic() - self._wall_anchor)
+        return self._t_anchor + self._speed * (wall - self._wall_anchor)
 
     def _reanchor_locked(self) -> None:
         self._t_anchor = self._now_locked()
