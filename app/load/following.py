@@ -46,6 +46,15 @@ def _press(probe: Probe, label: str, value: Any = True) -> None:
     probe.set_value(probe.widget(label)[0], value)
 
 
+def _why(probe: Probe, since: float) -> str:
+    """What a client that never saw its answer had seen, ``since`` a monotonic time."""
+    waited = f"after {time.monotonic() - since:.1f} s"
+    if probe.closed:
+        return f"{waited}, its connection closed by the server (code {probe.close_code})"
+    said = [str(w.props.get("_markdown", "")) for w in probe.widgets.values()]
+    return f"{waited}, its messages: {[s for s in said if s][-3:]}"
+
+
 def _connect(port: int, code: str, count: int, deadline: float) -> tuple[Probe, list[Probe]]:
     from poinsot.app.live.hardening.probe import Probe
     from poinsot.app.live.landing import resolve
@@ -58,13 +67,14 @@ def _connect(port: int, code: str, count: int, deadline: float) -> tuple[Probe, 
     lead, *followers = probes
     _press(lead, "Lecturer code", code)
     _press(lead, "Lead this class")
+    asked = time.monotonic()
     if not lead.wait_for(lambda p: _says(p, "You lead this class"), SCENE_TIMEOUT):
-        raise RuntimeError("the lead was refused")
+        raise RuntimeError(f"the lead was refused ({_why(lead, asked)})")
     for probe in followers:
         _press(probe, FOLLOW_LABEL)
     for probe in followers:
         if not probe.wait_for(lambda p: _says(p, "Following the lecturer"), SCENE_TIMEOUT):
-            raise RuntimeError("a follower never followed")
+            raise RuntimeError(f"a follower never followed ({_why(probe, asked)})")
     return lead, followers
 
 

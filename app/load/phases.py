@@ -51,6 +51,8 @@ def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:
     except Exception as exc:
         failure = f"failed: {type(exc).__name__}: {exc}"
         report.add(Figure(name, "completed", 0.0, failure, COMPLETES))
+        report.notes.append(f"{name} failed; the server log's last lines:")
+        report.notes.extend(f"    {line[:200]}" for line in server.log_tail(8))
     finally:
         server_cpu = _cpu_seconds(pids) - server_cpu
         report.add(_machine(name, machine, load, server_cpu, time.monotonic() - started))

@@ -166,5 +166,12 @@ class ServerProcess(Child):
         except OSError:
             return []
 
+    def log_tail(self, count: int) -> list[str]:
+        """The last ``count`` lines of the server's log (warnings included)."""
+        try:
+            return self.log_path.read_text(errors="replace").splitlines()[-count:]
+        except OSError:
+            return []
+
     def remove_log(self) -> None:
         self.log_path.unlink(missing_ok=True)

@@ -77,7 +77,7 @@ def follow_report() -> Report:
 @pytest.mark.slow
 def test_every_phase_completes_and_reads_its_server_log(report):
     failures = [f"{f.phase}: {f.text}" for f in report.figures if f.name == "completed"]
-    assert not failures, failures
+    assert not failures, (failures, report.notes)
     for phase in PHASES:
         errors = report.figure(phase, "server log errors")
         assert errors.value >= 0 and (errors.goal is not None) == (phase == "soak")
@@ -158,7 +158,7 @@ def test_follow_phase_measures_followers_and_their_cost(follow_report):
     slider moves reach every follower, and the CPU per frame is measured both ways."""
     report = follow_report
     failures = [f.text for f in report.figures if f.name == "completed"]
-    assert not failures, failures
+    assert not failures, (failures, report.notes)
     assert report.figure("follow", "3 followers: fps each").value > 0
     moves = report.figure("follow", "3 followers: lead's slider move").detail
     assert moves["moves"] >= 2 and moves["lost"] == 0 and moves["redraws"] == 3 * moves["moves"]
