@@ -31,6 +31,10 @@ MIN_COLOUR_PIXELS = 12
 #: renders the same picture twice, pixel for pixel; a short trace, such as a path that has
 #: played 60 frames, changes 150 to 250 pixels).
 MIN_PART_CHANGE = 60 / (WIDTH * HEIGHT)
+#: Scenes played from a fraction of their table's span: Explorer 1 half-way to its flat spin,
+#: where ω stands apart from the satellite and from L (early on, ω lies along the satellite's
+#: axis, inside the cylinder; in the flat spin, along L: hiding it changes almost no pixel).
+PLAY_FROM = {"explorer-1": 0.5}
 
 
 def render_once(session) -> np.ndarray:
@@ -80,6 +84,10 @@ def show(page, session, spec: SceneSpec, before: SceneSpec | None) -> None:
         assert wait_until(lambda la=label: page.control_count(la) == 1, 20), (spec.name, label)
     for label in old - labels:
         assert wait_until(lambda la=label: page.control_count(la) == 0, 20), (spec.name, label)
+    if spec.name in PLAY_FROM:
+        session.clock.reset(
+            PLAY_FROM[spec.name] * session.showcase.showcase.drawing.player.table.span
+        )
     session.clock.paused = False
     frames = session.stats.frames
     assert wait_until(lambda: session.stats.frames > frames + 60, 30), "not animating"
