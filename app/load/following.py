@@ -51,7 +51,8 @@ def _why(probe: Probe, since: float) -> str:
     waited = f"after {time.monotonic() - since:.1f} s"
     if probe.closed:
         return f"{waited}, its connection closed by the server (code {probe.close_code})"
-    said = [str(w.props.get("_markdown", "")) for w in probe.widgets.values()]
+    _, widgets = probe.snapshot()  # the reading thread may be adding widgets meanwhile
+    said = [str(w.props.get("_markdown", "")) for w in widgets.values()]
     return f"{waited}, its messages: {[s for s in said if s][-3:]}"
 
 
@@ -72,6 +73,7 @@ def _connect(port: int, code: str, count: int, deadline: float) -> tuple[Probe, 
         raise RuntimeError(f"the lead was refused ({_why(lead, asked)})")
     for probe in followers:
         _press(probe, FOLLOW_LABEL)
+    asked = time.monotonic()
     for probe in followers:
         if not probe.wait_for(lambda p: _says(p, "Following the lecturer"), SCENE_TIMEOUT):
             raise RuntimeError(f"a follower never followed ({_why(probe, asked)})")
