@@ -135,7 +135,11 @@ def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(
     # the body itself): a value that arrives before is clamped into the junk's range.
     d_range = pytest.approx(Parameters.from_preset(DEFAULT_PRESET).D_range)
     assert wait_until(lambda: (energy.min, energy.max) == d_range, 15), (energy.min, energy.max)
-    assert probe.wait_for(lambda p: p.widgets[d_uuid].props["max"] > p.widgets[d_uuid].props["min"])
+    # ... and the probe's once that range has reached it (the target is computed from it: from
+    # a range not yet updated, the target could lie outside the new one and be clamped).
+    assert probe.wait_for(
+        lambda p: (p.widgets[d_uuid].props["min"], p.widgets[d_uuid].props["max"]) == d_range
+    ), (probe.widgets[d_uuid].props["min"], probe.widgets[d_uuid].props["max"])
     d = probe.widgets[d_uuid]
     target = round(0.3 * d.props["min"] + 0.7 * d.props["max"], 2)
     probe.set_value(d_uuid, target)
