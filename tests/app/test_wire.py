@@ -125,6 +125,12 @@ def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(
     assert wait_until(lambda: session.scene.trail_points == 1234, 15)
     for handle in (session.panel.preset, session.panel.widgets.speed):
         assert handle.value == checked(handle, handle.value)
+    # ... and the body they asked for is shown (the rebuild runs after the callbacks: until it
+    # is done, the parameters and the D slider's range are still the first preset's, so the
+    # checks below would pass at once, and the D sent would meet the junk body's range).
+    build = session.choice.build
+    assert wait_until(lambda: session.params == build.desired and not build.dirty, 15)
+    after_frames(session, 2)
     # then valid edits: a preset (the junk made a sphere of the moments), and D
     preset_uuid, _ = probe.widget("Preset")
     probe.set_value(preset_uuid, DEFAULT_PRESET.label)
