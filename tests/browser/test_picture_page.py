@@ -662,6 +662,14 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
         ),
         20,
     ), (view, camera_handle.position, camera_handle.look_at)
+    # ... and reports the canvas's size (a page just opened reports it again as its columns
+    # dock): the layout's pixels are those of the camera reported.
+    canvas = page.canvas_box()
+    assert wait_until(
+        lambda: (camera_handle.image_width, camera_handle.image_height)
+        == (round(canvas["width"]), round(canvas["height"])),
+        20,
+    ), (camera_handle.image_width, camera_handle.image_height, canvas)
     lay_out_on_the_frame_thread(session)
     page.page.wait_for_timeout(800)
     shown = settled_screenshot(page)
