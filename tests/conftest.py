@@ -91,6 +91,10 @@ BROWSER_ELSEWHERE = frozenset(
 #: file that is not listed joins :data:`BROWSER_LAST_GROUP`; more groups are one entry each here.
 BROWSER_GROUPS: dict[str, str] = {}
 BROWSER_LAST_GROUP = "browser-1"
+#: Browser files that share no browser: their tests run the command line, which starts a
+#: Chromium of its own in a process of its own. Each is a group of its own, off the browser
+#: group's worker (whose tests are the suite's long pole), run once a worker is free.
+BROWSER_APART = frozenset({"tests/browser/test_video.py", "tests/browser/test_exports_cli.py"})
 #: Groups that take a minute or more without a browser: they start right after the browser
 #: groups (a long group started last would be the suite's long pole).
 LONG_GROUPS = (
@@ -114,6 +118,8 @@ def xdist_group(nodeid: str) -> str:
     other module in its own (its fixtures are built once). From the node id alone: xdist's
     controller collects nothing."""
     path = nodeid.split("::")[0]
+    if path in BROWSER_APART:
+        return path
     if path.startswith("tests/browser/") or nodeid.split("[")[0] in BROWSER_ELSEWHERE:
         return BROWSER_GROUPS.get(path, BROWSER_LAST_GROUP)
     if path.startswith("tests/report/"):
@@ -157,8 +163,11 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.browser)
         if fixtures & SERVER_FIXTURES:
             item.add_marker(pytest.mark.server)
-        if item.get_closest_marker("browser") and not xdist_group(item.nodeid).startswith(
-            "browser-"
+        group = xdist_group(item.nodeid)
+        if (
+            item.get_closest_marker("browser")
+            and not group.startswith("browser-")
+            and group not in BROWSER_APART
         ):
             raise pytest.UsageError(f"{item.nodeid} drives a browser: add it to BROWSER_ELSEWHERE")
     items.sort(key=lambda item: group_rank(item.nodeid))

@@ -666,8 +666,10 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     # dock): the layout's pixels are those of the camera reported.
     canvas = page.canvas_box()
     assert wait_until(
-        lambda: (camera_handle.image_width, camera_handle.image_height)
-        == (round(canvas["width"]), round(canvas["height"])),
+        lambda: (
+            (camera_handle.image_width, camera_handle.image_height)
+            == (round(canvas["width"]), round(canvas["height"]))
+        ),
         20,
     ), (camera_handle.image_width, camera_handle.image_height, canvas)
     lay_out_on_the_frame_thread(session)
