@@ -91,10 +91,17 @@ BROWSER_ELSEWHERE = frozenset(
 #: file that is not listed joins :data:`BROWSER_LAST_GROUP`; more groups are one entry each here.
 BROWSER_GROUPS: dict[str, str] = {}
 BROWSER_LAST_GROUP = "browser-1"
-#: Browser files that share no browser: their tests run the command line, which starts a
-#: Chromium of its own in a process of its own. Each is a group of its own, off the browser
-#: group's worker (whose tests are the suite's long pole), run once a worker is free.
-BROWSER_APART = frozenset({"tests/browser/test_video.py", "tests/browser/test_exports_cli.py"})
+#: Browser files that share no browser: their tests start a Chromium of their own (the
+#: command line's, in a process of its own, or one under strace). Each is a group of its own,
+#: off the browser group's worker (whose tests are the suite's long pole), run once a worker
+#: is free.
+BROWSER_APART = frozenset(
+    {
+        "tests/browser/test_video.py",
+        "tests/browser/test_exports_cli.py",
+        "tests/browser/test_loopback.py",
+    }
+)
 #: Groups that take a minute or more without a browser: they start right after the browser
 #: groups (a long group started last would be the suite's long pole).
 LONG_GROUPS = (
