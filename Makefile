@@ -46,13 +46,12 @@ run: install
 
 # The suite on JOBS pytest-xdist workers. tests/conftest.py groups the tests (--dist loadgroup,
 # xdist_group): the real-browser tests in one group (one worker with its own Chromium, started
-# first, as it is the longest; more Chromiums on two cores made browser tests flaky), but for
-# the files whose tests run the command line's own Chromium (a group each, run once a worker is
-# free), tests/report/ in one, every other module in its own. Most of a test's time is waiting (on a
-# browser, a server, a child process), so there are more workers than cores. Then the few `serial` tests, alone (they measure what the machine
-# gives them). Both stages always run.
-# The serial stage collects only the files that hold a `serial` test (collecting the whole suite
-# costs seconds of the stage).
+# first, as it is the longest; more Chromiums on two cores made browser tests flaky), but for the
+# files whose tests start a Chromium of their own (a group each, run once a worker is free);
+# tests/report/ in one; every other module in its own. Most of a test's time is waiting (on a
+# browser, a server, a child process), so there are more workers than cores. Then the few
+# `serial` tests, alone (they measure what the machine gives them), collected from the files that
+# hold one only (collecting the whole suite costs seconds). Both stages always run.
 JOBS ?= 4
 SERIAL_FILES = $(shell grep -rl --include='test_*.py' 'mark.serial' tests)
 test: install-test chromium
