@@ -45,9 +45,10 @@ run: install
 	$(VENV)/bin/poinsot serve --host $(HOST) --port $(PORT)
 
 # The suite on JOBS pytest-xdist workers. tests/conftest.py groups the tests (--dist loadgroup,
-# xdist_group): the real-browser tests in one group (one worker with its own Chromium, started
-# first, as it is the longest; more Chromiums on two cores made browser tests flaky), but for the
-# files whose tests start a Chromium of their own (a group each, run once a worker is free);
+# xdist_group): the real-browser tests in two groups (a worker each with its own Chromium,
+# started first, as they are the longest; the second holds the tests that neither type into a
+# slider nor point at the scene), but for the files whose tests start a Chromium of their own
+# (a group each, run once a worker is free);
 # tests/report/ in one; every other module in its own. Most of a test's time is waiting (on a
 # browser, a server, a child process), so there are more workers than cores. Then the few
 # `serial` tests, alone (they measure what the machine gives them), collected from the files that
