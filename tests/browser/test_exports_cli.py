@@ -14,6 +14,7 @@ import sys
 import threading
 import time
 import uuid
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -80,6 +81,26 @@ def cli(*args: str, token: str) -> subprocess.Popen:
     )
 
 
+def killed_midway(
+    proc: subprocess.Popen, token: str, begun: Callable[[], bool] = lambda: True
+) -> None:
+    """SIGTERM to a command once its Chromium runs and ``begun()`` holds: it exits with an
+    error, and no process it started is left."""
+    try:
+        started = wait_until(
+            lambda: any("chrom" in c for c in processes_with(token).values()), 60, poll=0.1
+        )
+        assert started, "chromium never started"
+        assert wait_until(begun, 120, poll=0.1), "the command never began its work"
+        proc.send_signal(signal.SIGTERM)
+        proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode != 0
+    assert wait_until(lambda: not processes_with(token), 15), processes_with(token)
+
+
 def test_cli_screenshot_writes_the_png_and_leaves_no_process(tmp_path):
     chromium_or_fail()
     out = tmp_path / "shot.png"
@@ -134,18 +155,7 @@ def test_cli_screenshot_killed_midway_leaves_no_process(tmp_path):
         str(tmp_path / "never.png"),
         token=token,
     )
-    try:
-        started = wait_until(
-            lambda: any("chrom" in c for c in processes_with(token).values()), 60, poll=0.1
-        )
-        assert started, "chromium never started"
-        proc.send_signal(signal.SIGTERM)
-        proc.communicate(timeout=60)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode != 0
-    assert wait_until(lambda: not processes_with(token), 15), processes_with(token)
+    killed_midway(proc, token)
     assert not (tmp_path / "never.png").exists()
 
 
@@ -165,18 +175,6 @@ def test_cli_video_killed_midway_leaves_no_process_and_no_file(tmp_path):
         str(out),
         token=token,
     )
-    try:
-        # Killed while it films: the progress has begun (its plain lines go to stderr).
-        started = wait_until(
-            lambda: any("chrom" in c for c in processes_with(token).values()), 60, poll=0.1
-        )
-        assert started, "chromium never started"
-        assert wait_until(lambda: out.exists(), 120, poll=0.1), "ffmpeg never began the file"
-        proc.send_signal(signal.SIGTERM)
-        proc.communicate(timeout=60)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode != 0
-    assert wait_until(lambda: not processes_with(token), 15), processes_with(token)
+    # Killed while it films: ffmpeg has begun the file.
+    killed_midway(proc, token, lambda: out.exists())
     assert not out.exists()  # no half-written video left behind
