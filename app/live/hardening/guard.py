@@ -54,6 +54,17 @@ MESSAGE_BURST = 400.0
 EXCESS_SECONDS = 3.0
 #: Websocket close code for a policy violation (RFC 6455, 7.4.1).
 POLICY_VIOLATION = 1008
+#: How long a client closed for a policy violation has to answer the close before its
+#: connection is dropped [s]. websockets waits 10 s by default; a flooding client's answer
+#: waits behind its flood, and its session would stay that long.
+POLICY_CLOSE_SECONDS = 1.0
+
+
+async def _close_for_policy(websocket: Any, reason: str) -> None:
+    """Close ``websocket`` for a policy violation, waiting at most
+    :data:`POLICY_CLOSE_SECONDS` for the client's answer (a websockets connection)."""
+    websocket.close_timeout = POLICY_CLOSE_SECONDS
+    await websocket.close(POLICY_VIOLATION, reason)
 
 
 def normalise_origin(origin: str) -> str:
@@ -349,7 +360,7 @@ class WireGuard:
                     if budget.sustained(now) and not closing:
                         with self._lock:
                             self.disconnected += 1
-                        close = websocket.close(POLICY_VIOLATION, "message budget exceeded")
+                        close = _close_for_policy(websocket, "message budget exceeded")
                         closing.append(asyncio.create_task(close))
                     # Read no faster than the budget refills: the rest waits in the client's
                     # socket (its sends block), costing this process nothing.
@@ -366,6 +377,6 @@ class WireGuard:
                     self.closed_for_message += 1
                 self.gate.say(f"closed {_peer(websocket)}: it sent {verdict}")
                 # The next read raises ConnectionClosed, which ends viser's handler cleanly.
-                await websocket.close(POLICY_VIOLATION, "message not allowed")
+                await _close_for_policy(websocket, "message not allowed")
 
         return recv
