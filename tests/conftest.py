@@ -431,6 +431,24 @@ class BrowserPage:
         renderer's counters for browser tests)."""
         return int(self.page.evaluate(FRAMES_DRAWN_JS))
 
+    def camera_fits_the_canvas(self, client, timeout: float = 20.0) -> FloatRect:
+        """The canvas's box, once the camera this page reports to ``client`` has the canvas's
+        size (a page just opened reports its camera again as its columns dock): what the page
+        draws is then in the reported camera's pixels."""
+        camera = client.camera
+        box = self.canvas_box()
+
+        def fits() -> bool:
+            nonlocal box
+            box = self.canvas_box()
+            return (camera.image_width, camera.image_height) == (
+                round(box["width"]),
+                round(box["height"]),
+            )
+
+        assert wait_until(fits, timeout), (camera.image_width, camera.image_height, box)
+        return box
+
     def canvas_box(self) -> FloatRect:
         box = self.page.locator("canvas").first.bounding_box()
         assert box is not None, "the canvas is not visible"
@@ -472,6 +490,49 @@ NO_LIVE_VIEW_JS = """(() => {
 })();"""
 
 
+#: The most frames a second a test's page draws [frames/s]: the page's pictures are the same,
+#: it draws fewer of them. A live 1280 x 800 view otherwise draws as many as software WebGL
+#: can, 7 to 11 a second at 1.7 to 1.8 cores of Chromium; capped at 5, it takes 1.2. Every
+#: wait on the page's drawing is an event (frames counted, pictures compared), never a time.
+PAGE_MAX_FPS = 5
+
+#: Caps a live page's animation frames at :data:`PAGE_MAX_FPS`: each ``requestAnimationFrame``
+#: callback waits for the first frame at least 1/PAGE_MAX_FPS after the last one let through
+#: (all the callbacks of a frame let through run in it, as they would). A parked page
+#: (:data:`NO_LIVE_VIEW_JS`) is not capped: it draws only the renders asked of it, and viser's
+#: client takes its messages and makes a render over several frames.
+FRAME_CAP_JS = """(() => {
+  const minGap = 1000 / MAX_FPS - 1;
+  const request = window.requestAnimationFrame.bind(window);
+  const cancel = window.cancelAnimationFrame.bind(window);
+  const pending = new Map();  // our id -> the browser's id of the frame it waits for now
+  let nextId = 1, decidedAt = -1, letThrough = true, lastThrough = -Infinity;
+  window.requestAnimationFrame = (callback) => {
+    const id = nextId++;
+    const tick = (time) => {
+      if (time !== decidedAt) {
+        decidedAt = time;
+        letThrough = window.__poinsotParked || time - lastThrough >= minGap;
+        if (letThrough) lastThrough = time;
+      }
+      if (letThrough) {
+        pending.delete(id);
+        callback(time);
+      } else {
+        pending.set(id, request(tick));
+      }
+    };
+    pending.set(id, request(tick));
+    return id;
+  };
+  window.cancelAnimationFrame = (id) => {
+    const frame = pending.get(id);
+    if (frame !== undefined) cancel(frame);
+    pending.delete(id);
+  };
+})();""".replace("MAX_FPS", str(PAGE_MAX_FPS))
+
+
 FRAMES_DRAWN_JS = """() => {
   const points = window.__viserTestpoints;
   return points ? points.rendererInfo.render.frame : 0;
@@ -493,6 +554,7 @@ def _page_opener(chromium) -> Iterator[Callable[..., BrowserPage]]:
         contexts.append(context)
         context.add_init_script(HIDE_SOFTWARE_WEBGL_NOTICE_JS)
         context.add_init_script(NO_LIVE_VIEW_JS % ("false" if live_view else "true"))
+        context.add_init_script(FRAME_CAP_JS)
         page = context.new_page()
         errors: list[str] = []
         page.on(

@@ -594,7 +594,10 @@ def test_two_views_show_the_body_frame_beside_the_space_frame(pages):
     ellipsoid with its polhode, no herpolhode), side by side."""
     page, session = pages.get(1280, 800)
     page.set_live_view(True)
-    started(session, frames=40)
+    # A third of ω's period played (a fresh page's first frames, or the first screen's preset
+    # chosen again, leave a herpolhode too short to count): a ring of a few hundred pixels.
+    session.set_speed(4.0)
+    assert wait_until(lambda: session.frame is not None and session.frame.t > 3.0, 30)
     page.set_checkbox("Two views: space | body", True)
     assert wait_until(lambda: session.lecture.display.body_view is not None, 10)
     pause(page, session)
@@ -664,14 +667,7 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     ), (view, camera_handle.position, camera_handle.look_at)
     # ... and reports the canvas's size (a page just opened reports it again as its columns
     # dock): the layout's pixels are those of the camera reported.
-    canvas = page.canvas_box()
-    assert wait_until(
-        lambda: (
-            (camera_handle.image_width, camera_handle.image_height)
-            == (round(canvas["width"]), round(canvas["height"]))
-        ),
-        20,
-    ), (camera_handle.image_width, camera_handle.image_height, canvas)
+    page.camera_fits_the_canvas(session.client)
     lay_out_on_the_frame_thread(session)
     page.page.wait_for_timeout(800)
     shown = settled_screenshot(page)
