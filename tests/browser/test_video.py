@@ -32,19 +32,19 @@ def filmed(tmp_path_factory) -> dict[str, Path]:
     chromium_or_fail()
     folder = tmp_path_factory.mktemp("video")
     outs = {suffix: folder / f"v{suffix}" for suffix in (".mp4", ".gif")}
-    argv = ["video", "--preset", "t_handle", "--seconds", "4", "--fps", "25"]
+    argv = ["video", "--preset", "t_handle", "--seconds", "2", "--fps", "25"]
     # A process of its own, as a lecturer runs it (this one may already drive Chromium through
     # playwright's sync API, which allows one per thread).
     done = run_command([*argv, "--size", "640x360", "--out", *map(str, outs.values())])
     assert done.returncode == 0, done.stderr
     for out in outs.values():
-        assert f"wrote {out} (640x360, 100 frames at 25 fps" in done.stdout, done.stdout
-    assert "100/100 frames" in done.stderr  # the progress (plain lines: not a terminal)
+        assert f"wrote {out} (640x360, 50 frames at 25 fps" in done.stdout, done.stdout
+    assert "50/50 frames" in done.stderr  # the progress (plain lines: not a terminal)
     return outs
 
 
 def assert_a_moving_scene(frames: np.ndarray) -> None:
-    assert frames.shape[:3] == (100, 360, 640), frames.shape
+    assert frames.shape[:3] == (50, 360, 640), frames.shape
     rgb = frames[..., :3]
     changes = np.array(
         [np.abs(b.astype(np.int16) - a).mean() for a, b in zip(rgb[:-1], rgb[1:], strict=True)]
@@ -57,7 +57,7 @@ def assert_a_moving_scene(frames: np.ndarray) -> None:
     assert 0.1 < drawn.mean() < 0.9, drawn.mean()
 
 
-def test_the_mp4_decodes_to_100_frames_of_640x360_that_change(filmed):
+def test_the_mp4_decodes_to_50_frames_of_640x360_that_change(filmed):
     out = filmed[".mp4"]
     reader = imageio.get_reader(out, format="FFMPEG")
     meta = reader.get_meta_data()
@@ -69,7 +69,7 @@ def test_the_mp4_decodes_to_100_frames_of_640x360_that_change(filmed):
     assert_a_moving_scene(frames)
 
 
-def test_the_gif_decodes_to_100_frames_of_640x360_that_change_and_loops(filmed):
+def test_the_gif_decodes_to_50_frames_of_640x360_that_change_and_loops(filmed):
     out = filmed[".gif"]
     with Image.open(out) as image:
         assert image.info.get("loop") == 0  # forever
