@@ -283,14 +283,15 @@ def film(
     with the body), into ``out`` (.mp4 or .gif; several files: each frame is rendered once and
     encoded into each). ``fit``: narrow a fixed view's field of view so that the construction
     at the start fills the picture. ``progress(done, total)`` is called after each frame;
-    setting ``cancel`` stops before the browser starts, before the first frame or at the next
-    one (Cancelled, no file left)."""
+    setting ``cancel`` stops before the browser starts, before the stage opens, before the
+    first frame or at the next one (Cancelled, no file left)."""
     start = time.perf_counter()
     outs = (out,) if isinstance(out, pathlib.Path) else tuple(out)
     width, height = clip.size
     window = (max(16, round(720 * width / height)), 720)
     _check(cancel, 0, clip.frames)
     with headless_chromium(chromium) as browser:
+        _check(cancel, 0, clip.frames)
         stage = open_stage(lambda server: open_window(browser, server, clip.size, 1.0))
         try:
             shots = _first_shot(stage, clip, view, window, fit)
