@@ -51,6 +51,7 @@ def _status(app: Any) -> dict[str, Any]:
         "session_errors": sum(s.stats.errors for s in sessions.values()),
         "session_threads": kinds.get("poinsot-session", 0),
         "connections": viser_private.connection_count(app.server),
+        "disconnected": app.guard.disconnected,  # cut off for exceeding the message budget
         "threads": dict(kinds),
     }
 

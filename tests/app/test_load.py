@@ -130,7 +130,9 @@ def test_stall_stops_one_client_and_measures_the_others(report):
 def test_flood_sends_and_measures_the_others(report):
     sent = report.figure("flood", "messages sent").detail
     assert 0 < sent["sent"] <= TINY.flood_rate * TINY.flood_seconds + TINY.flood_rate
-    assert report.figure("flood", "server CPU").detail["sessions"] == TINY.clients + 1
+    # Every session is live after the flood, but the flooder's if the server cut it off.
+    after = report.figure("flood", "server CPU").detail
+    assert after["sessions"] == TINY.clients + 1 - after["disconnected"], after
     keep = report.figure("flood", "others' frame rate")
     assert keep.detail["clients"] == 3 and keep.value > 0
     for phase in PHASES:
