@@ -431,10 +431,13 @@ class BrowserPage:
         renderer's counters for browser tests)."""
         return int(self.page.evaluate(FRAMES_DRAWN_JS))
 
-    def camera_fits_the_canvas(self, client, timeout: float = 20.0) -> FloatRect:
-        """The canvas's box, once the camera this page reports to ``client`` has the canvas's
-        size (a page just opened reports its camera again as its columns dock): what the page
-        draws is then in the reported camera's pixels."""
+    def settled_canvas(self, client, timeout: float = 20.0) -> FloatRect:
+        """The canvas's box, once the live view has drawn two more frames (what was sent is on
+        the page) and the camera this page reports to ``client`` has the canvas's size (a page
+        just opened, or whose panels fold, reports its camera again as the canvas changes):
+        what the page draws is then in the reported camera's pixels, where a click lands."""
+        drawn = self.frames_drawn()
+        assert wait_until(lambda: self.frames_drawn() >= drawn + 2, timeout), "no frame drawn"
         camera = client.camera
         box = self.canvas_box()
 

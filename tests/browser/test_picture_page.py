@@ -667,7 +667,7 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     ), (view, camera_handle.position, camera_handle.look_at)
     # ... and reports the canvas's size (a page just opened reports it again as its columns
     # dock): the layout's pixels are those of the camera reported.
-    page.camera_fits_the_canvas(session.client)
+    page.settled_canvas(session.client)
     lay_out_on_the_frame_thread(session)
     page.page.wait_for_timeout(800)
     shown = settled_screenshot(page)

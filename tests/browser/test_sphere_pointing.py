@@ -40,14 +40,12 @@ def test_a_click_on_landaus_sphere_sets_the_start(make_app, open_page) -> None:
     picture = pointer.picture()
     assert picture is not None and session.body is not None
     body, G = session.body, float(np.linalg.norm(session.body.angular_momentum))
-    drawn = page.frames_drawn()  # the sphere is on the page: the click's ray can meet it
-    assert wait_until(lambda: page.frames_drawn() >= drawn + 2, 30)
+    box = page.settled_canvas(session.client)  # the sphere is drawn where the camera says
     camera = session.client.camera
     centre = np.asarray(picture.offset)
     toward = np.asarray(camera.position, float) - centre
     toward /= np.linalg.norm(toward)
     aim = toward + np.array([0.5, 0.0, 0.35])
-    box = page.camera_fits_the_canvas(session.client)
     x, y = _pixel(camera, box, centre + picture.radius * aim / np.linalg.norm(aim))
     page.page.mouse.click(x, y)
     assert wait_until(lambda: session.body is not body, 15), "the click set no start"

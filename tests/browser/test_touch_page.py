@@ -59,7 +59,9 @@ def open_device(open_page, url: str, device: str) -> BrowserPage:
 
 
 def screen_point(session: Session, page: BrowserPage, point: np.ndarray) -> tuple[float, float]:
-    """Where the browser's camera draws the world ``point``, in the page's CSS pixels."""
+    """Where the browser's camera draws the world ``point``, in the page's CSS pixels (once the
+    page's view has settled: see :meth:`BrowserPage.settled_canvas`)."""
+    box = page.settled_canvas(session.client)
     camera = session.client.camera
     position = np.asarray(camera.position, float)
     forward = np.asarray(camera.look_at, float) - position
@@ -70,7 +72,6 @@ def screen_point(session: Session, page: BrowserPage, point: np.ndarray) -> tupl
     q = point - position
     depth = q @ forward
     half = math.tan(camera.fov / 2.0)
-    box = page.canvas_box()
     scale = box["height"] / 2.0 / half
     x = box["x"] + box["width"] / 2.0 + scale * (q @ right) / depth
     y = box["y"] + box["height"] / 2.0 - scale * (q @ up) / depth
