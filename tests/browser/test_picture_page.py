@@ -521,9 +521,10 @@ STALL_JS = "(ms) => { const t = Date.now(); while (Date.now() - t < ms) {} }"
 
 
 def test_sphere_and_custom_alternate_without_console_errors(pages):
-    """Switched back and forth by the dropdown, some switches made while the browser's main
-    thread is blocked for longer than a retired widget's delay (as software WebGL compiling a
-    new scene's shaders does): no update ever reaches a widget the browser no longer has."""
+    """Switched back and forth by the dropdown, some switches made by the server while the
+    browser's main thread is blocked (as software WebGL compiling a new scene's shaders blocks
+    it), so that all of a switch's messages wait for one drain: no update ever reaches a
+    widget the browser no longer has."""
     import threading
 
     page, session = pages.get(1280, 800)
@@ -534,7 +535,7 @@ def test_sphere_and_custom_alternate_without_console_errors(pages):
             if n % 2:  # the server switches while the page is frozen
                 timer = threading.Timer(0.3, lambda p=preset: session.choose_preset(p))
                 timer.start()
-                page.page.evaluate(STALL_JS, 2500)
+                page.page.evaluate(STALL_JS, 1500)  # the switch begins 0.3 s into it
                 timer.join()
             else:
                 page.choose("Preset", preset.label)
@@ -550,7 +551,9 @@ def test_sphere_and_custom_alternate_without_console_errors(pages):
 # (the threshold is 1.6) in two of three full runs; alone it passes.
 @pytest.mark.serial
 def test_projector_mode_folds_the_panels_and_thickens_the_picture(pages):
-    page, session = pages.get(1280, 800)
+    # Two pictures' pixels compared: the canvas's pixel ratio held (viser lowers it while a
+    # page draws few frames a second, as the suite's pages do).
+    page, session = pages.get(1280, 800, "?fixedDpr=1")
     page.set_live_view(True)
     started(session, frames=40)
     pause(page, session)
