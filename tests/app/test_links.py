@@ -65,6 +65,7 @@ def test_a_body_of_ones_own():
 
 def test_viser_s_own_parameters_are_left_to_viser():
     assert parse("preset=oblate&websocket=ws://h:1&darkMode").preset is preset_by_key("oblate")
+    assert parse("fixedDpr=1&preset=oblate&showStats").preset is preset_by_key("oblate")
 
 
 @pytest.mark.parametrize(

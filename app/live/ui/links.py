@@ -12,7 +12,8 @@ the query of what is on screen.
 
 A link with a parameter that is unknown, repeated or out of range opens the server's default
 scene with a message naming it (:func:`opening` never raises). viser's own page parameters
-(``websocket``, ``darkMode``, ``initialCamera…``) are left to viser.
+(``websocket``, ``darkMode``, ``initialCamera…``, ``fixedDpr``...: :data:`VISER_OWN`) are left
+to viser.
 
 How a session learns its page's address: :func:`poinsot.app.viser_private.page_address`.
 """
@@ -35,8 +36,19 @@ from poinsot.app.scenes.spec import Choice, SceneControl, SceneSpec, Slider, Val
 GENERAL = ("preset", "scene", "t", "view", "speed", "paused", "follow")
 #: A body of one's own.
 BODY = ("I", "D", "side", "pole", "w")
-#: The page parameters viser's client reads itself (prefixes).
-VISER_OWN = ("websocket", "darkMode", "initialCamera")
+#: The page parameters viser's client reads itself (prefixes): the server's address, the theme
+#: and the first camera, and its display settings (a fixed pixel ratio, the frame-rate
+#: panel, the camera's log, the logo, the orbit-origin tool).
+VISER_OWN = (
+    "websocket",
+    "darkMode",
+    "initialCamera",
+    "fixedDpr",
+    "showStats",
+    "logCamera",
+    "hideViserLogo",
+    "forceOrbitOriginTool",
+)
 #: Latest simulation time a link may ask for [time units].
 MAX_TIME = 1e6
 _TRUE, _FALSE = ("1", "true", "yes", "on"), ("0", "false", "no", "off", "")
