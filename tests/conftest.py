@@ -493,10 +493,12 @@ NO_LIVE_VIEW_JS = """(() => {
 })();"""
 
 
-#: The most frames a second a test's page draws [frames/s]: the page's pictures are the same,
-#: it draws fewer of them. A live 1280 x 800 view otherwise draws as many as software WebGL
-#: can, 7 to 11 a second at 1.7 to 1.8 cores of Chromium; capped at 5, it takes 1.2. Every
-#: wait on the page's drawing is an event (frames counted, pictures compared), never a time.
+#: The most frames a second a test's page draws [frames/s]. A live 1280 x 800 view otherwise
+#: draws as many as software WebGL can, 7 to 11 a second at 1.7 to 1.8 cores of Chromium;
+#: capped at 5, it takes 1.2. The pictures are the same at a given pixel ratio, but viser lowers
+#: the canvas's ratio (to 0.75 at the least) sooner on a page that draws few frames: a test that
+#: compares two pictures' pixels holds it (``?fixedDpr=1``). A test waits for frames drawn or a
+#: picture, not for the time that so many frames would take.
 PAGE_MAX_FPS = 5
 
 #: Caps a live page's animation frames at :data:`PAGE_MAX_FPS`: each ``requestAnimationFrame``
@@ -536,6 +538,23 @@ FRAME_CAP_JS = """(() => {
 })();""".replace("MAX_FPS", str(PAGE_MAX_FPS))
 
 
+#: Draws a test's page without multisampling: the WebGL context is asked for with ``antialias:
+#: false``. Software WebGL shades every pixel of a multisampled canvas four times: without it a
+#: live capped page takes 0.72 cores of Chromium instead of 0.96, and a 1280 x 800 render 0.22
+#: core-seconds instead of 0.32. The suite's checks read colours, counts and places, not how
+#: smooth an edge is; the README's pictures and ``poinsot screenshot``/``video`` keep their
+#: antialiasing (pages of their own).
+NO_MSAA_JS = """(() => {
+  const getContext = HTMLCanvasElement.prototype.getContext;
+  HTMLCanvasElement.prototype.getContext = function (type, attributes) {
+    if (type === "webgl2" || type === "webgl") {
+      attributes = Object.assign({}, attributes, { antialias: false });
+    }
+    return getContext.call(this, type, attributes);
+  };
+})();"""
+
+
 FRAMES_DRAWN_JS = """() => {
   const points = window.__viserTestpoints;
   return points ? points.rendererInfo.render.frame : 0;
@@ -558,6 +577,7 @@ def _page_opener(chromium) -> Iterator[Callable[..., BrowserPage]]:
         context.add_init_script(HIDE_SOFTWARE_WEBGL_NOTICE_JS)
         context.add_init_script(NO_LIVE_VIEW_JS % ("false" if live_view else "true"))
         context.add_init_script(FRAME_CAP_JS)
+        context.add_init_script(NO_MSAA_JS)
         page = context.new_page()
         errors: list[str] = []
         page.on(
