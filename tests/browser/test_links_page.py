@@ -87,10 +87,20 @@ def check_scene_link(page: BrowserPage, session) -> None:
 def check_body_link(page: BrowserPage, session) -> None:
     """?I=1,2,2.6&D=2.1&side=major&pole=plus&w=1.2&speed=0.5&paused=1"""
     assert wait_until(lambda: page.dropdown_value("Preset") == "Custom (edited)", 20)
-    assert [page.slider_value(f"I{c}") for c in "₁₂₃"] == [1.0, 2.0, 2.6]
-    assert page.slider_value("D = |L|²/2T") == pytest.approx(2.1, abs=1e-3)
-    assert page.slider_value("|ω₀|") == pytest.approx(1.2)
-    assert page.slider_value("Speed") == pytest.approx(0.5)
+    # The sliders' values reach the page in messages of their own, after the preset's name.
+    wanted = {"I₁": 1.0, "I₂": 2.0, "I₃": 2.6, "D = |L|²/2T": 2.1, "|ω₀|": 1.2, "Speed": 0.5}
+
+    def sliders() -> dict[str, float]:
+        return {label: page.slider_value(label) for label in wanted}
+
+    def shown() -> bool:
+        values = sliders()
+        return all(
+            values[k] == pytest.approx(v, abs=1e-3 if k[0] == "D" else 1e-9)
+            for k, v in wanted.items()
+        )
+
+    assert wait_until(shown, 20), sliders()
     assert wait_until(lambda: time_readout(page) == (0.0, "paused"), 20)
     assert session.params.inertia == (1.0, 2.0, 2.6) and session.params.pole_sign == 1
     assert session.clock.speed == 0.5
