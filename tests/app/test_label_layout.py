@@ -5,6 +5,7 @@ events only, never wall-clock bounds."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -12,6 +13,7 @@ import pytest
 import viser
 from conftest import record_messages, session_of, wait_until
 
+from poinsot.app.live.ui import display
 from poinsot.app.live.ui.session import PLOT_MIN_FRAMES
 from poinsot.app.parameters import Parameters
 from poinsot.app.presets import DEFAULT_PRESET
@@ -183,3 +185,12 @@ def test_a_frame_carries_at_most_one_of_traces_plot_and_a_layout_step(poinsot_ap
     # every PLOT_MIN_FRAMES frames).
     sent = sum("plot" in f for f in kinds)
     assert sent >= 0.9 * min(samples[0], len(kinds) / PLOT_MIN_FRAMES), (sent, samples, len(kinds))
+
+
+def test_a_view_of_another_height_is_laid_out_again():
+    """A still camera is laid out again only when what a layout depends on changes: the
+    view's height too (a phone's sheet folding leaves its width as it was)."""
+    camera = _camera()
+    taller = dataclasses.replace(camera, height=camera.height + 300.0)
+    assert display._camera_key(taller) != display._camera_key(camera)
+    assert display._camera_key(dataclasses.replace(camera)) == display._camera_key(camera)

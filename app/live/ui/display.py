@@ -107,8 +107,16 @@ def browser_camera(client: viser.ClientHandle) -> Camera | None:
 
 
 def _camera_key(camera: Camera) -> tuple[float, ...]:
-    """What a layout depends on of the camera."""
-    return (*camera.position, *camera.look_at, *camera.up, camera.fov, camera.width)
+    """What a layout depends on of the camera: its pose, its field of view and the view's size
+    (a phone's or a tablet's view changes its height alone as its sheet folds or opens)."""
+    return (
+        *camera.position,
+        *camera.look_at,
+        *camera.up,
+        camera.fov,
+        camera.width,
+        camera.height,
+    )
 
 
 class Display:
