@@ -555,57 +555,6 @@ def test_sphere_and_custom_alternate_without_console_errors(pages):
 
 
 # -- projector mode and the two views ---------------------------------------------------------
-# Runs alone after the parallel stage: beside three busy workers, the count of the trace's
-# pixels that it compared before its thickness came out under its threshold in two of three
-# full runs.
-@pytest.mark.serial
-def test_projector_mode_folds_the_panels_and_thickens_the_picture(pages):
-    # Two pictures' pixels compared: the canvas's pixel ratio held (viser lowers it while a
-    # page draws few frames a second, as the suite's pages do).
-    page, session = pages.get(1280, 800, "?fixedDpr=1")
-    page.set_live_view(True)
-    # Two thirds of ω's period played: the herpolhode's ring, a thousand pixels of it.
-    session.set_speed(4.0)
-    assert wait_until(lambda: session.frame is not None and session.frame.t > 6.0, 30)
-    pause(page, session)
-    page.page.wait_for_timeout(800)
-    before_box = page.canvas_box()
-    before = line_thickness(hue_mask(page.screenshot_rgb(), session.scene.look.herpolhode))
-    root = "parseFloat(getComputedStyle(document.documentElement).fontSize)"
-    base_font = page.page.evaluate(root)
-    page.set_checkbox("Projector mode", True)
-    assert wait_until(lambda: session.lecture.display.style.projector, 10)
-    # The flag is set before the scene is recoloured: wait for the projector's colours.
-    projector_look = palette.look(True, projector=True)
-    assert wait_until(lambda: session.scene.look is projector_look, 20), session.scene.look
-    look = session.scene.look
-    assert wait_until(lambda: page.canvas_box()["width"] > 0.85 * 1280, 10), page.canvas_box()
-    # The lines are drawn twice as thick (3.5 to 7 px) once the browser has taken the restyle:
-    # wait for it (a busy software-WebGL page can take seconds). Measured on their pixels of
-    # the trace's hue (a line's soft edge is not): 3.6 to 3.9 px before (and while the restyle
-    # is on its way), 6.0 to 6.4 after, a ratio of 1.59 to 1.74 in fourteen runs. Their count
-    # was compared before, and a label laid over a short herpolhode made it 1.2 to 1.9.
-    thicknesses: list[float] = []
-
-    def thickened() -> bool:
-        thicknesses.append(line_thickness(hue_mask(page.screenshot_rgb(), look.herpolhode)))
-        return thicknesses[-1] > 1.4 * before
-
-    assert wait_until(thickened, 15, poll=0.5), (before, thicknesses)
-    assert before_box["width"] < 0.6 * 1280
-    # A column opened from its strip shows its text large.
-    session.client.gui.main_panel.expand()
-    assert wait_until(lambda: page.page.evaluate(root) >= base_font * 1.45, 10)
-    session.client.gui.main_panel.minimize()
-    # Key P switches it off again: the columns are back.
-    page.page.mouse.click(640, 790)
-    page.page.keyboard.press("p")
-    assert wait_until(lambda: not session.lecture.display.style.projector, 10)
-    assert wait_until(lambda: page.canvas_box()["width"] < 0.6 * 1280, 10)
-    assert PROJECTOR_TEXT_PERCENT >= 140
-    assert page.errors == []
-
-
 def test_two_views_show_the_body_frame_beside_the_space_frame(pages):
     """The space frame (left: the herpolhode on the plane) and the body frame (right: the
     ellipsoid with its polhode, no herpolhode), side by side."""
@@ -657,6 +606,54 @@ def test_two_views_show_the_body_frame_beside_the_space_frame(pages):
     assert session.lecture.display.body_view.titles[1].text.startswith("body frame")
     page.page.keyboard.press("v")  # key V: back to one view
     assert wait_until(lambda: session.lecture.display.body_view is None, 10)
+    assert page.errors == []
+
+
+def test_projector_mode_folds_the_panels_and_thickens_the_picture(pages):
+    """On the labels' page (a fixed pixel ratio), before them."""
+    # Two pictures' pixels compared: the canvas's pixel ratio held (viser lowers it while a
+    # page draws few frames a second, as the suite's pages do).
+    page, session = pages.get(1280, 800, "?fixedDpr=1")
+    page.set_live_view(True)
+    # Two thirds of ω's period played: the herpolhode's ring, a thousand pixels of it.
+    session.set_speed(4.0)
+    assert wait_until(lambda: session.frame is not None and session.frame.t > 6.0, 30)
+    pause(page, session)
+    page.page.wait_for_timeout(800)
+    before_box = page.canvas_box()
+    before = line_thickness(hue_mask(page.screenshot_rgb(), session.scene.look.herpolhode))
+    root = "parseFloat(getComputedStyle(document.documentElement).fontSize)"
+    base_font = page.page.evaluate(root)
+    page.set_checkbox("Projector mode", True)
+    assert wait_until(lambda: session.lecture.display.style.projector, 10)
+    # The flag is set before the scene is recoloured: wait for the projector's colours.
+    projector_look = palette.look(True, projector=True)
+    assert wait_until(lambda: session.scene.look is projector_look, 20), session.scene.look
+    look = session.scene.look
+    assert wait_until(lambda: page.canvas_box()["width"] > 0.85 * 1280, 10), page.canvas_box()
+    # The lines are drawn twice as thick (3.5 to 7 px) once the browser has taken the restyle:
+    # wait for it (a busy software-WebGL page can take seconds). Measured on their pixels of
+    # the trace's hue (a line's soft edge is not): 3.6 to 3.9 px before (and while the restyle
+    # is on its way), 6.0 to 6.4 after, a ratio of 1.59 to 1.74 in fourteen runs. Their count
+    # was compared before, and a label laid over a short herpolhode made it 1.2 to 1.9.
+    thicknesses: list[float] = []
+
+    def thickened() -> bool:
+        thicknesses.append(line_thickness(hue_mask(page.screenshot_rgb(), look.herpolhode)))
+        return thicknesses[-1] > 1.4 * before
+
+    assert wait_until(thickened, 15, poll=0.5), (before, thicknesses)
+    assert before_box["width"] < 0.6 * 1280
+    # A column opened from its strip shows its text large.
+    session.client.gui.main_panel.expand()
+    assert wait_until(lambda: page.page.evaluate(root) >= base_font * 1.45, 10)
+    session.client.gui.main_panel.minimize()
+    # Key P switches it off again: the columns are back.
+    page.page.mouse.click(640, 790)
+    page.page.keyboard.press("p")
+    assert wait_until(lambda: not session.lecture.display.style.projector, 10)
+    assert wait_until(lambda: page.canvas_box()["width"] < 0.6 * 1280, 10)
+    assert PROJECTOR_TEXT_PERCENT >= 140
     assert page.errors == []
 
 
