@@ -16,7 +16,7 @@ import re
 
 import numpy as np
 import pytest
-from conftest import lecture_of, session_of, wait_until
+from conftest import FRAME_CAP_JS, NO_MSAA_JS, lecture_of, session_of, wait_until
 from PIL import Image
 
 from poinsot.app.exports import html as html_export
@@ -77,6 +77,8 @@ def test_html_export_plays_from_a_file_url_without_any_server(chromium, tmp_path
     path = tmp_path / "poinsot.html"
     path.write_text(html_export.preset_html(preset_by_key("major"), 3.0, fps=20), encoding="utf-8")
     context = chromium.new_context(viewport={"width": 960, "height": 540})
+    context.add_init_script(FRAME_CAP_JS)  # as the suite's other pages (the clip plays by time)
+    context.add_init_script(NO_MSAA_JS)
     refused: list[str] = []
 
     def only_local(route) -> None:
