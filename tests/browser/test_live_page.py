@@ -134,7 +134,8 @@ def test_moving_a_slider_changes_the_scene(shared):
     before_pixels = canvas_pixels(page)
     before_axes = session.scene.geometry.semi_axes.copy()
     generation = session.generation
-    page.press_slider("I₁", "ArrowRight", times=15)  # I1: 1.00 -> 1.15, 15 steps of 0.01
+    # I1: 1.00 -> 1.15, 15 steps of 0.01 (and the steps an answer of the server took back)
+    page.press_slider_to("I₁", 1.15, 0.01, lambda: session.params.inertia[0])
     assert wait_until(lambda: abs(session.params.inertia[0] - 1.15) < 1e-9, 10), session.params
     assert session.generation > generation
     assert page.slider_value("I₁") == pytest.approx(1.15)
@@ -189,7 +190,7 @@ def test_two_browsers_have_independent_sessions(shared, open_page):
     assert wait_until(lambda: b.stats.frames > 10, 30)
     first.choose("Preset", preset_by_key("oblate").label)
     assert wait_until(lambda: a.preset.key == "oblate", 10)
-    second.press_slider("|ω₀|", "ArrowRight", times=4)
+    second.press_slider_to("|ω₀|", 1.4, 0.05, lambda: b.params.omega_norm)  # 4 steps up
     assert wait_until(lambda: b.params.omega_norm == pytest.approx(1.4), 10)
     # Each change stayed in its own session, scene and panel.
     assert b.preset.key == "custom" and a.params.omega_norm == preset_by_key("oblate").omega_norm
@@ -217,7 +218,7 @@ def test_a_real_browser_sends_only_what_the_wire_allows(shared):
     for k in range(20):  # an orbit: camera messages
         mouse.move(box["x"] + box["width"] / 2 + 8 * k, box["y"] + box["height"] / 2 + 3 * k)
     mouse.up()
-    page.press_slider("I₁", "ArrowRight", times=3)
+    page.press_slider_to("I₁", 1.03, 0.01, lambda: session.params.inertia[0])  # 3 steps up
     assert wait_until(lambda: abs(session.params.inertia[0] - 1.03) < 1e-9, 10)
     page.choose("Preset", preset_by_key("minor").label)
     page.page.keyboard.press("Space")  # a command of the palette

@@ -374,7 +374,7 @@ def test_the_D_marks_follow_the_body(pages):
     assert wait_until(lambda: [m[1] for m in slider_marks(page)["marks"]][1:2] == ["I₂"], 10)
     before = slider_marks(page)["marks"][1][0]
     assert before == pytest.approx(62.5)  # (2 - 1) / (2.6 - 1)
-    page.press_slider("I₂", "ArrowRight", times=20)  # I2: 2.00 -> 2.20
+    page.press_slider_to("I₂", 2.2, 0.01, lambda: session.params.inertia[1])  # 20 steps up
     assert wait_until(lambda: session.params.inertia[1] == pytest.approx(2.2), 10)
     assert wait_until(lambda: slider_marks(page)["marks"][1][0] == pytest.approx(75.0), 10)
     assert page.errors == []
@@ -396,17 +396,7 @@ def test_D_at_the_I2_mark_is_the_exact_separatrix(pages):
     x = track["x"] + track["width"] * offset / 100.0
     page.page.mouse.click(x, track["y"] + track["height"] / 2)
     assert wait_until(lambda: abs(page.slider_value(label) - 2.0) < 0.05, 10)
-    # The arrow keys until the slider shows 2.000, as a user would: once the server and the
-    # page agree on D, the steps still missing (on a loaded machine the server's answer to an
-    # earlier key can come back between two presses and take the slider back a step).
-    for _ in range(5):
-        assert wait_until(
-            lambda: session.params.D == pytest.approx(page.slider_value(label), abs=1e-9), 30
-        )
-        steps = round((2.0 - page.slider_value(label)) / 0.001)
-        if not steps:
-            break
-        page.press_slider(label, "ArrowRight" if steps > 0 else "ArrowLeft", times=abs(steps))
+    page.press_slider_to(label, 2.0, 0.001, lambda: session.params.D)
     assert wait_until(lambda: page.slider_value(label) == 2.0, 10)
     assert wait_until(lambda: session.params.D == 2.0, 10), session.params
     assert session.body.regime is Regime.SEPARATRIX and session.body.D == 2.0
