@@ -78,12 +78,12 @@ bench: install
 # Both benchmarks of this working tree against another revision, alternating, as ratios new/old
 # (exits 1 when a figure regressed), e.g. make bench-compare AGAINST=8b3cd8c ARGS="--rounds 5".
 bench-compare: install
-	$(PY) -m poinsot.app.compare --against $(AGAINST) $(ARGS)
+	$(PY) -m poinsot.app.devtools.compare --against $(AGAINST) $(ARGS)
 
 # Load test of the live server on loopback (about 8 minutes; exits 1 when a goal is missed).
 # Options go in ARGS, e.g. make load ARGS="--phase soak storm --clients 10 --seconds 60".
 load: install
-	$(PY) -m poinsot.app.load $(ARGS)
+	$(PY) -m poinsot.app.devtools.load $(ARGS)
 
 # mypy checks the folders under their installed names: poinsot.physics, poinsot.app.
 TYPECHECK := $(VENV)/typecheck

@@ -1,3 +1,3 @@
-from poinsot.app.cli import main
+from poinsot.app.cli.main import main
 
 raise SystemExit(main())

@@ -20,15 +20,15 @@ from typing import Any
 
 from viser.infra import StateSerializer
 
-from poinsot.app.elements import ALL_ELEMENTS
+from poinsot.app.construction import palette
+from poinsot.app.construction.cameras import RIDE_ALONG, canonical, space_view
 from poinsot.app.exports.html import HTML_FPS, record
-from poinsot.app.live.ui.legend import caption, entries, legend_html
-from poinsot.app.parameters import Parameters, drawn_solid
-from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, PRESETS, Preset
-from poinsot.app.scene import palette
-from poinsot.app.scene.cameras import RIDE_ALONG, canonical, space_view
-from poinsot.app.scenes import scene_by_name
-from poinsot.app.scenes.spec import SceneSpec
+from poinsot.app.lessons import scene_by_name
+from poinsot.app.lessons.support.spec import SceneSpec
+from poinsot.app.live.panel.legend import caption, entries, legend_html
+from poinsot.app.model.elements import ALL_ELEMENTS
+from poinsot.app.model.parameters import Parameters, drawn_solid
+from poinsot.app.model.presets import CUSTOM, DEFAULT_PRESET, PRESETS, Preset
 from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.app.stage.served import Stage
 from poinsot.physics import FreeRigidBody

@@ -8,7 +8,7 @@ Reusable pieces (also for the screenshot and export tests):
 - ``poinsot_app`` (factory ``make_app``): a :class:`poinsot.app.live.server.PoinsotApp` on a
   free port;
 - ``probe`` (factory ``make_probe``): a headless websocket client
-  (:mod:`poinsot.app.live.hardening.probe`);
+  (:mod:`poinsot.app.devtools.probe`);
 - ``chromium`` (session scope): a launched playwright Browser;
 - ``open_page``: ``open_page(url, width=..., height=...) -> BrowserPage`` with the console
   errors collected, the canvas ready and the software-WebGL notice hidden;
@@ -33,17 +33,18 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pytest
 
-from poinsot.app.cli import main as cli_main
+from poinsot.app import viser_private
+from poinsot.app.cli.main import main as cli_main
+from poinsot.app.devtools.probe import Probe
 from poinsot.app.exports.chromium import CHROMIUM_ARGS, CHROMIUM_ENV, DEFAULT_CHROMIUM
-from poinsot.app.live.hardening.probe import Probe
+from poinsot.app.live.lecture.lecture import LectureControls
 from poinsot.app.live.server import PoinsotApp
-from poinsot.app.live.ui.lecture import LectureControls
-from poinsot.app.live.ui.session import Session
-from poinsot.app.presets import DEFAULT_PRESET, Preset
-from poinsot.app.report.cases import CASES, StudyConfig
-from poinsot.app.report.exact import load_reference
-from poinsot.app.report.progress import Progress
-from poinsot.app.report.study import CaseResult, study_case
+from poinsot.app.live.session.session import Session
+from poinsot.app.model.presets import DEFAULT_PRESET, Preset
+from poinsot.app.report.measure.cases import CASES, StudyConfig
+from poinsot.app.report.measure.exact import load_reference
+from poinsot.app.report.measure.progress import Progress
+from poinsot.app.report.measure.study import CaseResult, study_case
 
 if TYPE_CHECKING:
     from playwright.sync_api import FloatRect, Page
@@ -268,7 +269,7 @@ def probe(poinsot_app, make_probe) -> Probe:
 def run_command(argv: list[str], timeout: float = 900.0) -> subprocess.CompletedProcess[str]:
     """``poinsot ARGV`` in a process of its own (its output as text), as a lecturer runs it."""
     return subprocess.run(
-        [sys.executable, "-m", "poinsot.app.cli", *argv],
+        [sys.executable, "-m", "poinsot.app.cli.main", *argv],
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -327,7 +328,7 @@ def record_frame_times(session: Session) -> list[float]:
 def record_messages(server) -> list:
     """Every message ``server`` queues from now on (appended as it is queued)."""
     sent: list = []
-    transport = server._websock_server
+    transport = viser_private.infra(server)
     original = transport.queue_message
 
     def queue_message(message) -> None:

@@ -13,12 +13,12 @@ import numpy as np
 from conftest import session_of, wait_until
 from scipy.spatial.transform import Rotation
 
-from poinsot.app.elements import Element
-from poinsot.app.live.hardening.probe import Node, Probe
+from poinsot.app.construction.sampled.batch import Frame
+from poinsot.app.construction.sampled.frames import xyzw_from_wxyz
+from poinsot.app.devtools.probe import Node, Probe
 from poinsot.app.live.server import PoinsotApp
-from poinsot.app.live.ui.session import Session
-from poinsot.app.scene.batch import Frame
-from poinsot.app.scene.frames import xyzw_from_wxyz
+from poinsot.app.live.session.session import Session
+from poinsot.app.model.elements import Element
 
 #: Nodes every session has, whatever it shows.
 ALWAYS = {"/WorldAxes", "/space", "/space/body", "/space/tip", "/lights", "/lights/fill"}
@@ -182,10 +182,10 @@ def construction_nodes() -> dict:
     nodes the construction draws for an element)."""
     import viser
 
-    from poinsot.app.elements import Element
-    from poinsot.app.parameters import Parameters
-    from poinsot.app.presets import DEFAULT_PRESET
-    from poinsot.app.scene.construction import PoinsotScene
+    from poinsot.app.construction.construction import PoinsotScene
+    from poinsot.app.model.elements import Element
+    from poinsot.app.model.parameters import Parameters
+    from poinsot.app.model.presets import DEFAULT_PRESET
 
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     try:

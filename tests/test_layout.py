@@ -134,6 +134,104 @@ def test_modules_are_small_rooms():
     assert not big, f"modules over {MAX_MODULE_LINES} lines: {big}"
 
 
+#: A room holds at most this many modules (``__init__.py`` and ``__main__.py`` count): past it,
+#: a reader no longer finds a module by its room, and the room wants rooms of its own.
+MAX_ROOM_MODULES = 15
+#: The app's root holds only its front: the package, ``python -m poinsot.app`` and the notebook's
+#: ``show`` (everything else lives in a room named by what it holds).
+MAX_APP_ROOT_MODULES = 5
+
+
+def test_rooms_hold_few_modules():
+    crowded = {}
+    for top in ("physics", "app"):
+        for folder in sorted(p for p in (ROOT / top).rglob("*") if p.is_dir()):
+            count = len(list(folder.glob("*.py")))
+            if count > MAX_ROOM_MODULES:
+                crowded[str(folder.relative_to(ROOT))] = count
+    assert not crowded, f"folders of more than {MAX_ROOM_MODULES} modules: {crowded}"
+    root = sorted(p.name for p in (ROOT / "app").glob("*.py"))
+    assert len(root) <= MAX_APP_ROOT_MODULES, f"app/ holds {root} at its root"
+
+
+def _module_name(path: pathlib.Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(["poinsot", *parts])
+
+
+def _import_graph() -> dict[str, set[str]]:
+    """Every module of physics/ and app/ to the modules of ours it imports, wherever the import
+    stands (a function, ``if TYPE_CHECKING:``): ``from a import b`` is an import of ``a.b`` when
+    that is a module, of ``a`` otherwise."""
+    files = {_module_name(f): f for f in _code_files()}
+    graph = {}
+    for name, f in files.items():
+        found = set()
+        for node in ast.walk(ast.parse(f.read_text())):
+            if isinstance(node, ast.Import):
+                found.update(a.name for a in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                for a in node.names:
+                    full = f"{node.module}.{a.name}"
+                    found.add(full if full in files else node.module)
+        graph[name] = {m for m in found if m in files and m != name}
+    return graph
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found = []
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is None:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        top = stack.pop()
+                        on_stack.discard(top)
+                        component.append(top)
+                        if top == node:
+                            break
+                    if len(component) > 1:
+                        found.append(sorted(component))
+            elif child not in index:
+                index[child] = low[child] = len(index)
+                stack.append(child)
+                on_stack.add(child)
+                work.append((child, iter(sorted(graph[child]))))
+            elif child in on_stack:
+                low[node] = min(low[node], index[child])
+    return found
+
+
+def test_no_module_imports_itself_round_a_cycle():
+    """No cycle between modules, type-only imports included (a cycle is two rooms that are one)."""
+    assert _cycles(_import_graph()) == []
+
+
+def test_the_cycle_search_finds_one():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": set()}
+    assert _cycles(graph) == [["a", "b", "c"]]
+    assert _cycles({"a": {"b"}, "b": set()}) == []
+
+
 def test_functions_do_one_step():
     long = {}
     for f in _code_files():
@@ -385,16 +483,49 @@ def _private_viser_uses(source: str) -> list[str]:
     return found
 
 
+#: The adapter's own tests: they pin each private name the adapter relies on, so that a viser
+#: release that moves one fails there, naming the version (every other test goes through the
+#: adapter, hostile messages included).
+ADAPTER_TESTS = frozenset(
+    {ROOT / "tests" / "app" / "test_viser_private.py", ROOT / "tests" / "app" / "test_updates.py"}
+)
+
+
 def test_viser_s_private_names_are_used_only_in_the_adapter():
-    """One door to viser's internals: app/viser_private/ (its docstring is the inventory)."""
+    """One door to viser's internals: app/viser_private/ (its docstring is the inventory), for
+    the app and for the tests alike."""
     used = {}
-    for f in sorted((ROOT / "app").rglob("*.py")):
-        if VISER_ADAPTER in f.parents:
+    files = [*(ROOT / "app").rglob("*.py"), *(ROOT / "tests").rglob("*.py")]
+    for f in sorted(files):
+        if VISER_ADAPTER in f.parents or f in ADAPTER_TESTS:
             continue
         found = _private_viser_uses(f.read_text())
         if found:
             used[str(f.relative_to(ROOT))] = found
     assert not used, f"private viser names outside app/viser_private/: {used}"
+
+
+def test_the_adapter_is_entered_by_its_front_door():
+    """Every import of the adapter goes through its package, whose ``__all__`` is its front
+    (``from poinsot.app.viser_private import X`` or ``from poinsot.app import viser_private``),
+    never one of its modules."""
+    side_doors = {}
+    files = [*(ROOT / "app").rglob("*.py"), *(ROOT / "tests").rglob("*.py")]
+    for f in sorted(files):
+        if VISER_ADAPTER in f.parents or f in ADAPTER_TESTS:
+            continue
+        for node in ast.walk(ast.parse(f.read_text())):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module, *(f"{node.module}.{a.name}" for a in node.names)]
+            else:
+                continue
+            inner = [n for n in names if n.startswith("poinsot.app.viser_private.")]
+            inner = [n for n in inner if (VISER_ADAPTER / f"{n.split('.')[3]}.py").is_file()]
+            if inner:
+                side_doors.setdefault(str(f.relative_to(ROOT)), []).extend(inner)
+    assert not side_doors, f"imports of the adapter's modules, past its package: {side_doors}"
 
 
 def test_the_private_name_scan_sees_each_form():

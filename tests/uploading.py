@@ -7,9 +7,9 @@ import uuid
 
 import numpy as np
 import trimesh
-from viser import _messages
 
-from poinsot.app.live.hardening.probe import Probe
+from poinsot.app import viser_private
+from poinsot.app.devtools.probe import Probe
 from poinsot.physics.fit import synthetic_toss
 
 #: The T-handle of the presets, tossed spinning about its intermediate axis (it flips).
@@ -74,7 +74,11 @@ def upload(
     transfer = uuid.uuid4().hex
     parts = [content[i : i + PART] for i in range(0, len(content), PART)]
     size = len(content) if declared is None else declared
-    probe.send(_messages.FileTransferStartUpload(button, transfer, name, mime, len(parts), size))
+    probe.send(
+        viser_private.wire_message(
+            "FileTransferStartUpload", button, transfer, name, mime, len(parts), size
+        )
+    )
     for k, part in enumerate(parts):
-        probe.send(_messages.FileTransferPart(button, transfer, k, part))
+        probe.send(viser_private.wire_message("FileTransferPart", button, transfer, k, part))
     return transfer

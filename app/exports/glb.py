@@ -14,11 +14,9 @@ import numpy as np
 import trimesh
 import trimesh.visual.material
 
-from poinsot.app.elements import Solid
-from poinsot.app.exports.run_csv import DEFAULT_SPAN, period_or
-from poinsot.app.scene import meshes, palette
-from poinsot.app.scene.ellipsoid import ellipsoid_mesh
-from poinsot.app.scene.geometry import (
+from poinsot.app.construction import meshes, palette
+from poinsot.app.construction.ellipsoid import ellipsoid_mesh
+from poinsot.app.construction.geometry import (
     CONTACT_RADIUS,
     HERPOLHODE_LIFT,
     L_ARROW,
@@ -29,6 +27,8 @@ from poinsot.app.scene.geometry import (
     ArrowShape,
     Geometry,
 )
+from poinsot.app.exports.run_csv import DEFAULT_SPAN, period_or
+from poinsot.app.model.elements import Solid
 from poinsot.physics import FreeRigidBody
 
 #: Tube radius of the exported polhode and herpolhode, and its number of sides [display units].

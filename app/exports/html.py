@@ -15,12 +15,12 @@ from typing import Any
 
 from viser.infra import StateSerializer
 
-from poinsot.app.elements import Element, Solid
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import Preset
-from poinsot.app.scene.cameras import space_view
-from poinsot.app.scene.view import DEFAULT_VIEW, View
-from poinsot.app.scenes.spec import SceneSpec
+from poinsot.app.construction.cameras import space_view
+from poinsot.app.construction.view import DEFAULT_VIEW, View
+from poinsot.app.lessons.support.spec import SceneSpec
+from poinsot.app.model.elements import Element, Solid
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import Preset
 from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.app.stage.served import Stage
 
@@ -97,7 +97,7 @@ def scene_html(
     view: View | None = None,
     dark_mode: bool = True,
 ) -> str:
-    """:func:`animation_html` of a scene (:mod:`poinsot.app.scenes`) at its own settings,
+    """:func:`animation_html` of a scene (:mod:`poinsot.app.lessons`) at its own settings,
     speed and camera (``view`` overrides the camera)."""
     _check_clip(seconds, fps)
     with SceneStage(spec, dark_mode=dark_mode) as stage:

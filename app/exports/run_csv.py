@@ -15,7 +15,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from poinsot.app.scene.frames import wxyz
+from poinsot.app.construction.sampled.frames import wxyz
 from poinsot.physics import FreeRigidBody
 
 #: Written into the CSV header; the one convention of every quaternion this module exports.

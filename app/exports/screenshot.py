@@ -7,11 +7,11 @@ theme's background colour unless a transparent PNG is asked for (:func:`png_byte
 ``poinsot screenshot`` starts a :class:`~poinsot.app.stage.served.Stage` (the app's own scene
 construction on a viser server at a free port), seeks it to the requested time, opens it in headless
 Chromium through playwright, renders, and writes the PNG. The camera is a named view
-(:mod:`poinsot.app.scene.cameras`); unless ``--no-fit`` is given, its field of view is then narrowed
-so that the construction fills the picture (narrowing the field of view scales the image about its
-centre, so one small probe render tells the exact factor). Chromium and the server are stopped in
-``finally`` blocks, and SIGTERM is turned into a normal exit so that they are also stopped when the
-command is killed.
+(:mod:`poinsot.app.construction.cameras`); unless ``--no-fit`` is given, its field of view is then
+narrowed so that the construction fills the picture (narrowing the field of view scales the image
+about its centre, so one small probe render tells the exact factor). Chromium and the server are
+stopped in ``finally`` blocks, and SIGTERM is turned into a normal exit so that they are also
+stopped when the command is killed.
 """
 
 from __future__ import annotations
@@ -29,6 +29,9 @@ import numpy as np
 import viser
 from scipy.spatial.transform import Rotation
 
+from poinsot.app.construction.cameras import space_view
+from poinsot.app.construction.sampled.frames import wxyz as to_wxyz
+from poinsot.app.construction.view import View
 from poinsot.app.exports.chromium import (
     EXIT_NO_BROWSER,
     WINDOW_HEIGHT,
@@ -39,12 +42,9 @@ from poinsot.app.exports.chromium import (
     sigterm_exits,
 )
 from poinsot.app.exports.strobe import Strobe, StrobeError, add_strobe, body_of
-from poinsot.app.presets import PRESETS, Preset, preset_by_key
-from poinsot.app.scene.cameras import space_view
-from poinsot.app.scene.frames import wxyz as to_wxyz
-from poinsot.app.scene.view import View
-from poinsot.app.scenes import scene_by_name
-from poinsot.app.scenes.spec import SceneSpec
+from poinsot.app.lessons import scene_by_name
+from poinsot.app.lessons.support.spec import SceneSpec
+from poinsot.app.model.presets import PRESETS, Preset, preset_by_key
 from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.app.stage.served import ClientOf, Stage
 
@@ -226,7 +226,7 @@ def capture(
 
 # -- the command ----------------------------------------------------------------------------
 def resolve_scene(name: str) -> Preset | SceneSpec:
-    """A scene (:mod:`poinsot.app.scenes`) by name or label, or a preset by key or label
+    """A scene (:mod:`poinsot.app.lessons`) by name or label, or a preset by key or label
     (case-insensitive)."""
     try:
         return scene_by_name(name)
@@ -301,7 +301,7 @@ def screenshot_command(
     2 for a strobe that cannot be drawn.
 
     ``t``: simulation time of the picture (None: one period of omega, or a scene's own
-    time); ``view``: a camera of :data:`~poinsot.app.scene.cameras.CAMERA_NAMES` ("default"
+    time); ``view``: a camera of :data:`~poinsot.app.construction.cameras.CAMERA_NAMES` ("default"
     is a scene's own framing); ``background``: "dark", "light" or
     "transparent"; ``fit``: frame the construction (else keep the view's field of view);
     ``strobe``: copies of the body over an interval (:mod:`poinsot.app.exports.strobe`), the

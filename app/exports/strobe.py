@@ -22,15 +22,15 @@ import math
 import numpy as np
 import viser
 
-from poinsot.app.scene.ellipsoid import ellipsoid_mesh
-from poinsot.app.scene.geometry import (
+from poinsot.app.construction.ellipsoid import ellipsoid_mesh
+from poinsot.app.construction.geometry import (
     DISPLAY_RADIUS,
     L_OVERSHOOT,
     PLANE_RADIUS,
     Geometry,
     triple,
 )
-from poinsot.app.scene.view import View
+from poinsot.app.construction.view import View
 from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.app.stage.served import Stage
 from poinsot.physics import FreeRigidBody

@@ -32,6 +32,8 @@ from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 
+from poinsot.app.construction.cameras import BODY_VIEW, ride_along
+from poinsot.app.construction.view import View
 from poinsot.app.exports.chromium import headless_chromium, open_window
 from poinsot.app.exports.screenshot import (
     RGB,
@@ -40,8 +42,6 @@ from poinsot.app.exports.screenshot import (
     content_extent,
     fitted_fov,
 )
-from poinsot.app.scene.cameras import BODY_VIEW, ride_along
-from poinsot.app.scene.view import View
 from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.app.stage.served import ClientOf, Stage
 

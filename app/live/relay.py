@@ -15,7 +15,7 @@ import threading
 from collections.abc import Sequence
 from multiprocessing.connection import Connection
 
-from poinsot.app.live.ui.follow import ENDED, FollowHub, Message
+from poinsot.app.live.classroom.follow import ENDED, FollowHub, Message
 
 
 def worker_hub(feed: Connection, code: str) -> FollowHub:

@@ -1,4 +1,4 @@
-"""The viser server and its sessions: one :class:`~poinsot.app.live.ui.session.Session` per
+"""The viser server and its sessions: one :class:`~poinsot.app.live.session.session.Session` per
 browser."""
 
 from __future__ import annotations
@@ -12,18 +12,21 @@ from concurrent.futures import Future
 
 import viser
 
+from poinsot.app.lessons.support.spec import SceneSpec
+from poinsot.app.live.classroom import links
+from poinsot.app.live.classroom.follow import FollowHub
 from poinsot.app.live.hardening.backlog import BacklogLimit, BacklogWatch
 from poinsot.app.live.hardening.budget import RebuildGate
 from poinsot.app.live.hardening.guard import WireGuard, guarded_viser
 from poinsot.app.live.hardening.pacing import frame_share
 from poinsot.app.live.hardening.upkeep import MemoryTrim, fixed_pool
-from poinsot.app.live.ui import links
-from poinsot.app.live.ui.follow import FollowHub
-from poinsot.app.live.ui.session import MAX_FPS, Session
-from poinsot.app.presets import DEFAULT_PRESET, Preset
-from poinsot.app.scenes.spec import SceneSpec
-from poinsot.app.viser_private import handshake_origin, page_address
-from poinsot.app.viser_private import transport as private_transport
+from poinsot.app.live.session.session import MAX_FPS, Session
+from poinsot.app.model.presets import DEFAULT_PRESET, Preset
+from poinsot.app.viser_private import (
+    handshake_origin,
+    page_address,
+    senders_woken_on_their_loop,
+)
 
 log = logging.getLogger(__name__)
 
@@ -116,7 +119,7 @@ class PoinsotApp:
             return list(self._sessions.values())
 
     async def _on_connect(self, client: viser.ClientHandle) -> None:
-        private_transport.senders_woken_on_their_loop(client)  # before the session pushes
+        senders_woken_on_their_loop(client)  # before the session pushes
         if handshake_origin(self.server, client.client_id) is None:  # a tool: no page, no link
             self._build(client, None)
             return

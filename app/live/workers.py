@@ -27,8 +27,8 @@ from collections.abc import Callable, Sequence
 from multiprocessing.connection import Connection
 from typing import TYPE_CHECKING, Any
 
+from poinsot.app.live.classroom.follow import new_code
 from poinsot.app.live.hardening.network import PortError, check_port, port_problem
-from poinsot.app.live.ui.follow import new_code
 
 if TYPE_CHECKING:
     from poinsot.app.live.server import PoinsotApp
@@ -111,10 +111,10 @@ def _serve(
     feed: Connection | None = None,
     code: str = "",
 ) -> PoinsotApp:
+    from poinsot.app.lessons import scene_by_name
     from poinsot.app.live.relay import worker_hub
     from poinsot.app.live.server import PoinsotApp
-    from poinsot.app.presets import preset_by_key
-    from poinsot.app.scenes import scene_by_name
+    from poinsot.app.model.presets import preset_by_key
 
     start_scene = scene_by_name(scene) if scene else None
     return PoinsotApp(

@@ -21,8 +21,8 @@ from typing import Any
 
 import numpy as np
 
-from poinsot.app.report.runs import IntegratorRun
-from poinsot.app.report.study import CaseResult
+from poinsot.app.report.measure.runs import IntegratorRun
+from poinsot.app.report.measure.study import CaseResult
 from poinsot.app.report.tables import EXACT
 from poinsot.physics.integrators import INTEGRATORS
 

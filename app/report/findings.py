@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import math
 
-from poinsot.app.report.conditioning import SEPARATRIX_TOLERANCE, Conditioning
 from poinsot.app.report.formatting import exp, sig
-from poinsot.app.report.runs import IntegratorRun
-from poinsot.app.report.study import FLIP_SAMPLES, CaseResult
+from poinsot.app.report.measure.conditioning import SEPARATRIX_TOLERANCE, Conditioning
+from poinsot.app.report.measure.runs import IntegratorRun
+from poinsot.app.report.measure.study import FLIP_SAMPLES, CaseResult
 from poinsot.app.report.verdicts import ORDER_FIT_RANGE, observed_order, order_fit_runs
 from poinsot.physics.integrators import INTEGRATORS
 

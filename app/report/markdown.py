@@ -15,8 +15,6 @@ from pathlib import Path
 import numpy as np
 import scipy
 
-from poinsot.app.report.cases import StudyConfig
-from poinsot.app.report.exact import FAR_PERIODS
 from poinsot.app.report.figures import caption, takeaway
 from poinsot.app.report.findings import (
     conditioning_section,
@@ -24,10 +22,12 @@ from poinsot.app.report.findings import (
     saturation_section,
 )
 from poinsot.app.report.formatting import exp, sig, vector
-from poinsot.app.report.games import GameRow, games_section
-from poinsot.app.report.speedup import SPEEDUP_REPEATS, Speedup
-from poinsot.app.report.study import CaseResult
-from poinsot.app.report.timing import repeats_text
+from poinsot.app.report.measure.cases import StudyConfig
+from poinsot.app.report.measure.exact import FAR_PERIODS
+from poinsot.app.report.measure.games import GameRow, games_section
+from poinsot.app.report.measure.speedup import SPEEDUP_REPEATS, Speedup
+from poinsot.app.report.measure.study import CaseResult
+from poinsot.app.report.measure.timing import repeats_text
 from poinsot.app.report.verdicts import verdict
 from poinsot.physics.integrators import INTEGRATORS
 
@@ -48,7 +48,7 @@ class ReportInputs:
     elapsed: float
     """Wall time of the whole run [s]."""
     games: tuple[GameRow, ...] = ()
-    """The game-engine table's rows (:mod:`~poinsot.app.report.games`)."""
+    """The game-engine table's rows (:mod:`~poinsot.app.report.measure.games`)."""
 
 
 def write_markdown(out: Path, inputs: ReportInputs) -> None:
@@ -100,10 +100,10 @@ def _method(config: StudyConfig, results: list[CaseResult]) -> list[str]:
         "- **energy drift**: |T(t) - T(0)| / T(0).",
         "",
         "The `exact` rows carry the closed form's own errors against an independent "
-        "high-precision Taylor-series integration (`app/report/reference.py`, no formula shared "
-        f"with the closed form), at {config.reference_points} irregularly placed points in the "
-        f"horizon and at {FAR_PERIODS:.0e} + 0.38 periods, and its energy drift over the grid. "
-        f"The reference took {reference_seconds:.1f} s in all.",
+        "high-precision Taylor-series integration (`app/report/measure/reference.py`, no "
+        f"formula shared with the closed form), at {config.reference_points} irregularly placed "
+        f"points in the horizon and at {FAR_PERIODS:.0e} + 0.38 periods, and its energy drift "
+        f"over the grid. The reference took {reference_seconds:.1f} s in all.",
         f"Timings are medians of repeats ({repeats_text(config.quick)}). Fixed steps are set as "
         "h = tau / n, tau = 2 pi / (|omega0| max(1, max |I_j - I_k| / I_i)), "
         f"n in {list(config.steps_per_scale)}; tolerances rtol in {tolerances} (atol = rtol "

@@ -8,7 +8,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from poinsot.app.report.formatting import csv_float
-from poinsot.app.report.study import CaseResult
+from poinsot.app.report.measure.study import CaseResult
 
 __all__ = ["ERROR_VS_TIME_COLUMNS", "EXACT", "WORK_PRECISION_COLUMNS", "write_csvs"]
 

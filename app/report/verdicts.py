@@ -9,8 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from poinsot.app.report.formatting import sig
-from poinsot.app.report.runs import IntegratorRun
-from poinsot.app.report.study import CaseResult
+from poinsot.app.report.measure.runs import IntegratorRun
+from poinsot.app.report.measure.study import CaseResult
 from poinsot.physics.integrators import INTEGRATORS
 
 __all__ = ["ACCURACY_LEVELS", "Verdict", "observed_order", "verdict"]

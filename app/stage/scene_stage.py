@@ -1,16 +1,16 @@
 """A scene on a viser server's shared scene, with no control panel and no session: what
 ``poinsot screenshot --scene`` photographs and ``poinsot export-html --scene`` records.
 
-The same :class:`~poinsot.app.scenes.runtime.Showcase` a live session draws, driven by explicit
-times (like :class:`poinsot.app.stage.served.Stage` for the presets), so that a picture at time
-T or a clip of S seconds is reproducible.
+The same :class:`~poinsot.app.lessons.support.runtime.Showcase` a live session draws, driven by
+explicit times (like :class:`poinsot.app.stage.served.Stage` for the presets), so that a picture at
+time T or a clip of S seconds is reproducible.
 """
 
 from __future__ import annotations
 
-from poinsot.app.scene.batch import Frame
-from poinsot.app.scenes.runtime import Showcase
-from poinsot.app.scenes.spec import SceneSpec, Settings
+from poinsot.app.construction.sampled.batch import Frame
+from poinsot.app.lessons.support.runtime import Showcase
+from poinsot.app.lessons.support.spec import SceneSpec, Settings
 from poinsot.app.stage.served import (
     ClientOf,
     ServedStage,

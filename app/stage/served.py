@@ -2,9 +2,9 @@
 with no control panel and no session.
 
 What the standalone HTML export records and what ``poinsot screenshot`` photographs: the same
-:class:`~poinsot.app.scene.construction.PoinsotScene` the live app draws for each browser, driven
-here by explicit times instead of a clock, so that a picture at time T or a clip of S seconds is
-reproducible.
+:class:`~poinsot.app.construction.construction.PoinsotScene` the live app draws for each browser,
+driven here by explicit times instead of a clock, so that a picture at time T or a clip of S seconds
+is reproducible.
 """
 
 from __future__ import annotations
@@ -20,14 +20,14 @@ from typing import Self
 import numpy as np
 import viser
 
-from poinsot.app.elements import Element, Solid
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import Preset
-from poinsot.app.scene import palette
-from poinsot.app.scene.batch import Frame
-from poinsot.app.scene.construction import PoinsotScene
-from poinsot.app.scene.labels import Camera
-from poinsot.app.scene.view import View, apply_lighting, configure_theme
+from poinsot.app.construction import palette
+from poinsot.app.construction.construction import PoinsotScene
+from poinsot.app.construction.labels.layout import Camera
+from poinsot.app.construction.sampled.batch import Frame
+from poinsot.app.construction.view import View, apply_lighting, configure_theme
+from poinsot.app.model.elements import Element, Solid
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import Preset
 
 #: Largest step of simulation time between two trail updates while seeking [time units]. The
 #: scene resamples every step by chord length (at most 48 points a step), so this only bounds

@@ -108,10 +108,59 @@ from poinsot.app.viser_private.page import (
     handshake_origin,
     page_address,
 )
+from poinsot.app.viser_private.scene import (
+    CACHED_HINTS,
+    NODE_FIELDS,
+    cache_property_hints,
+    node_state,
+    queue_orientation,
+    queue_position,
+    queue_props,
+)
+from poinsot.app.viser_private.transport import (
+    BUFFER_FIELDS,
+    SetOnItsLoop,
+    broadcasts_woken_on_their_loop,
+    closed,
+    connection_of,
+    last_queued,
+    last_taken,
+    message_buffer,
+    pending,
+    quiet_if_closed,
+    senders_woken_on_their_loop,
+    set_on_its_loop_only,
+)
 from poinsot.app.viser_private.version import VISER_SERIES, ViserChanged
 
 __all__ = [
     "ALLOWED",
+    "BUFFER_FIELDS",
+    "CACHED_HINTS",
+    "NODE_FIELDS",
+    "SetOnItsLoop",
+    "broadcasts_woken_on_their_loop",
+    "cache_property_hints",
+    "closed",
+    "connection_of",
+    "last_queued",
+    "last_taken",
+    "message_buffer",
+    "node_state",
+    "pending",
+    "queue_orientation",
+    "queue_position",
+    "queue_props",
+    "quiet_if_closed",
+    "senders_woken_on_their_loop",
+    "set_on_its_loop_only",
+    "connection_count",
+    "infra",
+    "live_connection_ids",
+    "store_value",
+    "stored_value",
+    "upload_states",
+    "wire_message",
     "LOCAL_STORAGE_PREFIX",
     "VISER_SERIES",
     "GetRenderResponse",
@@ -145,6 +194,11 @@ def live_connection(server: viser.ViserServer, client_id: int) -> ServerConnecti
 def connection_count(server: viser.ViserServer) -> int:
     """The websocket connections viser holds state for (live ones, or leaked ones)."""
     return len(infra(server)._client_state_from_id)
+
+
+def live_connection_ids(server: viser.ViserServer) -> list[int]:
+    """The client ids viser holds a live websocket connection for."""
+    return list(infra(server)._live_connections)
 
 
 def wrap_recv(
@@ -183,6 +237,18 @@ def gui_widget(gui: viser.GuiApi, uuid: str) -> Any:
 def handle_id(handle: Any) -> str:
     """The wire id of a GUI handle (viser 1.1 keeps it in ``handle._impl.uuid``)."""
     return str(handle._impl.uuid)
+
+
+def stored_value(handle: Any) -> Any:
+    """The value viser holds for a GUI widget (what the browser sent last, before or without
+    the widget's callbacks: ``handle.value`` may be a callback's view of it)."""
+    return handle._impl.value
+
+
+def store_value(handle: Any, value: Any) -> None:
+    """Store ``value`` as viser does when a browser's update arrives, before the callbacks run
+    (nothing is sent, no callback runs)."""
+    handle._impl.value = value
 
 
 def upload_states(gui: viser.GuiApi) -> dict[str, Any]:

@@ -9,7 +9,7 @@ private names (:mod:`poinsot.app.viser_private`, whose docstring has the invento
 - :func:`connection_of`: ``ClientHandle._viser_server._websock_server`` with its
   ``_live_connections`` (client id -> websockets connection) and ``_background_event_loop``;
 - :func:`set_on_its_loop_only`: a buffer's ``message_event`` (an ``asyncio.Event``) and
-  ``event_loop``, the event made one that only its loop sets (:class:`_SetOnItsLoop`: viser
+  ``event_loop``, the event made one that only its loop sets (:class:`SetOnItsLoop`: viser
   also sets it from the pushing thread, which races with the sender's wait);
 
 Both answer None rather than raise when a name has moved (the pacer then never skips, and the
@@ -81,7 +81,7 @@ def quiet_if_closed(buffer: Any) -> AbstractContextManager[None]:
     return buffer.sanctioned_dead_writes()
 
 
-class _SetOnItsLoop(asyncio.Event):
+class SetOnItsLoop(asyncio.Event):
     """A send queue's message event, set only on the queue's own event loop. viser's buffer sets
     its event where a message is pushed, any thread, and again on its loop
     (``call_soon_threadsafe``, at once or when an atomic block ends), which is what wakes the
@@ -101,15 +101,15 @@ class _SetOnItsLoop(asyncio.Event):
 
 def set_on_its_loop_only(buffer: Any) -> bool:
     """Make ``buffer``'s ``message_event`` (an ``asyncio.Event``, woken on ``event_loop``) a
-    :class:`_SetOnItsLoop`, in place (the sender waiting on it keeps waiting on it). False if
+    :class:`SetOnItsLoop`, in place (the sender waiting on it keeps waiting on it). False if
     viser's buffer no longer has them (nothing changed then)."""
     event = getattr(buffer, "message_event", None)
     loop = getattr(buffer, "event_loop", None)
     if not isinstance(event, asyncio.Event) or not isinstance(loop, asyncio.AbstractEventLoop):
         return False
-    if not isinstance(event, _SetOnItsLoop):
-        event.__class__ = _SetOnItsLoop
-    assert isinstance(event, _SetOnItsLoop)
+    if not isinstance(event, SetOnItsLoop):
+        event.__class__ = SetOnItsLoop
+    assert isinstance(event, SetOnItsLoop)
     event.owner = loop
     return True
 

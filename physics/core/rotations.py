@@ -3,7 +3,7 @@ axis-angle quaternions and the geodesic angle between attitudes.
 
 Quaternions are **scalar-last**, ``(x, y, z, w)``, as in ``scipy.spatial.transform.Rotation``
 (``as_quat``). viser's scalar-first ``wxyz`` is converted in exactly one place, the app's
-:mod:`poinsot.app.scene.frames`.
+:mod:`poinsot.app.construction.sampled.frames`.
 
 The component functions (:func:`hamilton`, :func:`rotate_vector`, :func:`conjugate`,
 :func:`axis_angle`) take quaternions as 4-sequences of *anything that has + and ×*: Python

@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from poinsot.app.arguments import in_bounds
+from poinsot.app.cli.arguments import in_bounds
 
 
 @pytest.mark.parametrize("text", ["0", "0.5", "1"])

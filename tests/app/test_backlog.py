@@ -1,5 +1,5 @@
 """The per-client bounds: what a client leaves untaken (app/live/hardening/backlog.py) and the
-actions a session has queued (app/live/ui/actions.py). Counts and events only, never wall-clock
+actions a session has queued (app/live/session/actions.py). Counts and events only, never wall-clock
 bounds."""
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ import types
 
 from conftest import session_of, wait_until
 
+from poinsot.app.devtools.probe import Probe
 from poinsot.app.live.hardening.backlog import BacklogLimit, BacklogWatch
-from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.live.server import PoinsotApp
-from poinsot.app.live.ui.session import Session
+from poinsot.app.live.session.session import Session
 
 FAST = 0.05  # the watch's poll in these tests [s]: sooner events, same rules
 

@@ -8,7 +8,7 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from poinsot.app.bodies import (
+from poinsot.app.model.bodies import (
     BUNDLED,
     MAX_MESH_BYTES,
     MeshError,

@@ -16,8 +16,8 @@ import pytest
 from conftest import session_of, wait_until
 from scipy.integrate import solve_ivp
 
-from poinsot.app.live.ui import challenges
-from poinsot.app.live.ui.challenge_set import AXES, OUTCOMES, challenge_set, parse_time
+from poinsot.app.live.lecture import challenges
+from poinsot.app.live.lecture.challenge_set import AXES, OUTCOMES, challenge_set, parse_time
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.models.flip import integrated_flip_times
 from poinsot.physics.models.twins import measured_lag

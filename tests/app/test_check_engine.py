@@ -12,9 +12,9 @@ from conftest import session_of, wait_until
 from test_server import markdown_texts
 from uploading import upload
 
-from poinsot.app.cli import main
-from poinsot.app.engine_logs import write_engine_log
-from poinsot.app.live.ui.engine_upload import BUTTON, MOMENTS
+from poinsot.app.cli.main import main
+from poinsot.app.live.panel.engine_upload import BUTTON, MOMENTS
+from poinsot.app.model.engine_logs import write_engine_log
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.integrators import integrate
 

@@ -9,8 +9,8 @@ import sys
 
 import pytest
 
-from poinsot.app import cli
-from poinsot.app.load import cli as load_cli
+from poinsot.app.cli import main as cli
+from poinsot.app.devtools.load import cli as load_cli
 
 
 def _run_main(main, argv: list[str], capsys) -> tuple[int, str]:
@@ -128,7 +128,7 @@ def test_a_bad_argument_is_one_line_and_status_2(argv, prog, tmp_path, recording
     assert not list(tmp_path.glob("x.*")), "nothing is written for a refused command"
 
 
-LOAD = "python -m poinsot.app.load"
+LOAD = "python -m poinsot.app.devtools.load"
 BAD_LOAD = [
     ["--clients", "0"],
     ["--clients", "many"],

@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 from uploading import TOSS_INERTIA, expected_moments, toss_recording
 
-from poinsot.app import cli
+from poinsot.app.cli import main as cli
 from poinsot.physics.fit import synthetic_toss
 
 
 def poinsot(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "poinsot.app.cli", "fit", *args],
+        [sys.executable, "-m", "poinsot.app.cli.main", "fit", *args],
         capture_output=True,
         text=True,
         timeout=120,
@@ -28,7 +28,7 @@ def poinsot(*args: str) -> subprocess.CompletedProcess[str]:
 
 @pytest.fixture
 def in_process(capsys):
-    """``poinsot fit ARGS`` through :func:`poinsot.app.cli.main` in this process, as a
+    """``poinsot fit ARGS`` through :func:`poinsot.app.cli.main.main` in this process, as a
     finished process: its exit status (argparse's too) and what it printed."""
 
     def run(*args: str) -> subprocess.CompletedProcess[str]:

@@ -1,5 +1,5 @@
-"""The phone's and tablet's page (app/live/ui/layout.py): who gets it, and the camera that frames
-the whole construction for the screen's shape (app/scene/cameras.framed)."""
+"""The phone's and tablet's page (app/live/lecture/layout.py): who gets it, and the camera that
+frames the whole construction for the screen's shape (app/construction/cameras.framed)."""
 
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from conftest import session_of, wait_until
 
-from poinsot.app.live.ui.layout import compact_aspect, touch_agent
-from poinsot.app.presets import DEFAULT_PRESET
-from poinsot.app.scene.cameras import construction_points, framed, sphere_points
-from poinsot.app.scene.view import DEFAULT_VIEW, View
-from poinsot.app.scenes import scene_by_name
+from poinsot.app.construction.cameras import construction_points, framed, sphere_points
+from poinsot.app.construction.view import DEFAULT_VIEW, View
+from poinsot.app.lessons import scene_by_name
+from poinsot.app.live.lecture.layout import compact_aspect, touch_agent
+from poinsot.app.model.presets import DEFAULT_PRESET
 
 
 def _projected(view, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1,4 +1,4 @@
-"""``python -m poinsot.app.compare``: parsing the benchmarks' text, the ratios and their
+"""``python -m poinsot.app.devtools.compare``: parsing the benchmarks' text, the ratios and their
 verdicts, and running two revisions of a repository from a temporary git worktree.
 
 Everything but the last test runs on canned outputs or on a tiny git repository whose
@@ -14,12 +14,12 @@ from pathlib import Path
 
 import pytest
 
-from poinsot.app import benchmark as app_benchmark
-from poinsot.app import compare
-from poinsot.app.compare import COST, RATE, Ratio
+from poinsot.app.devtools import benchmark as app_benchmark
+from poinsot.app.devtools import compare
+from poinsot.app.devtools.compare import COST, RATE, Ratio
 from poinsot.physics.tools import benchmark as physics_benchmark
 
-REPO = Path(compare.__file__).resolve().parents[1]
+REPO = Path(compare.__file__).resolve().parents[3]
 
 
 def physics_text(omega_ns: float = 25.0, construct_ms: float = 0.050) -> str:
@@ -257,7 +257,10 @@ def test_the_working_tree_runs_against_an_older_layout_from_a_temporary_worktree
 def test_a_namespaced_tree_imports_its_own_folders_not_the_installed_package(tmp_path):
     _write_layout(tmp_path, True, "physics", "app")
     tree = compare.prepare(tmp_path, tmp_path / "scratch")
-    assert tree.namespaced and tree.module("app") == "poinsot.app.benchmark"
+    assert tree.namespaced and tree.module("app") == "poinsot.app.benchmark"  # the older place
+    (tmp_path / "app" / "devtools").mkdir()
+    (tmp_path / "app" / "devtools" / "benchmark.py").write_text("")
+    assert tree.module("app") == "poinsot.app.devtools.benchmark"  # today's, where it is
     done = subprocess.run(
         [compare.sys.executable, "-c", "import poinsot.physics.canned as c; print(c.__file__)"],
         cwd=tree.root,

@@ -20,15 +20,15 @@ import trimesh
 import zstandard
 from PIL import Image
 
-from poinsot.app import cli
+from poinsot.app.cli import main as cli
+from poinsot.app.construction.cameras import BODY_VIEW, ride_along, space_view
+from poinsot.app.construction.geometry import HERPOLHODE_LIFT, POLHODE_INFLATE, Geometry
+from poinsot.app.construction.sampled.frames import wxyz, xyzw_from_wxyz
+from poinsot.app.construction.view import VIEWS
 from poinsot.app.exports import chromium, glb, run_csv, screenshot
 from poinsot.app.exports import html as html_export
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import PRESETS, preset_by_key
-from poinsot.app.scene.cameras import BODY_VIEW, ride_along, space_view
-from poinsot.app.scene.frames import wxyz, xyzw_from_wxyz
-from poinsot.app.scene.geometry import HERPOLHODE_LIFT, POLHODE_INFLATE, Geometry
-from poinsot.app.scene.view import VIEWS
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import PRESETS, preset_by_key
 from poinsot.physics.core import rotations
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -36,7 +36,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CLOSE = 1e-12
 #: glTF stores vertices as float32: positions of size ~1 round to ~6e-8.
 FLOAT32 = 1e-6
-#: The ellipsoid mesh is an icosphere with chord error ~2e-3 of the radius (app/scene/meshes.py).
+#: The ellipsoid mesh is an icosphere with chord error ~2e-3 of the radius
+# (app/construction/meshes.py).
 MESH_CHORD = 3e-3
 
 

@@ -1,6 +1,6 @@
 """Follow the lecturer: a lead, its followers on two workers, and what a follower may not do.
 
-Headless probes stand for the browsers (:mod:`poinsot.app.live.hardening.probe`); every wait is on
+Headless probes stand for the browsers (:mod:`poinsot.app.devtools.probe`); every wait is on
 an event the probes receive (a widget's value, a readout's text), never on wall-clock time.
 """
 
@@ -15,13 +15,13 @@ from typing import Any
 
 import pytest
 
-from poinsot.app.elements import Element
-from poinsot.app.live.hardening.probe import Probe
+from poinsot.app.construction.sampled.motion import KEPT_BATCHES
+from poinsot.app.devtools.probe import Probe
+from poinsot.app.live.classroom import links
+from poinsot.app.live.classroom.follow import ENDED, MAX_WRONG_CODES, FollowHub, LeadState
+from poinsot.app.live.classroom.lead import HELD
 from poinsot.app.live.relay import Relay
-from poinsot.app.live.ui import links
-from poinsot.app.live.ui.follow import ENDED, MAX_WRONG_CODES, FollowHub, LeadState
-from poinsot.app.live.ui.lead import HELD
-from poinsot.app.scene.motion import KEPT_BATCHES
+from poinsot.app.model.elements import Element
 from poinsot.app.viser_private import wire_message
 from tests.app.test_workers import start_classroom, stop_classroom
 from tests.conftest import after_frames, session_of, wait_until

@@ -1,6 +1,6 @@
-"""The numerical ghost (app/scene/ghost.py and its controls, app/live/ui/ghost_controls.py),
-server-side on a real ViserServer(port=0) observed through the websocket probe, and once in a
-real browser.
+"""The numerical ghost (app/construction/ghost/ghost.py and its controls,
+app/live/panel/ghost_controls.py), server-side on a real ViserServer(port=0) observed through the
+websocket probe, and once in a real browser.
 
 Layers: nothing exists until the ghost is switched on, and everything goes when it is switched
 off; what travels per frame; the readout and the plot; restarts (method, setting, Reset, a new
@@ -19,16 +19,16 @@ import viser
 from conftest import session_of, wait_until
 from scipy.spatial.transform import Rotation
 
-from poinsot.app.live.ui.ghost_controls import METHOD_LABELS
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import DEFAULT_PRESET, preset_by_key
-from poinsot.app.scene import ghost as ghost_module
-from poinsot.app.scene.batch import Frame
-from poinsot.app.scene.frames import wxyz_from_xyzw
-from poinsot.app.scene.geometry import Geometry
-from poinsot.app.scene.ghost import Ghost, GhostErrors
-from poinsot.app.scene.ghost_setting import DEFAULT_TOLERANCE, GhostConfig, time_scale
-from poinsot.app.scene.sampling import evaluate
+from poinsot.app.construction.geometry import Geometry
+from poinsot.app.construction.ghost import ghost as ghost_module
+from poinsot.app.construction.ghost.ghost import Ghost, GhostErrors
+from poinsot.app.construction.ghost.setting import DEFAULT_TOLERANCE, GhostConfig, time_scale
+from poinsot.app.construction.sampled.batch import Frame
+from poinsot.app.construction.sampled.frames import wxyz_from_xyzw
+from poinsot.app.construction.sampled.sampling import evaluate
+from poinsot.app.live.panel.ghost_controls import METHOD_LABELS
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import DEFAULT_PRESET, preset_by_key
 from poinsot.physics.core.rotations import geodesic_angle, rotate_vector
 from poinsot.physics.integrators import METHODS, State
 

@@ -1,7 +1,7 @@
-"""The labels' layout as a frame carries it (app/scene/labels.py, app/live/ui/display.py): its
-shortcuts choose what the plain sums choose, it runs in steps that send only at their end, and
-a frame takes at most one step, never on a frame that sends the traces or the plot. Counts and
-events only, never wall-clock bounds."""
+"""The labels' layout as a frame carries it (app/construction/labels/layout.py,
+app/live/lecture/display.py): its shortcuts choose what the plain sums choose, it runs in steps that
+send only at their end, and a frame takes at most one step, never on a frame that sends the traces
+or the plot. Counts and events only, never wall-clock bounds."""
 
 from __future__ import annotations
 
@@ -13,13 +13,13 @@ import pytest
 import viser
 from conftest import record_messages, session_of, wait_until
 
-from poinsot.app.live.ui import display
-from poinsot.app.live.ui.session import PLOT_MIN_FRAMES
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import DEFAULT_PRESET
-from poinsot.app.scene import labels
-from poinsot.app.scene.construction import TRAIL_EVERY, PoinsotScene
-from poinsot.app.scene.labels import Camera, finish
+from poinsot.app.construction.construction import TRAIL_EVERY, PoinsotScene
+from poinsot.app.construction.labels import layout as labels
+from poinsot.app.construction.labels.layout import Camera, finish
+from poinsot.app.live.lecture import display
+from poinsot.app.live.session.session import PLOT_MIN_FRAMES
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import DEFAULT_PRESET
 
 
 def _reference_choice(boxes: np.ndarray, reach: np.ndarray) -> tuple[list[int], list[float]]:

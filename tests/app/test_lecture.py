@@ -1,5 +1,5 @@
 """The lecture panel of a live session, driven by a headless websocket client
-(app/live/hardening/probe.py): the CSV and GLB buttons hand files to the browser that parse back to
+(app/devtools/probe.py): the CSV and GLB buttons hand files to the browser that parse back to
 the session's body and time, and a screenshot that the client never renders ends in a message in the
 panel, not a hang. (The real-browser side is in browser/test_exports_page.py.)"""
 
@@ -140,8 +140,8 @@ def test_a_view_chosen_during_a_ride_along_frame_is_the_last_camera_sent(live, m
     """Key 3 pressed (viser's thread) while the frame thread is between its ride-along check
     and sending that camera: the chosen view must still be the last camera the browser gets
     (it was not: the ride-along camera landed after it and the browser stayed on the ride)."""
-    from poinsot.app.live.ui import lecture as lecture_module
-    from poinsot.app.scene.cameras import space_view
+    from poinsot.app.construction.cameras import space_view
+    from poinsot.app.live.lecture import lecture as lecture_module
 
     _, _, session = live
     controls = lecture_of(session)

@@ -11,10 +11,11 @@ import numpy as np
 import pytest
 from conftest import session_of, wait_until
 
-from poinsot.app.live.ui.panel import D_STEP
-from poinsot.app.live.ui.widgets import Shelf
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import preset_by_key
+from poinsot.app import viser_private
+from poinsot.app.live.panel.panel import D_STEP
+from poinsot.app.live.panel.widgets import Shelf
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import preset_by_key
 from poinsot.physics import Regime
 
 
@@ -107,7 +108,7 @@ def test_the_shelf_hides_keeps_and_gives_back():
 def test_switching_sphere_and_custom_deletes_no_panel_widget(poinsot_app, probe):
     """The browser logs an error for an update that reaches a deleted widget; the panel's
     widgets are only hidden and shown, so the widgets it ever made are all still there."""
-    from poinsot.app.presets import CUSTOM
+    from poinsot.app.model.presets import CUSTOM
 
     session = session_of(poinsot_app)
     removed: list[str] = []
@@ -134,8 +135,8 @@ def test_a_callback_reads_the_users_value_not_a_later_server_write(make_probe):
 
     import viser
 
-    from poinsot.app.live.hardening.probe import Probe
-    from poinsot.app.live.ui.widgets import on_user
+    from poinsot.app.devtools.probe import Probe
+    from poinsot.app.live.panel.widgets import on_user
 
     server = viser.ViserServer("127.0.0.1", 0, verbose=False)
     try:
@@ -167,7 +168,7 @@ def test_a_preset_shown_late_does_not_overwrite_the_users_newer_choice():
     read the server's value, and viser dropped the user's next choice as "unchanged"."""
     import viser
 
-    from poinsot.app.live.ui.widgets import Sent, on_user, write_unless_newer
+    from poinsot.app.live.panel.widgets import Sent, on_user, write_unless_newer
 
     server = viser.ViserServer("127.0.0.1", 0, verbose=False)
     try:
@@ -189,9 +190,11 @@ def test_a_preset_shown_late_does_not_overwrite_the_users_newer_choice():
         menu.count += 1  # the browser chose again since (recorded)
         written("Major", count)
         assert dropdown.value == "Custom"
-        dropdown._impl.value = "Sphere"  # stored by viser, not yet recorded by the callback
+        viser_private.store_value(
+            dropdown, "Sphere"
+        )  # stored by viser, not yet recorded by the callback
         written("Major", menu.count)
-        assert dropdown._impl.value == "Sphere"
+        assert viser_private.stored_value(dropdown) == "Sphere"
         assert errors == []
     finally:
         server.stop()
@@ -212,9 +215,9 @@ def test_after_a_stall_no_trace_segment_cuts_through_the_body(stall):
     exact solution after 2 s, lifted after 60 s), then frames again: every polhode segment
     stays on the ellipsoid within the margin it is drawn off it, every herpolhode segment is a
     short chord."""
-    from poinsot.app.elements import Element
-    from poinsot.app.scene.geometry import POLHODE_INFLATE
-    from poinsot.app.scene.motion import MAX_CHORD
+    from poinsot.app.construction.geometry import POLHODE_INFLATE
+    from poinsot.app.construction.sampled.motion import MAX_CHORD
+    from poinsot.app.model.elements import Element
     from poinsot.app.stage.served import Stage
 
     with Stage.from_preset(preset_by_key("major"), trail_points=6000) as stage:
@@ -234,7 +237,7 @@ def test_after_a_stall_no_trace_segment_cuts_through_the_body(stall):
 
 # -- labels laid out for a camera -----------------------------------------------------------
 def _camera(position, look_at=(0.0, 0.0, 0.0), up=(0.0, 0.0, 1.0)):
-    from poinsot.app.scene.labels import Camera
+    from poinsot.app.construction.labels.layout import Camera
 
     return Camera(
         np.array(position, float),
@@ -249,7 +252,7 @@ def _camera(position, look_at=(0.0, 0.0, 0.0), up=(0.0, 0.0, 1.0)):
 def test_labels_whose_points_meet_on_screen_get_boxes_apart():
     """Seen along L, the tips of L and ω and the end of axis 3 fall on one spot: their boxes
     still do not overlap, nor cover the contact point's marker."""
-    from poinsot.app.scene.labels import Slot, lay_out, overlapping
+    from poinsot.app.construction.labels.layout import Slot, lay_out, overlapping
 
     camera = _camera((0.0, -0.01, 5.4), up=(0.0, 1.0, 0.0))
     top, contact = np.array([0.0, 0.0, 1.3]), np.array([0.05, 0.0, 0.65])
@@ -285,7 +288,7 @@ def test_labels_whose_points_meet_on_screen_get_boxes_apart():
 
 def test_a_label_goes_beyond_its_tip():
     """An axis pointing right on screen: its label's box lies right of its point."""
-    from poinsot.app.scene.labels import Slot, lay_out
+    from poinsot.app.construction.labels.layout import Slot, lay_out
 
     camera = _camera((0.0, -5.0, 0.0))
     tip = np.array([1.0, 0.0, 0.0])
@@ -298,7 +301,7 @@ def test_a_label_box_is_as_wide_as_the_browser_draws_it():
     """ω is wider than a Latin letter: Chromium draws ω's box at font scale 1.4 18-19 CSS px
     wide (the mean advance of a letter gave 13.3 px, and ω's box then touched the herpolhode's
     label beside it); a Latin letter's stays at the mean."""
-    from poinsot.app.scene.labels import box_size
+    from poinsot.app.construction.labels.layout import box_size
 
     assert box_size("ω", 1.4)[0] >= 19.0
     assert box_size("L", 1.4)[0] == pytest.approx(13.272)
@@ -307,9 +310,9 @@ def test_a_label_box_is_as_wide_as_the_browser_draws_it():
 
 # -- the legend and the caption --------------------------------------------------------------
 def test_the_legend_lists_the_declared_elements_in_the_looks_colours():
-    from poinsot.app.elements import ALL_ELEMENTS, TRACE_ELEMENTS
-    from poinsot.app.live.ui.legend import entries, legend_html
-    from poinsot.app.scene import palette
+    from poinsot.app.construction import palette
+    from poinsot.app.live.panel.legend import entries, legend_html
+    from poinsot.app.model.elements import ALL_ELEMENTS, TRACE_ELEMENTS
 
     for look in (palette.DARK, palette.LIGHT, palette.PROJECTOR_DARK):
         items = entries(ALL_ELEMENTS, look)
@@ -325,8 +328,8 @@ def test_the_legend_lists_the_declared_elements_in_the_looks_colours():
 def test_every_preset_has_a_caption_and_a_scene_can_set_its_own():
     import dataclasses
 
-    from poinsot.app.live.ui.legend import CAPTIONS, caption
-    from poinsot.app.presets import MENU, PRESETS
+    from poinsot.app.live.panel.legend import CAPTIONS, caption
+    from poinsot.app.model.presets import MENU, PRESETS
 
     for preset in PRESETS:
         assert caption(preset) == CAPTIONS[preset.key]
@@ -338,8 +341,8 @@ def test_every_preset_has_a_caption_and_a_scene_can_set_its_own():
 
 # -- one vocabulary for views; --help shows the defaults -----------------------------------
 def test_the_views_have_one_name_in_the_browser_and_on_the_command_line():
-    from poinsot.app.cli import build_parser
-    from poinsot.app.scene.cameras import CAMERA_NAMES, canonical
+    from poinsot.app.cli.main import build_parser
+    from poinsot.app.construction.cameras import CAMERA_NAMES, canonical
 
     assert CAMERA_NAMES == ("default", "along-L", "side", "ride-along")
     parser = build_parser()
@@ -354,7 +357,7 @@ def test_the_views_have_one_name_in_the_browser_and_on_the_command_line():
     "command", [[], ["serve"], ["report"], ["screenshot"], ["export-html"], ["benchmark"], ["fit"]]
 )
 def test_help_shows_the_defaults_and_no_backticks(command, capsys):
-    from poinsot.app.cli import build_parser
+    from poinsot.app.cli.main import build_parser
 
     with pytest.raises(SystemExit):
         build_parser().parse_args([*command, "--help"])
@@ -372,8 +375,8 @@ def test_an_inline_callback_sees_every_value_in_the_order_sent():
     a quick run of slider values reaches them all, in order, none read twice."""
     import viser
 
-    from poinsot.app.live.hardening.probe import Probe
-    from poinsot.app.live.ui.widgets import on_user
+    from poinsot.app.devtools.probe import Probe
+    from poinsot.app.live.panel.widgets import on_user
 
     server = viser.ViserServer("127.0.0.1", 0, verbose=False)
     try:

@@ -7,13 +7,13 @@ import urllib.parse
 
 import pytest
 
-from poinsot.app import cli
+from poinsot.app.cli import main as cli
+from poinsot.app.lessons import SCENES, scene_by_name
+from poinsot.app.lessons.support.spec import Slider
+from poinsot.app.live.classroom import links
+from poinsot.app.live.classroom.links import LinkError, opening, parse
 from poinsot.app.live.hardening import network
-from poinsot.app.live.ui import links
-from poinsot.app.live.ui.links import LinkError, opening, parse
-from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, preset_by_key
-from poinsot.app.scenes import SCENES, scene_by_name
-from poinsot.app.scenes.spec import Slider
+from poinsot.app.model.presets import CUSTOM, DEFAULT_PRESET, preset_by_key
 
 
 def test_a_preset_at_a_time_from_a_view():

@@ -7,9 +7,9 @@ import math
 
 import pytest
 
-from poinsot.app.live.ui.readouts import rows
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import PRESETS, Preset
+from poinsot.app.live.panel.readouts import rows
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import PRESETS, Preset
 from poinsot.physics import Regime
 from poinsot.physics.models.geometric_phase import wrap_angle
 

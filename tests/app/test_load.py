@@ -1,5 +1,5 @@
-"""The load test (``python -m poinsot.app.load``) at tiny sizes: every phase runs against a real
-server child on loopback and produces its figures, with the counts behind them; the goals are
+"""The load test (``python -m poinsot.app.devtools.load``) at tiny sizes: every phase runs against a
+real server child on loopback and produces its figures, with the counts behind them; the goals are
 judged from the figures and the bounds alone (met bounds give exit status 0, an impossible one
 gives 1). Counts and events are asserted, never the seconds the server took."""
 
@@ -12,13 +12,13 @@ import struct
 
 import pytest
 
-from poinsot.app.load import PHASES, Bounds, Config, Report, cli, exit_status, run
-from poinsot.app.load.config import server_processes
-from poinsot.app.load.figures import COMPLETES, Figure, at_least, at_most, percentile
-from poinsot.app.load.procfs import usage
-from poinsot.app.load.raw import client_frame
-from poinsot.app.load.server_process import error_lines, thread_kind
-from poinsot.app.load.storm import KINDS
+from poinsot.app.devtools.load import PHASES, Bounds, Config, Report, cli, exit_status, run
+from poinsot.app.devtools.load.config import server_processes
+from poinsot.app.devtools.load.figures import COMPLETES, Figure, at_least, at_most, percentile
+from poinsot.app.devtools.load.procfs import usage
+from poinsot.app.devtools.load.raw import client_frame
+from poinsot.app.devtools.load.server_process import error_lines, thread_kind
+from poinsot.app.devtools.load.workloads.storm import KINDS
 
 TINY = Config(
     clients=3,

@@ -10,9 +10,9 @@ import re
 import numpy as np
 from conftest import session_of, wait_until
 
-from poinsot.app.live.ui import neighbour
-from poinsot.app.presets import preset_by_key
-from poinsot.app.scenes.twins import TWIN_STEP
+from poinsot.app.lessons.twins import TWIN_STEP
+from poinsot.app.live.lecture import neighbour
+from poinsot.app.model.presets import preset_by_key
 from poinsot.physics.core.rotations import geodesic_angle
 
 

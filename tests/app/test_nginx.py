@@ -22,7 +22,7 @@ from unittest import mock
 import pytest
 import websockets.sync.client
 
-from poinsot.app.live.hardening.probe import Probe
+from poinsot.app.devtools.probe import Probe
 from poinsot.app.live.server import PoinsotApp
 from tests.conftest import in_ci, wait_until
 

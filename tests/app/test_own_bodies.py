@@ -8,12 +8,12 @@ import pytest
 from test_recordings import I_TRUE, three_throws
 from uploading import box_stl, phyphox_csv, toss_recording
 
-from poinsot.app import own_bodies
-from poinsot.app.bodies import bundled_body, load_mesh_body
-from poinsot.app.elements import Plot
-from poinsot.app.live.ui.overlay import Measured, merge
-from poinsot.app.parameters import SPEED_RANGE, Parameters
-from poinsot.app.presets import FITTED_TOSS, MENU, MESH_BODY, preset_by_key, preset_by_label
+from poinsot.app.live.panel.overlay import Measured, merge
+from poinsot.app.model import own_bodies
+from poinsot.app.model.bodies import bundled_body, load_mesh_body
+from poinsot.app.model.elements import Plot
+from poinsot.app.model.parameters import SPEED_RANGE, Parameters
+from poinsot.app.model.presets import FITTED_TOSS, MENU, MESH_BODY, preset_by_key, preset_by_label
 
 
 @pytest.mark.parametrize(

@@ -10,16 +10,16 @@ import warnings
 import viser
 from conftest import record_messages, session_of, wait_until
 
+from poinsot.app.construction.construction import TRAIL_EVERY, PoinsotScene
 from poinsot.app.live.hardening.pacing import (
     MAX_IN_FLIGHT,
     MAX_UNACKED,
     MIN_FPS,
     Pacer,
 )
-from poinsot.app.live.ui.frame_loop import next_due
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import DEFAULT_PRESET
-from poinsot.app.scene.construction import TRAIL_EVERY, PoinsotScene
+from poinsot.app.live.session.frame_loop import next_due
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import DEFAULT_PRESET
 
 
 class FakeOutbox:

@@ -14,14 +14,14 @@ import pytest
 from conftest import record_frame_times, session_of, wait_until
 from scipy.spatial.transform import Rotation
 
-from poinsot.app import cli
-from poinsot.app.elements import ALL_ELEMENTS, Element
-from poinsot.app.live.ui.clock import SimClock
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import CUSTOM, PRESETS, preset_by_key, preset_by_label
-from poinsot.app.scene.frames import rotation_from_wxyz, wxyz
-from poinsot.app.scene.meshes import solid_mesh
-from poinsot.app.scene.trail import Trail
+from poinsot.app.cli import main as cli
+from poinsot.app.construction.meshes import solid_mesh
+from poinsot.app.construction.sampled.frames import rotation_from_wxyz, wxyz
+from poinsot.app.construction.trail import Trail
+from poinsot.app.live.panel.clock import SimClock
+from poinsot.app.model.elements import ALL_ELEMENTS, Element
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import CUSTOM, PRESETS, preset_by_key, preset_by_label
 from poinsot.physics import Regime
 
 EXPECTED_REGIME = {
@@ -275,7 +275,7 @@ def test_cli_serves_the_page_and_prints_the_url(argv):
 
 
 @pytest.mark.parametrize(
-    "command", [[sys.prefix + "/bin/poinsot"], [sys.executable, "-m", "poinsot.app.cli"]]
+    "command", [[sys.prefix + "/bin/poinsot"], [sys.executable, "-m", "poinsot.app"]]
 )
 def test_console_script_and_module_forms_answer(command):
     out = subprocess.run([*command, "serve", "--help"], capture_output=True, text=True, timeout=30)
@@ -283,14 +283,14 @@ def test_console_script_and_module_forms_answer(command):
 
 
 def test_element_enum_matches_labels():
-    from poinsot.app.live.ui.panel import ELEMENT_LABELS
+    from poinsot.app.live.panel.panel import ELEMENT_LABELS
 
     assert set(ELEMENT_LABELS) == set(Element)
 
 
 # -- motion sampling and the frame budget ------------------------------------------------
 def test_motion_sampler_gives_the_exact_solution_at_grid_times_in_batches():
-    from poinsot.app.scene.sampling import BATCH, MotionSampler
+    from poinsot.app.construction.sampled.sampling import BATCH, MotionSampler
 
     body = Parameters.from_preset(preset_by_key("t_handle")).build()
     sampler = MotionSampler(body, step=0.01, stride=2, t0=0.5)
@@ -308,7 +308,11 @@ def test_motion_sampler_gives_the_exact_solution_at_grid_times_in_batches():
 
 
 def test_grid_step_keeps_trace_chords_short():
-    from poinsot.app.scene.sampling import STEPS_PER_FRAME, MotionSampler, trace_speed
+    from poinsot.app.construction.sampled.sampling import (
+        STEPS_PER_FRAME,
+        MotionSampler,
+        trace_speed,
+    )
 
     body = Parameters.from_preset(preset_by_key("major")).build()
     scale = 1.0 / float(np.max(body.semi_axes))
@@ -325,7 +329,7 @@ def test_grid_step_keeps_trace_chords_short():
 def test_a_rebuild_holds_the_other_sessions_frames_for_a_bounded_time(probe, poinsot_app):
     """While some session rebuilds (a slider moved), the others hold their frames so that the
     rebuild runs alone; a rebuild that never ends holds them at most HOLD_SECONDS each."""
-    from poinsot.app.live.ui.session import HOLD_SECONDS
+    from poinsot.app.live.session.session import HOLD_SECONDS
 
     session = session_of(poinsot_app)
     budget = poinsot_app.budget

@@ -12,7 +12,7 @@ import numpy as np
 from conftest import session_of, wait_until
 from scipy.spatial.transform import Rotation
 
-from poinsot.app.live.ui import plots
+from poinsot.app.live.panel import plots
 
 
 def _plot(session):

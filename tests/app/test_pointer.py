@@ -1,5 +1,5 @@
-"""A start pointed at on the live ellipsoid (app/live/ui/pointer.py): a click sets it, a drag draws
-the polhode through it and starts there on release, the separatrix is reached by hand, a miss
+"""A start pointed at on the live ellipsoid (app/live/pointing/pointer.py): a click sets it, a drag
+draws the polhode through it and starts there on release, the separatrix is reached by hand, a miss
 does nothing."""
 
 from __future__ import annotations
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from conftest import session_of, wait_until
 
-from poinsot.app.live.ui.pointer import SNAP_PX
-from poinsot.app.live.ui.session import Session
-from poinsot.app.scene.frames import rotation_from_wxyz
+from poinsot.app.construction.sampled.frames import rotation_from_wxyz
+from poinsot.app.live.pointing.pointer import SNAP_PX
+from poinsot.app.live.session.session import Session
 from poinsot.physics import FreeRigidBody, Regime
 
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from poinsot.app.bodies import MEASURED
-from poinsot.app.scenes.tennis_racket import BRODY_OPTION, SPEC, mesh_against_brody, racquet
+from poinsot.app.lessons.tennis_racket import BRODY_OPTION, SPEC, mesh_against_brody, racquet
+from poinsot.app.model.bodies import MEASURED
 
 
 def test_brody_is_a_body_beside_the_mesh() -> None:

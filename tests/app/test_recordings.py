@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from poinsot.app import recordings
-from poinsot.app.fitting import fit_segments, format_table, run_fit, to_json
-from poinsot.app.recordings import find_flights, read_recording, select_segments
+from poinsot.app.model import recordings
+from poinsot.app.model.fitting import fit_segments, format_table, run_fit, to_json
+from poinsot.app.model.recordings import find_flights, read_recording, select_segments
 from poinsot.physics import FreeRigidBody
 
 HEADER = ["Time (s)", "Gyroscope x (rad/s)", "Gyroscope y (rad/s)", "Gyroscope z (rad/s)"]

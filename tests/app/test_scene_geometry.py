@@ -1,6 +1,6 @@
 """The rolling is visibly right, checked on the geometry the browser actually receives.
 
-A websocket probe (app/live/hardening/probe.py) decodes viser's wire messages and rebuilds the scene
+A websocket probe (app/devtools/probe.py) decodes viser's wire messages and rebuilds the scene
 as the browser would: the ellipsoid mesh vertices, its node scale, the body pose, the plane height,
 the contact marker and the omega arrow. From those alone:
 - the ellipsoid mesh is the unit sphere scaled by the sent semi-axes;
@@ -18,11 +18,11 @@ import numpy as np
 import pytest
 from conftest import session_of, wait_until
 
-from poinsot.app.elements import Control
-from poinsot.app.live.hardening.probe import Probe
-from poinsot.app.presets import PRESETS
-from poinsot.app.scene.frames import rotation_from_wxyz
-from poinsot.app.scene.meshes import ELLIPSOID_SUBDIVISIONS
+from poinsot.app.construction.meshes import ELLIPSOID_SUBDIVISIONS
+from poinsot.app.construction.sampled.frames import rotation_from_wxyz
+from poinsot.app.devtools.probe import Probe
+from poinsot.app.model.elements import Control
+from poinsot.app.model.presets import PRESETS
 
 #: Wire floats: poses and scales travel as float64, mesh vertices and arrow points as float32.
 FLOAT32_REL = 2e-6

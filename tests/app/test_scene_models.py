@@ -12,15 +12,13 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from poinsot.app.cli import build_parser
-from poinsot.app.elements import Control
+from poinsot.app.cli.main import build_parser
+from poinsot.app.construction import palette
+from poinsot.app.construction.geometry import SceneDataError
+from poinsot.app.devtools.probe import Probe
 from poinsot.app.exports.html import scene_html
 from poinsot.app.exports.screenshot import resolve_scene
-from poinsot.app.live.hardening.probe import Probe
-from poinsot.app.presets import MENU, preset_by_key
-from poinsot.app.scene import palette
-from poinsot.app.scene.geometry import SceneDataError
-from poinsot.app.scenes import (
+from poinsot.app.lessons import (
     SCENES,
     dzhanibekov,
     explorer_1,
@@ -30,8 +28,10 @@ from poinsot.app.scenes import (
     scene_by_name,
     scene_names,
 )
-from poinsot.app.scenes.spec import Choice, Readout, SceneSpec, table
-from poinsot.app.scenes.tabulated import Player, Table
+from poinsot.app.lessons.support.spec import Choice, Readout, SceneSpec, table
+from poinsot.app.lessons.support.tabulated import Player, Table
+from poinsot.app.model.elements import Control
+from poinsot.app.model.presets import MENU, preset_by_key
 from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.app.stage.served import ServedStage, Stage
 
@@ -84,7 +84,7 @@ def test_each_scene_cites_listed_sources_and_declares_what_it_shares():
         cited = set(re.findall(r"\b([A-Z][A-Za-z]*\d\d)\b", spec.source))
         assert cited and cited <= listed, (spec.name, cited - listed)
         assert spec.shared <= {Control.SPEED, Control.PLAYBACK, Control.TRAIL, Control.VISIBILITY}
-        module = ROOT / "app" / "scenes" / (spec.name.replace("-", "_") + ".py")
+        module = ROOT / "app" / "lessons" / (spec.name.replace("-", "_") + ".py")
         assert module.is_file() and module.read_text().startswith('"""Scene "' + spec.name)
 
 

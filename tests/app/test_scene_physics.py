@@ -24,9 +24,9 @@ from scene_probing import (
     wait_readouts,
 )
 
-from poinsot.app.scene.geometry import POLHODE_INFLATE
-from poinsot.app.scenes import dzhanibekov, explorer_1, gyroscope_torque, scene_by_name
-from poinsot.app.scenes import polhode_family as family_scene
+from poinsot.app.construction.geometry import POLHODE_INFLATE
+from poinsot.app.lessons import dzhanibekov, explorer_1, gyroscope_torque, scene_by_name
+from poinsot.app.lessons import polhode_family as family_scene
 
 
 def body_frame_omega(nodes) -> np.ndarray:

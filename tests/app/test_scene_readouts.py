@@ -1,4 +1,4 @@
-"""The readout table of the scenes (``python -m poinsot.app.scenes.readouts``): it runs, covers
+"""The readout table of the scenes (``python -m poinsot.app.lessons.readouts``): it runs, covers
 every scene, and each row's gap between theory and measurement is within the tolerance its
 scene states; the gap it carries is the one the readout shows."""
 
@@ -10,8 +10,8 @@ import re
 
 import pytest
 
-from poinsot.app.scenes import SCENES, readouts
-from poinsot.app.scenes.spec import Readout
+from poinsot.app.lessons import SCENES, readouts
+from poinsot.app.lessons.support.spec import Readout
 
 NAMES = [spec.name for spec in SCENES]
 
@@ -78,7 +78,7 @@ def test_a_gap_beyond_the_tolerance_is_flagged() -> None:
 
 def test_the_readme_shows_the_table_of_every_row(tables) -> None:
     readme = (pathlib.Path(__file__).resolve().parents[2] / "README.md").read_text()
-    assert "python -m poinsot.app.scenes.readouts" in readme
+    assert "python -m poinsot.app.lessons.readouts" in readme
     start = readme.index(readouts.HEADER[0])
     shown = readme[start:].split("\n\n", 1)[0].splitlines()[2:]
     printed = readouts.markdown(tables).splitlines()[2:]

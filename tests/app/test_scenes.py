@@ -1,4 +1,4 @@
-"""The scenes (app/scenes) in the live server, observed through websocket probes: each creates
+"""The scenes (app/lessons) in the live server, observed through websocket probes: each creates
 exactly the nodes and widgets it declares, the menu switches between scenes and presets
 creating and removing exactly, bad input leaves a message and the last valid scene, and per
 frame only poses and trail increments are sent."""
@@ -20,11 +20,11 @@ from scene_probing import (
     visible_labels,
 )
 
-from poinsot.app.elements import Control, Element
-from poinsot.app.live.ui.panel import ELEMENT_LABELS
-from poinsot.app.presets import preset_by_key
-from poinsot.app.scenes import SCENES, scene_by_name
-from poinsot.app.scenes.spec import SceneSpec
+from poinsot.app.lessons import SCENES, scene_by_name
+from poinsot.app.lessons.support.spec import SceneSpec
+from poinsot.app.live.panel.panel import ELEMENT_LABELS
+from poinsot.app.model.elements import Control, Element
+from poinsot.app.model.presets import preset_by_key
 
 #: The panel's shared groups: their widgets' labels and the folder they go in.
 SHARED_LABELS: dict[Control, set[str]] = {

@@ -1,5 +1,5 @@
 """Server-side behaviour on a real ViserServer(port=0), observed through websocket probes that
-speak viser's protocol like a browser (app/live/hardening/probe.py): what is created, what is sent
+speak viser's protocol like a browser (app/devtools/probe.py): what is created, what is sent
 per frame, the frame rate, sessions, invalid input, and robustness."""
 
 from __future__ import annotations
@@ -12,13 +12,13 @@ import pytest
 from conftest import after_frames, record_frame_times, session_of, wait_until
 from test_scene_geometry import check_finite
 
-from poinsot.app.elements import Control, Element, Plot
-from poinsot.app.live.ui.display import LABEL_MIN_FRAMES
-from poinsot.app.live.ui.panel import ELEMENT_LABELS
-from poinsot.app.live.ui.session import MAX_FPS, STEP_SECONDS
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, PRESETS, preset_by_key
-from poinsot.app.scene.trail import CHUNK_SEGMENTS
+from poinsot.app.construction.trail import CHUNK_SEGMENTS
+from poinsot.app.live.lecture.display import LABEL_MIN_FRAMES
+from poinsot.app.live.panel.panel import ELEMENT_LABELS
+from poinsot.app.live.session.session import MAX_FPS, STEP_SECONDS
+from poinsot.app.model.elements import Control, Element, Plot
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import CUSTOM, DEFAULT_PRESET, PRESETS, preset_by_key
 
 #: Nodes each element creates (trail chunks "…/c<n>" come and go under their group).
 ELEMENT_NODES: dict[Element, set[str]] = {
@@ -406,7 +406,7 @@ def _session_threads() -> list[str]:
 def test_clients_that_leave_during_connect_leave_no_session(poinsot_app):
     """Connect and drop at once, 100 times (some drops land while the session is being built,
     some after it started): afterwards no session, no frame thread and no pending departure."""
-    from poinsot.app.live.hardening.probe import Probe
+    from poinsot.app.devtools.probe import Probe
 
     before = len(_session_threads())
     for i in range(100):

@@ -1,6 +1,6 @@
 """A start pointed at on Landau's momentum sphere in the polhode-family scene
-(app/live/ui/sphere_pointer.py): a click sets it at |L| kept, a drag draws the polhode through it
-on the sphere and on the ellipsoid and starts there on release, the separatrix is reached by
+(app/live/pointing/sphere_pointer.py): a click sets it at |L| kept, a drag draws the polhode through
+it on the sphere and on the ellipsoid and starts there on release, the separatrix is reached by
 hand, a miss does nothing, the D slider takes the motion back."""
 
 from __future__ import annotations
@@ -10,12 +10,12 @@ import pytest
 from conftest import wait_until
 from scene_probing import start
 
-from poinsot.app.live.ui.pointer import SNAP_PX, snap_length
-from poinsot.app.live.ui.session import Session
-from poinsot.app.scene.frames import rotation_from_wxyz
-from poinsot.app.scene.geometry import POLHODE_INFLATE
-from poinsot.app.scenes import scene_by_name
-from poinsot.app.scenes.polhode_family import INERTIA
+from poinsot.app.construction.geometry import POLHODE_INFLATE
+from poinsot.app.construction.sampled.frames import rotation_from_wxyz
+from poinsot.app.lessons import scene_by_name
+from poinsot.app.lessons.polhode_family import INERTIA
+from poinsot.app.live.pointing.pointer import SNAP_PX, snap_length
+from poinsot.app.live.session.session import Session
 from poinsot.physics import Regime
 
 I = np.asarray(INERTIA)  # noqa: E741 (the inertia tensor's usual name)

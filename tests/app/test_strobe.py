@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 
+from poinsot.app.construction.cameras import space_view
 from poinsot.app.exports.strobe import (
     DEFAULT_SPAN,
     Strobe,
@@ -17,9 +18,8 @@ from poinsot.app.exports.strobe import (
     default_interval,
     row_below,
 )
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import preset_by_key
-from poinsot.app.scene.cameras import space_view
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import preset_by_key
 
 
 def body(key: str):

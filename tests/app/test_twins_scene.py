@@ -14,8 +14,8 @@ import math
 import numpy as np
 import pytest
 
-from poinsot.app.scenes import dzhanibekov, scene_by_name
-from poinsot.app.scenes.twins import TWIN_STEP
+from poinsot.app.lessons import dzhanibekov, scene_by_name
+from poinsot.app.lessons.twins import TWIN_STEP
 from poinsot.app.stage.scene_stage import SceneStage
 from poinsot.physics import FreeRigidBody, attitude_with_L_along_z
 from poinsot.physics.core.rotations import geodesic_angle

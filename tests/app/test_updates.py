@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 import viser
 
-from poinsot.app.scene import updates
-from poinsot.app.viser_private import scene as private_scene
+from poinsot.app import viser_private
+from poinsot.app.construction import updates
 
 
 @pytest.fixture(scope="module")
@@ -116,7 +116,7 @@ def test_property_hints_are_looked_up_once_per_class(server: viser.ViserServer) 
     from viser import _assignable_props_api
 
     base = _assignable_props_api.AssignablePropsBase
-    assert base.__dict__["_prop_hints"] is private_scene.CACHED_HINTS
+    assert base.__dict__["_prop_hints"] is viser_private.CACHED_HINTS
     a = server.scene.add_label("/hints_a", "a")
     b = server.scene.add_label("/hints_b", "b")
     lines = server.scene.add_line_segments("/hints_c", np.zeros((1, 2, 3)), (0, 0, 0))
@@ -124,4 +124,4 @@ def test_property_hints_are_looked_up_once_per_class(server: viser.ViserServer) 
     assert a._prop_hints == typing.get_type_hints(type(a._impl.props))
     assert lines._prop_hints == typing.get_type_hints(type(lines._impl.props))
     updates.cache_property_hints()  # again: no change
-    assert base.__dict__["_prop_hints"] is private_scene.CACHED_HINTS
+    assert base.__dict__["_prop_hints"] is viser_private.CACHED_HINTS

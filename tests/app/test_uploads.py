@@ -25,12 +25,12 @@ from uploading import (
     toss_recording,
     upload,
 )
-from viser import _messages
 
-from poinsot.app import own_bodies
-from poinsot.app.bodies import bundled_body, load_mesh_body
-from poinsot.app.elements import Control, Plot
-from poinsot.app.presets import DEFAULT_PRESET, FITTED_TOSS, MESH_BODY, preset_by_key
+from poinsot.app import viser_private
+from poinsot.app.model import own_bodies
+from poinsot.app.model.bodies import bundled_body, load_mesh_body
+from poinsot.app.model.elements import Control, Plot
+from poinsot.app.model.presets import DEFAULT_PRESET, FITTED_TOSS, MESH_BODY, preset_by_key
 
 SLIDERS = ("I₁", "I₂", "I₃")
 
@@ -337,7 +337,7 @@ def test_a_file_over_the_cap_is_dropped_while_it_arrives(
     assert "long.csv is" in session.uploads.toss_lines.status
     assert "files up to 0.191 MB are accepted" in session.uploads.toss_lines.status
     assert wait_until(lambda: session.uploads.guard.dropped == 0, 10)  # every part answered
-    assert session.client.gui._current_file_upload_states == {}  # nothing kept in viser
+    assert viser_private.upload_states(session.client.gui) == {}  # nothing kept in viser
     assert work == []  # never parsed
     assert_kept(session, probe, before)
 
@@ -363,12 +363,18 @@ def test_the_browser_is_told_every_part_of_a_dropped_file_arrived(small_caps, to
     button, _ = probe.widget(RECORDING)
     parts = [content[i : i + PART] for i in range(0, len(content), PART)]
     probe.send(
-        _messages.FileTransferStartUpload(
-            button, transfer, "long.csv", "text/csv", len(parts), len(content)
+        viser_private.wire_message(
+            "FileTransferStartUpload",
+            button,
+            transfer,
+            "long.csv",
+            "text/csv",
+            len(parts),
+            len(content),
         )
     )
     for k, part in enumerate(parts):
-        probe.send(_messages.FileTransferPart(button, transfer, k, part))
+        probe.send(viser_private.wire_message("FileTransferPart", button, transfer, k, part))
     assert probe.wait_for(lambda p: len(acks) == len(parts), 10), acks
     assert acks[-1] == len(content)
 

@@ -12,7 +12,7 @@ import pytest
 from PIL import Image
 
 from poinsot.app.exports.video import Clip, check_clip, encoder, one_behind, rgb_on
-from poinsot.app.live.ui.video_export import fit_within
+from poinsot.app.live.lecture.video_export import fit_within
 
 
 def frames(count: int, size: tuple[int, int]) -> list[np.ndarray]:

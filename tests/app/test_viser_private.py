@@ -21,8 +21,6 @@ from viser import _messages
 from poinsot.app import viser_private
 from poinsot.app.live.hardening.guard import WireGuard
 from poinsot.app.live.hardening.transfers import handle_id
-from poinsot.app.viser_private import scene as private_scene
-from poinsot.app.viser_private import transport as private_transport
 
 WRITTEN_FOR = f"written for viser {viser_private.VISER_SERIES}.x, found viser {viser.__version__}"
 
@@ -124,8 +122,8 @@ def test_the_share_handlers_are_where_viser_put_them(make_app):
 def test_a_node_s_state_and_its_scene_queue_are_where_viser_put_them(make_app):
     server = make_app().server
     frame = server.scene.add_frame("/pinned", show_axes=False)
-    node = private_scene.node_state(frame)
-    missing = [name for name in private_scene.NODE_FIELDS if not hasattr(node, name)]
+    node = viser_private.node_state(frame)
+    missing = [name for name in viser_private.NODE_FIELDS if not hasattr(node, name)]
     assert not missing, f"{missing}: {WRITTEN_FOR}"
     assert callable(getattr(node.api, "_queue_scene_message", None)), WRITTEN_FOR
     for name, fields in _SCENE_MESSAGES.items():
@@ -145,7 +143,7 @@ _SCENE_MESSAGES = {
 def test_the_property_hints_patch_replaces_viser_s_per_handle_lookup():
     """viser 1.1 looks the hints up in ``AssignablePropsBase._prop_hints``, once per handle."""
     base = viser._assignable_props_api.AssignablePropsBase
-    assert base.__dict__.get("_prop_hints") is private_scene.CACHED_HINTS, WRITTEN_FOR
+    assert base.__dict__.get("_prop_hints") is viser_private.CACHED_HINTS, WRITTEN_FOR
     source = inspect.getsource(viser._assignable_props_api)
     assert "self._prop_hints" in source, WRITTEN_FOR
 
@@ -154,16 +152,16 @@ def test_the_property_hints_patch_replaces_viser_s_per_handle_lookup():
 def test_a_client_s_queue_and_socket_are_where_viser_put_them(poinsot_app, probe):
     session = session_of(poinsot_app)
     client = session.client
-    buffer = private_transport.message_buffer(client)
+    buffer = viser_private.message_buffer(client)
     assert buffer is not None, WRITTEN_FOR
-    assert private_transport.last_queued(buffer) >= 0, WRITTEN_FOR  # the scene was sent
-    taken = private_transport.last_taken(buffer, client.client_id)
-    assert taken is not None and taken <= private_transport.last_queued(buffer), WRITTEN_FOR
-    assert private_transport.pending(buffer) >= 0
-    assert private_transport.closed(buffer) is False, WRITTEN_FOR  # set once the client leaves
-    with private_transport.quiet_if_closed(buffer):  # viser's scope for benign dead writes
+    assert viser_private.last_queued(buffer) >= 0, WRITTEN_FOR  # the scene was sent
+    taken = viser_private.last_taken(buffer, client.client_id)
+    assert taken is not None and taken <= viser_private.last_queued(buffer), WRITTEN_FOR
+    assert viser_private.pending(buffer) >= 0
+    assert viser_private.closed(buffer) is False, WRITTEN_FOR  # set once the client leaves
+    with viser_private.quiet_if_closed(buffer):  # viser's scope for benign dead writes
         pass
-    connection, loop = private_transport.connection_of(client)
+    connection, loop = viser_private.connection_of(client)
     assert isinstance(connection, websockets.asyncio.server.ServerConnection), WRITTEN_FOR
     assert isinstance(loop, asyncio.AbstractEventLoop) and loop.is_running(), WRITTEN_FOR
     assert connection is viser_private.live_connection(poinsot_app.server, client.client_id)
@@ -188,23 +186,23 @@ def test_a_send_queue_is_woken_on_its_loop_only(poinsot_app, probe):
     queue have the event; set from another thread it is untouched, on its loop it wakes."""
     session = session_of(poinsot_app)
     buffers = [
-        private_transport.message_buffer(session.client),
+        viser_private.message_buffer(session.client),
         viser_private.infra(poinsot_app.server).get_message_buffer(),
     ]
     for buffer in buffers:
         event, loop = buffer.message_event, buffer.event_loop
         assert isinstance(event, asyncio.Event), WRITTEN_FOR
         assert isinstance(loop, asyncio.AbstractEventLoop) and loop.is_running(), WRITTEN_FOR
-        assert isinstance(event, private_transport._SetOnItsLoop) and event.owner is loop
+        assert isinstance(event, viser_private.SetOnItsLoop) and event.owner is loop
     # The behaviour, on an event of its own: a plain asyncio.Event set from another thread
     # walks its waiters there; the queue's does not, and its own loop's set wakes the waiter.
     loop = asyncio.new_event_loop()
     thread = threading.Thread(target=loop.run_forever, daemon=True)
     thread.start()
     try:
-        for kind in (asyncio.Event, private_transport._SetOnItsLoop):
+        for kind in (asyncio.Event, viser_private.SetOnItsLoop):
             event = kind()
-            if isinstance(event, private_transport._SetOnItsLoop):
+            if isinstance(event, viser_private.SetOnItsLoop):
                 event.owner = loop
             event._waiters = waiters = _Walked()
             waiting = asyncio.run_coroutine_threadsafe(event.wait(), loop)

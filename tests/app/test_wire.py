@@ -15,20 +15,19 @@ import pytest
 import websockets
 from conftest import after_frames, session_of, wait_until
 from uploading import MESH
-from viser import _messages
 
 from poinsot.app import viser_private
+from poinsot.app.devtools.load import crafted
+from poinsot.app.devtools.probe import Probe
 from poinsot.app.live.hardening import guard
 from poinsot.app.live.hardening import transfers as transfers_module
 from poinsot.app.live.hardening.budget import MessageBudget
 from poinsot.app.live.hardening.guard import POLICY_VIOLATION, origin_allowed
-from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.live.hardening.transfers import handle_id
-from poinsot.app.live.ui.motion_window import PLOT_SAMPLES, MotionWindow
-from poinsot.app.live.ui.widgets import checked
-from poinsot.app.load import crafted
-from poinsot.app.parameters import TRAIL_RANGE, Parameters
-from poinsot.app.presets import DEFAULT_PRESET, MESH_BODY
+from poinsot.app.live.panel.motion_window import PLOT_SAMPLES, MotionWindow
+from poinsot.app.live.panel.widgets import checked
+from poinsot.app.model.parameters import TRAIL_RANGE, Parameters
+from poinsot.app.model.presets import DEFAULT_PRESET, MESH_BODY
 
 # -- origins ---------------------------------------------------------------------------------
 
@@ -77,7 +76,7 @@ def test_a_page_from_another_origin_gets_no_session(make_app, make_probe, origin
             make_probe(app, origin=origin)
         assert refused.value.response.status_code == 403
         assert app.guard.refused == 1
-        assert not viser_private.infra(app.server)._client_state_from_id
+        assert not viser_private.connection_count(app.server)
         assert len(app.sessions()) == 0
 
 
@@ -201,7 +200,9 @@ def test_a_gui_update_naming_another_property_is_dropped(poinsot_app, probe):
     session = session_of(poinsot_app)
     after_frames(session, 30)  # settled: the panel's playback values are not shown again
     uuid, widget = probe.widget("Speed")
-    probe.send(_messages.GuiUpdateMessage(uuid, {"max": 1e300, "update_cb": []}))
+    probe.send(
+        viser_private.wire_message("GuiUpdateMessage", uuid, {"max": 1e300, "update_cb": []})
+    )
     assert wait_until(lambda: poinsot_app.guard.malformed == 1, 10)
     probe.set_value(uuid, 1e300)
     assert wait_until(lambda: session.clock.speed == widget.props["max"], 10)
@@ -221,7 +222,7 @@ def test_a_flooding_client_is_cut_off_and_the_others_keep_their_frames(make_app,
     """A raw client (its own process) sends 10k camera messages a second: beyond its budget
     they are dropped unread by viser, then it is disconnected; another client's frames during
     the flood stay >= 80 % of its frames in as long a quiet window, measured just before."""
-    from poinsot.app.load.flood import Flooder
+    from poinsot.app.devtools.load.workloads.flood import Flooder
 
     app = make_app()
     make_probe(app)
@@ -285,17 +286,25 @@ def test_pending_uploads_stay_bounded_and_are_freed_when_the_client_leaves(poins
     def send_200_mb() -> None:
         transfers = [f"t{k}" for k in range(10)]
         for t in transfers:
-            probe.send(_messages.FileTransferStartUpload(button, t, f"{t}.stl", "x", 19, 19 * MB))
-        probe.send(_messages.FileTransferStartUpload(slider, "s", "s.stl", "x", 10, 10 * MB))
+            probe.send(
+                viser_private.wire_message(
+                    "FileTransferStartUpload", button, t, f"{t}.stl", "x", 19, 19 * MB
+                )
+            )
+        probe.send(
+            viser_private.wire_message(
+                "FileTransferStartUpload", slider, "s", "s.stl", "x", 10, 10 * MB
+            )
+        )
         for k in range(19):
             for t in transfers:
-                probe.send(_messages.FileTransferPart(button, t, k, part))
+                probe.send(viser_private.wire_message("FileTransferPart", button, t, k, part))
         for k in range(9):  # the slider's, and the first transfer's last part, never come
-            probe.send(_messages.FileTransferPart(slider, "s", k, part))
+            probe.send(viser_private.wire_message("FileTransferPart", slider, "s", k, part))
         probe.widget(MESH)  # the probe's own model: nothing to wait for on the server
 
     peak = _peak_while(guard_.pending_bytes, send_200_mb)
-    states = session.client.gui._current_file_upload_states
+    states = viser_private.upload_states(session.client.gui)
     assert wait_until(lambda: guard_.pending_bytes() == 19 * MB or not states, 20)
     assert peak <= transfers_module.MAX_PENDING_BYTES + MB, peak
     assert set(states) <= {"t0"}  # one transfer in progress at most, the first
@@ -429,8 +438,8 @@ def test_two_thousand_bad_handshakes_leave_nothing_behind(poinsot_app, caplog, c
     before = _rss()
     assert crafted.bad_handshakes(port, 2000) == {"403": 2000}
     after = _rss()
-    infra = viser_private.infra(poinsot_app.server)
-    assert not infra._client_state_from_id and not infra._live_connections
+    assert not viser_private.connection_count(poinsot_app.server)
+    assert not viser_private.live_connection_ids(poinsot_app.server)
     assert poinsot_app.guard.refused == 2200 and not poinsot_app.sessions()
     assert after <= 1.05 * before, (before, after)
     _, terminal = _quiet(caplog, capfd)

@@ -23,9 +23,9 @@ from pathlib import Path
 import pytest
 import segno
 
-from poinsot.app import cli
+from poinsot.app.cli import main as cli
+from poinsot.app.devtools.probe import Probe
 from poinsot.app.live.hardening import network
-from poinsot.app.live.hardening.probe import Probe
 from poinsot.app.live.landing import PENDING_SECONDS, Balancer, _loopback, resolve, status
 from tests.conftest import wait_until
 
@@ -331,10 +331,10 @@ def test_the_real_interfaces_give_non_loopback_ipv4_addresses():
 # -- the load test through a landing -------------------------------------------------------
 @pytest.mark.slow
 def test_the_load_test_soaks_a_classroom_of_workers():
-    """``python -m poinsot.app.load --phase soak --workers 2``: the clients arrive through
+    """``python -m poinsot.app.devtools.load --phase soak --workers 2``: the clients arrive through
     the landing, the sessions are counted in both workers, their CPU and memory are summed."""
-    from poinsot.app.load.cli import run
-    from poinsot.app.load.config import Config
+    from poinsot.app.devtools.load.cli import run
+    from poinsot.app.devtools.load.config import Config
 
     report = run(["soak"], Config(clients=4, workers=2, seconds=3.0), verbose=False)
     assert report.figure("soak", "sessions lost").value == 0
@@ -345,7 +345,7 @@ def test_the_load_test_soaks_a_classroom_of_workers():
 
 
 def test_the_load_test_takes_workers_for_the_soak_only(capsys):
-    from poinsot.app.load import cli as load_cli
+    from poinsot.app.devtools.load import cli as load_cli
 
     with pytest.raises(SystemExit):
         load_cli.main(["--phase", "storm", "--workers", "2"])

@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 from conftest import session_of, wait_until
 
-from poinsot.app.live.ui import challenges
-from poinsot.app.live.ui.challenge_set import AXES, OUTCOMES
+from poinsot.app.live.lecture import challenges
+from poinsot.app.live.lecture.challenge_set import AXES, OUTCOMES
 
 pytestmark = pytest.mark.browser
 

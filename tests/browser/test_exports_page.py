@@ -19,12 +19,12 @@ import pytest
 from conftest import FRAME_CAP_JS, NO_MSAA_JS, lecture_of, session_of, wait_until
 from PIL import Image
 
+from poinsot.app.construction.cameras import BODY_VIEW, ride_along
+from poinsot.app.construction.view import VIEWS
 from poinsot.app.exports import html as html_export
 from poinsot.app.exports.screenshot import THEME_BACKGROUND
-from poinsot.app.live.ui.lecture import LARGE_TEXT_PERCENT
-from poinsot.app.presets import preset_by_key
-from poinsot.app.scene.cameras import BODY_VIEW, ride_along
-from poinsot.app.scene.view import VIEWS
+from poinsot.app.live.lecture.lecture import LARGE_TEXT_PERCENT
+from poinsot.app.model.presets import preset_by_key
 
 pytestmark = pytest.mark.browser
 

@@ -11,10 +11,10 @@ import urllib.parse
 import numpy as np
 import pytest
 
+from poinsot.app.construction.cameras import space_view
 from poinsot.app.live.landing import Balancer, LandingServer
 from poinsot.app.live.server import PoinsotApp
-from poinsot.app.presets import DEFAULT_PRESET, preset_by_key
-from poinsot.app.scene.cameras import space_view
+from poinsot.app.model.presets import DEFAULT_PRESET, preset_by_key
 from tests.app.test_nginx import balancer  # noqa: F401 (the README's nginx, a fixture)
 from tests.conftest import BrowserPage, session_of, wait_until
 

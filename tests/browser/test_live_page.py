@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 from conftest import session_of, wait_until
 
-from poinsot.app.elements import Element
-from poinsot.app.presets import DEFAULT_PRESET, preset_by_key
-from poinsot.app.scene import palette
+from poinsot.app.construction import palette
+from poinsot.app.model.elements import Element
+from poinsot.app.model.presets import DEFAULT_PRESET, preset_by_key
 
 pytestmark = pytest.mark.browser
 

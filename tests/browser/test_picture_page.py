@@ -16,13 +16,13 @@ import pytest
 from conftest import BrowserPage, session_of, wait_until
 from scipy import ndimage
 
-from poinsot.app.elements import Element
-from poinsot.app.live.ui.display import PROJECTOR_TEXT_PERCENT, browser_camera
-from poinsot.app.live.ui.legend import CAPTIONS
-from poinsot.app.parameters import Parameters
-from poinsot.app.presets import CUSTOM, DEFAULT_PRESET, preset_by_key
-from poinsot.app.scene import palette
-from poinsot.app.scene.view import VIEWS
+from poinsot.app.construction import palette
+from poinsot.app.construction.view import VIEWS
+from poinsot.app.live.lecture.display import PROJECTOR_TEXT_PERCENT, browser_camera
+from poinsot.app.live.panel.legend import CAPTIONS
+from poinsot.app.model.elements import Element
+from poinsot.app.model.parameters import Parameters
+from poinsot.app.model.presets import CUSTOM, DEFAULT_PRESET, preset_by_key
 from poinsot.physics import Regime
 
 pytestmark = pytest.mark.browser
@@ -726,7 +726,7 @@ def settled_screenshot(page, unlike: np.ndarray | None = None, timeout: float = 
 
 def handle_world(session, handle) -> np.ndarray:
     """A label's point in world coordinates (its parent frame's pose applied)."""
-    from poinsot.app.scene.frames import rotation_from_wxyz
+    from poinsot.app.construction.sampled.frames import rotation_from_wxyz
 
     position = np.asarray(handle.position, float)
     if "/body/" in handle.name:

@@ -13,10 +13,10 @@ import pytest
 from conftest import session_of, wait_until
 from test_live_page import amber_fraction
 
-from poinsot.app.elements import Element
-from poinsot.app.presets import preset_by_key
-from poinsot.app.scenes import SCENES, scene_by_name
-from poinsot.app.scenes.spec import SceneSpec
+from poinsot.app.lessons import SCENES, scene_by_name
+from poinsot.app.lessons.support.spec import SceneSpec
+from poinsot.app.model.elements import Element
+from poinsot.app.model.presets import preset_by_key
 
 pytestmark = pytest.mark.browser
 

@@ -1,5 +1,5 @@
 """In Chromium at 1280×800: a click on Landau's momentum sphere in the polhode-family scene
-sets the start there, at |L| kept (app/live/ui/sphere_pointer.py)."""
+sets the start there, at |L| kept (app/live/pointing/sphere_pointer.py)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from conftest import session_of, wait_until
 
-from poinsot.app.scenes import scene_by_name
+from poinsot.app.lessons import scene_by_name
 
 #: viser's drag binding on a node answers a mouse press so (the same on the energy ellipsoid).
 DRAG_BINDING = "Unable to preventDefault inside passive event listener invocation."

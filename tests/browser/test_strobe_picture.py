@@ -10,7 +10,7 @@ from conftest import chromium_or_fail, run_command
 from PIL import Image
 from strobe_counting import copies_in, hue_saturation_value
 
-from poinsot.app.scene import palette
+from poinsot.app.construction import palette
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 

@@ -1,6 +1,6 @@
 """The page on a phone and a tablet, in Chromium with touch emulation: the scene fills the
 screen, the legend opens in one tap, a tap on the ellipsoid sets a new start that the readouts
-show, and no console error (app/live/ui/layout.py, app/live/ui/pointer.py)."""
+show, and no console error (app/live/lecture/layout.py, app/live/pointing/pointer.py)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from conftest import BrowserPage, session_of, wait_until
 
-from poinsot.app.live.ui.session import Session
+from poinsot.app.live.session.session import Session
 
 IPHONE = (
     "Mozilla/5.0 (iPhone; CPU iPhone OS 17_0 like Mac OS X) AppleWebKit/605.1.15 "

@@ -9,9 +9,9 @@ import pytest
 from conftest import session_of, wait_until
 from uploading import MESH, RECORDING, expected_moments, toss_recording
 
-from poinsot.app import own_bodies
-from poinsot.app.bodies import ASSETS, load_mesh_body
-from poinsot.app.presets import FITTED_TOSS, MESH_BODY
+from poinsot.app.model import own_bodies
+from poinsot.app.model.bodies import ASSETS, load_mesh_body
+from poinsot.app.model.presets import FITTED_TOSS, MESH_BODY
 
 pytestmark = pytest.mark.browser
 

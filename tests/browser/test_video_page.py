@@ -17,8 +17,8 @@ from PIL import Image
 from strobe_counting import copies_in
 
 from poinsot.app.exports.video import BROWSER_MAX_SIZE, DEFAULT_FPS
-from poinsot.app.live.ui.video_export import fit_within
-from poinsot.app.presets import preset_by_key
+from poinsot.app.live.lecture.video_export import fit_within
+from poinsot.app.model.presets import preset_by_key
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 

@@ -26,7 +26,7 @@ from poinsot.app.report.figures import (
     takeaway,
     write_figures,
 )
-from poinsot.app.report.study import CaseResult
+from poinsot.app.report.measure.study import CaseResult
 
 pytest.importorskip("matplotlib")
 

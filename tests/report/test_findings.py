@@ -18,15 +18,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from poinsot.app.report.cases import CASES
-from poinsot.app.report.conditioning import (
+from poinsot.app.report.findings import crossed, flip_reading, saturated
+from poinsot.app.report.measure.cases import CASES
+from poinsot.app.report.measure.conditioning import (
     UNIT_ROUNDOFF,
     FlipCounter,
     condition_number,
     separatrix_distance,
 )
-from poinsot.app.report.findings import crossed, flip_reading, saturated
-from poinsot.app.report.runs import IntegratorRun, RunErrors
+from poinsot.app.report.measure.runs import IntegratorRun, RunErrors
 from poinsot.app.report.verdicts import observed_order, verdict
 from poinsot.physics import FreeRigidBody
 

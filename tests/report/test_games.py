@@ -1,10 +1,10 @@
-"""The report's game-engine table (:mod:`poinsot.app.report.games`)."""
+"""The report's game-engine table (:mod:`poinsot.app.report.measure.games`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from poinsot.app.report.games import flip_verdict, game_rows, games_section
+from poinsot.app.report.measure.games import flip_verdict, game_rows, games_section
 from poinsot.physics.integrators import GAME_STEPS
 
 

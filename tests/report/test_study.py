@@ -23,10 +23,10 @@ from conftest import STDERR_NAME
 from PIL import Image
 from rich.console import Console
 
-from poinsot.app.report.cases import CASES, StudyConfig
-from poinsot.app.report.progress import PLAIN_STEPS, Progress
-from poinsot.app.report.reference import TaylorReference
-from poinsot.app.report.runs import time_scale
+from poinsot.app.report.measure.cases import CASES, StudyConfig
+from poinsot.app.report.measure.progress import PLAIN_STEPS, Progress
+from poinsot.app.report.measure.reference import TaylorReference
+from poinsot.app.report.measure.runs import time_scale
 from poinsot.app.report.tables import ERROR_VS_TIME_COLUMNS, EXACT, WORK_PRECISION_COLUMNS
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.integrators import INTEGRATORS

@@ -30,7 +30,7 @@ from typing import Any, Protocol
 import viser
 
 from poinsot.app.live.hardening.pacing import Outbox
-from poinsot.app.viser_private.transport import connection_of
+from poinsot.app.viser_private import connection_of
 
 log = logging.getLogger(__name__)
 

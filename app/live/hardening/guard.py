@@ -44,7 +44,6 @@ from websockets.http11 import Request, Response
 
 from poinsot.app import viser_private
 from poinsot.app.live.hardening.budget import MessageBudget
-from poinsot.app.viser_private import transport as private_transport
 
 #: Messages a second one client may send, sustained, and in one burst (a browser sends a few
 #: dozen a second at most: camera moves while orbiting, a dragged slider, upload parts).
@@ -244,7 +243,7 @@ def guarded_viser(
     with viser_private.hooked_server(gate.check, gate.error):
         server = viser.ViserServer(host=host, port=port, verbose=verbose)
     viser_private.disable_share(server)
-    private_transport.broadcasts_woken_on_their_loop(server)
+    viser_private.broadcasts_woken_on_their_loop(server)
     return server, gate
 
 

@@ -42,7 +42,7 @@ from typing import Any
 
 import viser
 
-from poinsot.app.viser_private import transport as private
+from poinsot.app import viser_private as private
 
 #: Frames a client may have queued, not yet taken, before the next frame is skipped. 0: a
 #: frame is drawn only once the one before was taken; with 1, under a busy event loop, a
