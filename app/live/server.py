@@ -11,7 +11,10 @@ from collections.abc import Iterable
 from concurrent.futures import Future
 
 import viser
+from websockets.datastructures import Headers
+from websockets.http11 import Response
 
+from poinsot.app import docs_site
 from poinsot.app.live.hardening.backlog import BacklogLimit, BacklogWatch
 from poinsot.app.live.hardening.budget import RebuildGate
 from poinsot.app.live.hardening.guard import WireGuard, guarded_viser
@@ -29,6 +32,14 @@ log = logging.getLogger(__name__)
 
 #: Seconds a new page has to say its address (its link) before it opens the default scene.
 PAGE_TIMEOUT = 10.0
+
+
+def guide_page(path: str) -> Response | None:
+    """The guide's page or file at ``path`` (:mod:`poinsot.app.docs_site`), or None."""
+    found = docs_site.answer(path)
+    if found is None:
+        return None
+    return Response(found.status, found.reason, Headers(list(found.headers)), found.body)
 
 
 class PoinsotApp:
@@ -74,7 +85,10 @@ class PoinsotApp:
         self._connected = threading.Condition(self._lock)
         self.budget = RebuildGate()
         # Handshakes checked before viser sees them, the share tunnel off (:mod:`.hardening.guard`).
-        self.server, gate = guarded_viser(host, port, verbose=verbose, allow_origins=allow_origins)
+        # The guide (``make docs``) at /docs/, offline, beside the scene (:mod:`..docs_site`).
+        self.server, gate = guarded_viser(
+            host, port, verbose=verbose, allow_origins=allow_origins, pages=guide_page
+        )
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
         self.server.scene.world_axes.visible = False
         # First of this app's handlers: every message passes the guard before viser's.
