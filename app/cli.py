@@ -162,7 +162,7 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="QUERY",
         help="also print the link to this state and its QR code, as 'preset=t_handle&t=12"
-        "&view=side' (the README's table lists the parameters)",
+        "&view=side' (the guide's page Link parameters lists them)",
     )
     which = parser.add_mutually_exclusive_group()
     which.add_argument(

@@ -4,6 +4,7 @@ browser."""
 from __future__ import annotations
 
 import asyncio
+import functools
 import logging
 import threading
 import warnings
@@ -40,6 +41,10 @@ def guide_page(path: str) -> Response | None:
     if found is None:
         return None
     return Response(found.status, found.reason, Headers(list(found.headers)), found.body)
+
+
+#: The guarded viser server of :mod:`.hardening.guard`, answering the guide at /docs/ too.
+_guarded_viser = functools.partial(guarded_viser, pages=guide_page)
 
 
 class PoinsotApp:
@@ -85,10 +90,7 @@ class PoinsotApp:
         self._connected = threading.Condition(self._lock)
         self.budget = RebuildGate()
         # Handshakes checked before viser sees them, the share tunnel off (:mod:`.hardening.guard`).
-        # The guide (``make docs``) at /docs/, offline, beside the scene (:mod:`..docs_site`).
-        self.server, gate = guarded_viser(
-            host, port, verbose=verbose, allow_origins=allow_origins, pages=guide_page
-        )
+        self.server, gate = _guarded_viser(host, port, verbose=verbose, allow_origins=allow_origins)
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
         self.server.scene.world_axes.visible = False
         # First of this app's handlers: every message passes the guard before viser's.

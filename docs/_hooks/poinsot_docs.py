@@ -87,7 +87,9 @@ def cli_reference() -> str:
         for a in a._choices_actions
     }
     rows = ["| command | what it does |", "|---|---|"]
-    rows += [f"| [`poinsot {name}`](#poinsot-{name}) | {helps.get(name, '')} |" for name in commands]
+    rows += [
+        f"| [`poinsot {name}`](#poinsot-{name}) | {helps.get(name, '')} |" for name in commands
+    ]
     parts = ["\n".join(rows), "## `poinsot`", "```text\n" + _help_text(parser) + "```"]
     for name, sub in commands.items():
         parts += [f"## `poinsot {name}` {{#poinsot-{name}}}", "```text\n" + _help_text(sub) + "```"]
@@ -141,9 +143,7 @@ def figure(name: str) -> str:
 
 
 # -- equations --------------------------------------------------------------------------------
-_MATH = re.compile(
-    r'<(span|div) class="arithmatex">\s*\\[\(\[](.*?)\\[\)\]]\s*</\1>', re.DOTALL
-)
+_MATH = re.compile(r'<(span|div) class="arithmatex">\s*\\[\(\[](.*?)\\[\)\]]\s*</\1>', re.DOTALL)
 
 
 def _mathml(match: re.Match[str]) -> str:
