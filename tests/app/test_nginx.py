@@ -1,10 +1,10 @@
 """Several Poinsot servers behind Debian's nginx with sticky websockets, on loopback.
 
-The nginx configuration is the guide's own (docs/how-to/classroom.md, "Several machines"), with
-the upstream servers and the listening address replaced; nginx runs unprivileged in the foreground with its
-pid, logs and temporary files under ``tmp_path``. Headless clients connect from distinct
-loopback addresses (127.0.0.1 to 127.0.0.16: Linux answers on all of 127/8), so that
-``hash $remote_addr`` has addresses to spread. Skipped when nginx is missing, except in CI.
+The nginx configuration is the guide's own (docs/how-to/classroom.md, "Several machines"),
+with the upstream servers and the listening address replaced; nginx runs unprivileged in the
+foreground with its pid, logs and temporary files under ``tmp_path``. Headless clients connect
+from distinct loopback addresses (127.0.0.1 to 127.0.0.16: Linux answers on all of 127/8), so
+that ``hash $remote_addr`` has addresses to spread. Skipped when nginx is missing, except in CI.
 """
 
 from __future__ import annotations
