@@ -85,9 +85,13 @@ def page_for(key: str) -> str:
 
 
 def help_markdown(key: str) -> str:
-    """The panel's "Help" line for what is shown: a link to its page of the guide, and how to
-    build the guide when it has not been built."""
-    link = f"[Help: the guide to what you see]({page_for(key)})"
+    """The panel's "Help" line for what is shown: a link to its page of the guide, opened beside
+    the scene (a new tab: the session stays), and how to build the guide when it has not been
+    built."""
+    link = (
+        f'<a href="{page_for(key)}" target="_blank" rel="noopener">'
+        "Help: the guide to what you see</a>"
+    )
     if site_dir() is None:
         return f"<small>{link} (not built yet: run `{BUILD_COMMAND}`, then reload)</small>"
     return f"<small>{link}</small>"
