@@ -12,7 +12,7 @@ SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # again (about 12 core-seconds of the suite on a 2-core machine).
 unexport PYTHONDONTWRITEBYTECODE
 
-.PHONY: run test test-fast install install-test chromium bench bench-compare load lint clean
+.PHONY: run test test-fast install install-test chromium bench bench-compare load lint docs pictures clean
 
 $(VENV)/bin/activate:
 	$(PYTHON) -m venv $(VENV)
@@ -31,6 +31,10 @@ $(VENV)/.installed-test: pyproject.toml | $(VENV)/bin/activate
 $(VENV)/.installed-dev: pyproject.toml | $(VENV)/bin/activate
 	$(PY) -m pip install -e '.[dev]'
 	touch $@ $(VENV)/.installed-test $(VENV)/.installed
+
+$(VENV)/.installed-docs: pyproject.toml | $(VENV)/bin/activate
+	$(PY) -m pip install -e '.[docs]'
+	touch $@
 
 install: $(VENV)/.installed
 install-test: $(VENV)/.installed-test
@@ -96,5 +100,15 @@ lint: $(VENV)/.installed-dev
 	MYPYPATH=$(TYPECHECK) $(VENV)/bin/mypy -p poinsot.physics -p poinsot.app
 	$(VENV)/bin/lint-imports
 
+# The user guide (mkdocs.yml, docs/) into site/, which `poinsot serve` serves at /docs/. --strict:
+# a broken link, a missing page or a docstring the API reference cannot read fails the build.
+docs: $(VENV)/.installed-docs
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict
+
+# The pictures of the README and the guide, made again by Poinsot's own commands (headless
+# Chromium: `make chromium`). Minutes of software rendering; not part of CI.
+pictures: install chromium
+	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" sh docs/pictures.sh
+
 clean:
-	rm -rf $(VENV) .pytest_cache build *.egg-info
+	rm -rf $(VENV) .pytest_cache build site *.egg-info

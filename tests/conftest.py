@@ -269,7 +269,7 @@ def probe(poinsot_app, make_probe) -> Probe:
 def run_command(argv: list[str], timeout: float = 900.0) -> subprocess.CompletedProcess[str]:
     """``poinsot ARGV`` in a process of its own (its output as text), as a lecturer runs it."""
     return subprocess.run(
-        [sys.executable, "-m", "poinsot.app.cli.main", *argv],
+        [sys.executable, "-m", "poinsot.app.cli", *argv],
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -667,3 +667,33 @@ def small_study() -> list[CaseResult]:
     reference_cls, _ = load_reference()
     progress = Progress(1, enabled=False)
     return [study_case(case, config, reference_cls, progress) for case in config.cases]
+
+
+# -- the user guide ----------------------------------------------------------------------
+def build_docs(config: Path, site: Path) -> subprocess.CompletedProcess[str]:
+    """``mkdocs build --strict`` of ``config`` into ``site``, as ``make docs`` runs it (skipped
+    locally, failed in CI, when MkDocs is not installed: the ``docs`` extra)."""
+    try:
+        import mkdocs  # noqa: F401
+    except ImportError:
+        message = "MkDocs is missing: `make install-test` installs the docs extra"
+        if in_ci():
+            pytest.fail(message + " [CI=true: the guide must build]")
+        pytest.skip(message)
+    return subprocess.run(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "-f", str(config), "-d", str(site)],
+        cwd=Path(__file__).resolve().parents[1],
+        env={**os.environ, "NO_MKDOCS_2_WARNING": "1"},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+
+
+@pytest.fixture(scope="session")
+def built_docs(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The guide built from this checkout (``mkdocs.yml``) into a folder of its own."""
+    site = tmp_path_factory.mktemp("docs") / "site"
+    done = build_docs(Path(__file__).resolve().parents[1] / "mkdocs.yml", site)
+    assert done.returncode == 0, done.stderr[-3000:]
+    return site

@@ -153,7 +153,7 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="QUERY",
         help="also print the link to this state and its QR code, as 'preset=t_handle&t=12"
-        "&view=side' (the README's table lists the parameters)",
+        "&view=side' (the guide's page Link parameters lists them)",
     )
     which = parser.add_mutually_exclusive_group()
     which.add_argument(
@@ -304,9 +304,3 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser(_command(argv)).parse_args(argv)
     prog = f"poinsot {args.command or 'serve'}"
     return run_guarded(prog, lambda: _run(args), debug=args.debug)
-
-
-if (
-    __name__ == "__main__"
-):  # python -m poinsot.app.cli.main behaves as python -m poinsot.app and poinsot
-    raise SystemExit(main())

@@ -401,7 +401,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("compare: --rounds must be at least 1", file=sys.stderr)
         return 2
     benchmarks = [b for b in BENCHMARKS if getattr(options, b)] or list(BENCHMARKS)
-    repo = pathlib.Path(__file__).resolve().parents[3]
+    repo = pathlib.Path(__file__).resolve().parents[2]
     load0 = os.getloadavg()[0]
     try:
         rows, unpaired = run_comparison(repo, options.against, benchmarks, options)

@@ -6,6 +6,8 @@ so a session lives in exactly one process. "Least loaded" is the fewest connecte
 each worker reports them, plus the browsers sent to it that have not connected yet (a class
 arriving at once would otherwise all land on the worker that looked empty a moment ago).
 
+The guide (``make docs``, :mod:`poinsot.app.model.docs_site`) is answered here at ``/docs/``, not
+redirected: a reader of the guide is no browser on its way to a worker.
 ``GET /poinsot-status`` answers the workers' ports, clients and health as JSON (the load test
 and the tests read it); their process ids only to a client on the same machine (loopback).
 """
@@ -25,6 +27,7 @@ from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
 from poinsot.app.live.hardening.network import PortError, bind_errno, port_problem
+from poinsot.app.model import docs_site
 
 #: A browser sent to a worker that has not connected within this many seconds is forgotten
 #: (it closed the tab, reloaded straight on the worker's port, or was a tool that only follows
@@ -149,6 +152,15 @@ class _Handler(http.server.BaseHTTPRequestHandler):
             if not _loopback(self.client_address[0]):  # the LAN sees no process ids
                 status = [{k: v for k, v in entry.items() if k != "pid"} for entry in status]
             self._reply(200, "application/json", json.dumps(status))
+            return
+        guide = docs_site.answer(self.path)  # the guide is served here, not by a worker
+        if guide is not None:
+            self.send_response(guide.status)
+            for name, value in guide.headers:
+                self.send_header(name, value)
+            self.end_headers()
+            if self.command == "GET":
+                self.wfile.write(guide.body)
             return
         backend = self.server.balancer.choose(counted=self.command == "GET")
         if backend is None:

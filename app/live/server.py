@@ -4,6 +4,7 @@ browser."""
 from __future__ import annotations
 
 import asyncio
+import functools
 import logging
 import threading
 import warnings
@@ -11,6 +12,8 @@ from collections.abc import Iterable
 from concurrent.futures import Future
 
 import viser
+from websockets.datastructures import Headers
+from websockets.http11 import Response
 
 from poinsot.app.lessons.support.spec import SceneSpec
 from poinsot.app.live.classroom import links
@@ -21,6 +24,7 @@ from poinsot.app.live.hardening.guard import WireGuard, guarded_viser
 from poinsot.app.live.hardening.pacing import frame_share
 from poinsot.app.live.hardening.upkeep import MemoryTrim, fixed_pool
 from poinsot.app.live.session.session import MAX_FPS, Session
+from poinsot.app.model import docs_site
 from poinsot.app.model.presets import DEFAULT_PRESET, Preset
 from poinsot.app.viser_private import (
     handshake_origin,
@@ -32,6 +36,18 @@ log = logging.getLogger(__name__)
 
 #: Seconds a new page has to say its address (its link) before it opens the default scene.
 PAGE_TIMEOUT = 10.0
+
+
+def guide_page(path: str) -> Response | None:
+    """The guide's page or file at ``path`` (:mod:`poinsot.app.model.docs_site`), or None."""
+    found = docs_site.answer(path)
+    if found is None:
+        return None
+    return Response(found.status, found.reason, Headers(list(found.headers)), found.body)
+
+
+#: The guarded viser server of :mod:`.hardening.guard`, answering the guide at /docs/ too.
+_guarded_viser = functools.partial(guarded_viser, pages=guide_page)
 
 
 class PoinsotApp:
@@ -77,7 +93,7 @@ class PoinsotApp:
         self._connected = threading.Condition(self._lock)
         self.budget = RebuildGate()
         # Handshakes checked before viser sees them, the share tunnel off (:mod:`.hardening.guard`).
-        self.server, gate = guarded_viser(host, port, verbose=verbose, allow_origins=allow_origins)
+        self.server, gate = _guarded_viser(host, port, verbose=verbose, allow_origins=allow_origins)
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
         self.server.scene.world_axes.visible = False
         # First of this app's handlers: every message passes the guard before viser's.

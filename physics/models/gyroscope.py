@@ -152,7 +152,7 @@ class Gyroscope:
         self.amplitude = math.hypot(float(w[0]) - self.nutation_center, float(w[1]))
         """C [rad/time], the radius of the nutation circle [FM06 Eq. 7.94]."""
         self.phase = math.atan2(float(w[1]), float(w[0]) - self.nutation_center)
-        """α [rad] [FM06 Eq. 7.95]."""
+        """α [rad]: the phase on the nutation circle [FM06 Eq. 7.95]."""
         self.drift_rate = M / ((J3 - J) * w3)
         """The mean rate [rad/time] of the axis towards the torque [FM06 Eq. 7.98]."""
         self.nutation_period = (

@@ -19,7 +19,7 @@ from poinsot.physics.fit import synthetic_toss
 
 def poinsot(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "poinsot.app.cli.main", "fit", *args],
+        [sys.executable, "-m", "poinsot.app.cli", "fit", *args],
         capture_output=True,
         text=True,
         timeout=120,

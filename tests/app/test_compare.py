@@ -19,7 +19,7 @@ from poinsot.app.devtools import compare
 from poinsot.app.devtools.compare import COST, RATE, Ratio
 from poinsot.physics.tools import benchmark as physics_benchmark
 
-REPO = Path(compare.__file__).resolve().parents[3]
+REPO = Path(compare.__file__).resolve().parents[2]
 
 
 def physics_text(omega_ns: float = 25.0, construct_ms: float = 0.050) -> str:

@@ -1,10 +1,10 @@
 """Several Poinsot servers behind Debian's nginx with sticky websockets, on loopback.
 
-The nginx configuration is the README's own (its "A classroom" section), with the upstream
-servers and the listening address replaced; nginx runs unprivileged in the foreground with its
-pid, logs and temporary files under ``tmp_path``. Headless clients connect from distinct
-loopback addresses (127.0.0.1 to 127.0.0.16: Linux answers on all of 127/8), so that
-``hash $remote_addr`` has addresses to spread. Skipped when nginx is missing, except in CI.
+The nginx configuration is the guide's own (docs/how-to/classroom.md, "Several machines"),
+with the upstream servers and the listening address replaced; nginx runs unprivileged in the
+foreground with its pid, logs and temporary files under ``tmp_path``. Headless clients connect
+from distinct loopback addresses (127.0.0.1 to 127.0.0.16: Linux answers on all of 127/8), so
+that ``hash $remote_addr`` has addresses to spread. Skipped when nginx is missing, except in CI.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from poinsot.app.devtools.probe import Probe
 from poinsot.app.live.server import PoinsotApp
 from tests.conftest import in_ci, wait_until
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+GUIDE = Path(__file__).resolve().parents[2] / "docs" / "how-to" / "classroom.md"
 SOURCES = [f"127.0.0.{i}" for i in range(1, 17)]
 
 pytestmark = pytest.mark.slow
@@ -44,9 +44,9 @@ def nginx_or_skip() -> str:
 
 
 def readme_config() -> str:
-    """The nginx block of the README's classroom section."""
-    text = README.read_text()
-    section = text[text.index("## A classroom") :]
+    """The nginx block of the guide's classroom page."""
+    text = GUIDE.read_text()
+    section = text[text.index("## Several machines") :]
     return re.search(r"```nginx\n(.*?)```", section, re.DOTALL).group(1)
 
 
@@ -54,7 +54,7 @@ def nginx_conf(tmp: Path, listen: int, backends: list[int]) -> str:
     servers = "".join(f"    server 127.0.0.1:{port};\n" for port in backends)
     block = re.sub(r"(    server [\d.:]+;\n)+", servers, readme_config())
     block = re.sub(r"listen \d+;", f"listen 127.0.0.1:{listen};", block)
-    assert servers in block and f"127.0.0.1:{listen}" in block, "the README's block changed"
+    assert servers in block and f"127.0.0.1:{listen}" in block, "the guide's block changed"
     temps = "".join(
         f"    {kind}_temp_path {tmp}/{kind};\n"
         for kind in ("client_body", "proxy", "fastcgi", "uwsgi", "scgi")

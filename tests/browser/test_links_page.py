@@ -15,7 +15,7 @@ from poinsot.app.construction.cameras import space_view
 from poinsot.app.live.landing import Balancer, LandingServer
 from poinsot.app.live.server import PoinsotApp
 from poinsot.app.model.presets import DEFAULT_PRESET, preset_by_key
-from tests.app.test_nginx import balancer  # noqa: F401 (the README's nginx, a fixture)
+from tests.app.test_nginx import balancer  # noqa: F401 (the guide's nginx, a fixture)
 from tests.conftest import BrowserPage, session_of, wait_until
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
@@ -185,7 +185,7 @@ def test_links_through_the_landing_open_on_either_worker(make_app, make_probe, o
 
 
 def test_a_link_through_the_readme_s_nginx_opens_its_state(balancer, open_page):  # noqa: F811
-    """Through the README's nginx in front of two servers: the state opens, and "Copy link"
+    """Through the guide's nginx in front of two servers: the state opens, and "Copy link"
     gives the address the browser sees (nginx's), not the server's behind it."""
     port, apps = balancer
     query = "preset=t_handle&t=12&view=side&paused=1"

@@ -232,15 +232,34 @@ def _peer(connection: Any) -> str:
         return "?"
 
 
+#: Pages of our own served before viser's page server: a request's path -> a response, or None.
+Pages = Callable[[str], Response | None]
+
+
 def guarded_viser(
-    host: str, port: int, *, verbose: bool = False, allow_origins: Iterable[str] = ()
+    host: str,
+    port: int,
+    *,
+    verbose: bool = False,
+    allow_origins: Iterable[str] = (),
+    pages: Pages | None = None,
 ) -> tuple[viser.ViserServer, HandshakeGate]:
     """A viser server whose handshakes pass :class:`HandshakeGate` and whose share tunnel is
     off (its handlers removed; the wire refuses the messages too). Its broadcast queue is woken
     on viser's loop only, as each client's is once connected (the server's connect handler):
-    :func:`poinsot.app.viser_private.transport.set_on_its_loop_only`."""
+    :func:`poinsot.app.viser_private.transport.set_on_its_loop_only`. ``pages`` answers the
+    page requests it knows (the guide at ``/docs/``) before viser's page server."""
     gate = HandshakeGate(host, allow_origins)
-    with viser_private.hooked_server(gate.check, gate.error):
+
+    def check(connection: ServerConnection, request: Request) -> Response | None:
+        refusal = gate.check(connection, request)
+        if refusal is not None or pages is None:
+            return refusal
+        if "websocket" in {v.lower() for v in request.headers.get_all("Upgrade")}:
+            return None
+        return pages(request.path)
+
+    with viser_private.hooked_server(check, gate.error):
         server = viser.ViserServer(host=host, port=port, verbose=verbose)
     viser_private.disable_share(server)
     viser_private.broadcasts_woken_on_their_loop(server)

@@ -35,6 +35,7 @@ from poinsot.app.live.panel.widgets import (
     set_value,
     write_unless_newer,
 )
+from poinsot.app.model.docs_site import help_markdown
 from poinsot.app.model.elements import Control, Element, Plot
 from poinsot.app.model.parameters import (
     SPEED_RANGE,
@@ -120,6 +121,8 @@ class ControlPanel:
                 hint="Start from a classical case; editing a slider turns it into 'Custom'.",
             )
             self.source = gui.add_markdown(self._source_text(preset))
+            #: The guide's page for what is shown (served at /docs/: :mod:`...docs_site`).
+            self.help = gui.add_markdown(help_markdown(preset.key))
             self.status = gui.add_markdown("")
         self.motion = MotionWindow(gui, order=_ORDER["readouts"])
         #: The body's groups (moments, D, side and pole, |ω₀|).
@@ -318,6 +321,7 @@ class ControlPanel:
         again since ``menu_count`` (``menu.count`` read when the change was asked for)."""
         write_unless_newer(self.preset, preset.label, self.menu, menu_count, self._loop)
         self.source.content = self._source_text(preset)
+        self.help.content = help_markdown(preset.key)
         self.motion.legend.show_caption(caption(preset))
 
     @staticmethod
