@@ -277,8 +277,10 @@ def run_command(argv: list[str], timeout: float = 900.0) -> subprocess.Completed
     )
 
 
-def session_of(app: PoinsotApp, count: int = 1, timeout: float = 10.0) -> Session:
-    """The newest session of ``app`` (waiting until ``count`` sessions exist)."""
+def session_of(app: PoinsotApp, count: int = 1, timeout: float = 60.0) -> Session:
+    """The newest session of ``app`` (waiting until ``count`` sessions exist: a condition the
+    app notifies, so the timeout only bounds a failure; at load 18, a session took over 10 s
+    to be built)."""
     sessions = app.wait_for_sessions(count, timeout)
     assert len(sessions) >= count, f"only {len(sessions)} sessions"
     return max(sessions, key=lambda s: s.client.client_id)
@@ -443,6 +445,20 @@ class BrowserPage:
         )
         if on:
             assert wait_until(lambda: self.frames_drawn() >= drawn + 2, 30), "no frame drawn"
+
+    def drawn_after(self, client) -> None:
+        """Return once the page has drawn everything sent to ``client`` (its viser client)
+        before this call: a render asked of the page now comes back once the page has applied
+        the messages in front of it (viser answers a render request after them, in order); the
+        live view, if on (:meth:`set_live_view`), then draws two more frames. The events a
+        picture of the page waits for, not a fixed wait nor two screenshots alike (a paused
+        page draws about a frame a second: on a loaded machine two screenshots can agree
+        between two frames, not all drawn yet)."""
+        client.get_render(8, 8, timeout=60.0)
+        if self.page.evaluate("() => window.__poinsotParked === true"):
+            return
+        drawn = self.frames_drawn()
+        assert wait_until(lambda: self.frames_drawn() >= drawn + 2, 30), "no frame drawn"
 
     def frames_drawn(self) -> int:
         """The frames the page's 3D view has drawn (three.js counts them; viser exposes its

@@ -7,6 +7,7 @@ session drew for that time."""
 
 from __future__ import annotations
 
+import itertools
 import re
 
 import numpy as np
@@ -31,11 +32,11 @@ def start(make_app, make_probe, spec) -> tuple[PoinsotApp, Session, Probe]:
     app = make_app(scene=spec)
     probe = make_probe(app)
     session = session_of(app)
-    assert wait_until(lambda: session.running and session.stats.frames > 3, 20), "no frames"
-    assert wait_until(lambda: session.showcase is not None and session.showcase.loaded, 20)
+    assert wait_until(lambda: session.running and session.stats.frames > 3, 30), "no frames"
+    assert wait_until(lambda: session.showcase is not None and session.showcase.loaded, 30)
     # The scene's controls as the probe has them (sent before the frames, read after them).
     labels = {control.label for control in spec.controls}
-    assert probe.wait_for(lambda p: labels <= set(p.labels()), 20), (labels, probe.labels())
+    assert probe.wait_for(lambda p: labels <= set(p.labels()), 30), (labels, probe.labels())
     return app, session, probe
 
 
@@ -48,7 +49,7 @@ def sent_at(session: Session, probe: Probe, t: float) -> tuple[Frame, dict[str, 
         frame = session.frame
         return frame is not None and t - 0.06 < frame.t <= t + 1e-9
 
-    assert wait_until(drawn, 10), f"the session did not draw t = {t}"
+    assert wait_until(drawn, 30), f"the session did not draw t = {t}"
     frame = session.frame
     assert frame is not None
     assert probe.wait_for(
@@ -56,7 +57,7 @@ def sent_at(session: Session, probe: Probe, t: float) -> tuple[Frame, dict[str, 
             "/space/body" in p.nodes
             and np.allclose(p.nodes["/space/body"].wxyz, frame.wxyz, atol=1e-9)
         ),
-        10,
+        30,
     ), "the pose never arrived"
     nodes, _ = probe.snapshot()
     return frame, nodes
@@ -94,7 +95,7 @@ def drawn_traces(session: Session, probe: Probe) -> dict[str, np.ndarray]:
     """Every trace of the scene as sent (by group name), once all the points the session has
     drawn have reached the probe: the traces are sent every few frames, and paused, the last
     points go out with the next frame drawn (for traces not yet trimmed to their length)."""
-    assert wait_until(lambda: session.scene.traces_complete, 10), "the traces were not all sent"
+    assert wait_until(lambda: session.scene.traces_complete, 30), "the traces were not all sent"
     drawn = {
         trail.group.name: len(trail.points())
         for element in Element
@@ -104,7 +105,7 @@ def drawn_traces(session: Session, probe: Probe) -> dict[str, np.ndarray]:
     def arrived(p: Probe) -> bool:
         return all(len(trail_points(p.nodes, name)) == n for name, n in drawn.items())
 
-    assert probe.wait_for(arrived, 10), f"the traces never arrived in full: {drawn}"
+    assert probe.wait_for(arrived, 30), f"the traces never arrived in full: {drawn}"
     nodes, _ = probe.snapshot()
     return {name: trail_points(nodes, name) for name in drawn}
 
@@ -192,10 +193,10 @@ def construction_nodes() -> dict:
         probe = Probe(server.get_port())
         scene = PoinsotScene(server.scene, frozenset())
         scene.load(Parameters.from_preset(DEFAULT_PRESET).build(), DEFAULT_PRESET.solid)
-        base = _settled_names(probe, scene, frozenset())
+        base = _drawn_names(server, probe, scene, frozenset())
         nodes = {}
         for element in Element:
-            names = _settled_names(probe, scene, frozenset({element}))
+            names = _drawn_names(server, probe, scene, frozenset({element}))
             nodes[element] = {n for n in names - base if not _is_chunk(n)}
         probe.close()
         return nodes
@@ -208,19 +209,29 @@ def _is_chunk(name: str) -> bool:
     return tail.startswith("c") and tail[1:].isdigit()
 
 
-def _settled_names(probe: Probe, scene, elements) -> set[str]:
-    """Declare ``elements``, draw a frame, and return the node names once they stop changing."""
-    import time
+#: The name of the marks :func:`received_names` sends after what it waits for, and their count.
+MARK = "/received-mark"
+_MARKS = itertools.count()
 
+
+def _drawn_names(server, probe: Probe, scene, elements) -> set[str]:
+    """Declare ``elements``, draw a frame, and return the node names the probe has then."""
     scene.declare(elements)
     scene.advance(0.5)
     scene.flush_trails()
-    previous: set[str] = set()
-    for _ in range(50):
-        time.sleep(0.1)
+    return received_names(server, probe)
+
+
+def received_names(server, probe: Probe, timeout: float = 60.0) -> set[str]:
+    """The node names ``probe`` has once everything ``server`` queued before this call reached
+    it: a mark node added now, after them, has arrived (a connection's messages arrive in the
+    order they were queued; viser drops a queued message only for a later one on the same
+    node). The event to wait for, not a quiet period: a loaded machine delivers late."""
+    mark = f"{MARK}/{next(_MARKS)}"
+    handle = server.scene.add_frame(mark, show_axes=False)
+    try:
+        assert probe.wait_for(lambda p: mark in p.nodes, timeout), "the mark never arrived"
         nodes, _ = probe.snapshot()
-        current = set(nodes)
-        if current == previous:
-            return current
-        previous = current
-    return previous
+    finally:
+        handle.remove()
+    return {name for name in nodes if not name.startswith(MARK)}

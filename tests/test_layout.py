@@ -294,7 +294,6 @@ CLOCK_ALLOWED: dict[tuple[str, str], str] = {
 #: wait on the event it stands for (``wait_until``, ``probe.wait_for``, ``after_frames``).
 SLEEPS_ALLOWED: dict[tuple[str, str], str] = {
     ("tests/conftest.py", "wait_until"): "the poll period of the one waiting primitive",
-    ("tests/scene_probing.py", "_settled_names"): "the poll period while node names settle",
     ("tests/app/test_server.py", "test_random_input_never_raises_nor_sends_nan"): (
         "the storm's irregular rhythm of input, not a wait"
     ),
@@ -302,18 +301,11 @@ SLEEPS_ALLOWED: dict[tuple[str, str], str] = {
         "two equal windows, quiet and flooded, in which the frames are counted and compared"
     ),
     ("tests/app/test_wire.py", "poll"): "the sampling period of a peak-memory poller",
-    ("tests/app/test_ghost.py", "test_the_ghost_shows_a_second_ellipsoid_in_the_browser"): (
-        "a software-WebGL render: no page event says the picture shows the new state"
-    ),
 }
 #: Browser tests: the same reason as above, for each module (the page gives no "drawn" event).
 SLEEPS_ALLOWED_IN = {
-    "tests/browser/test_exports_page.py",
-    "tests/browser/test_live_page.py",
     "tests/browser/test_loopback.py",
     "tests/browser/test_picture_page.py",
-    "tests/browser/test_scenes_page.py",
-    "tests/browser/test_uploads_page.py",
     # Not a test: the script that makes the README's phone and drag pictures; its pauses let
     # the traces grow for the picture.
     "tests/browser/touch_pictures.py",

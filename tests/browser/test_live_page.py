@@ -66,7 +66,7 @@ def shared(make_module_app, open_module_page):
 def test_page_loads_without_console_errors(shared):
     app, page, session = shared
     started(app, frames=60)
-    page.page.wait_for_timeout(1000)
+    page.drawn_after(session.client)
     assert page.errors == []
     assert session.stats.errors == 0, session.stats.last_error
     assert page.page.get_by_text("Stable about the major axis").count() >= 1
@@ -91,14 +91,18 @@ def test_the_omega_plot_draws_its_three_components(shared):
     started(app, frames=30)
     plot = page.page.locator(".uplot-container").first
     plot.wait_for(state="visible", timeout=20000)
-    page.page.wait_for_timeout(2500)  # a couple of seconds of samples
     import io
 
-    rgb = np.asarray(Image.open(io.BytesIO(plot.screenshot())).convert("RGB")).astype(int)
-    for hex_color in palette.PLOT_SERIES:
-        color = np.array([int(hex_color[i : i + 2], 16) for i in (1, 3, 5)])
-        near = np.sum(np.abs(rgb - color).sum(axis=2) < 60)
-        assert near > 40, (hex_color, near)
+    colors = [np.array([int(c[i : i + 2], 16) for i in (1, 3, 5)]) for c in palette.PLOT_SERIES]
+    near: list[int] = []
+
+    def three_curves() -> bool:
+        # The event: the plot shows its samples (as many as a loaded machine has drawn by then).
+        rgb = np.asarray(Image.open(io.BytesIO(plot.screenshot())).convert("RGB")).astype(int)
+        near[:] = [int(np.sum(np.abs(rgb - color).sum(axis=2) < 60)) for color in colors]
+        return all(n > 40 for n in near)
+
+    assert wait_until(three_curves, 30, poll=0.5), dict(zip(palette.PLOT_SERIES, near, strict=True))
     assert page.errors == []
 
 
@@ -107,12 +111,12 @@ def test_canvas_shows_the_ellipsoid(shared):
     session = started(app)
     pause(page, session)
     page.set_live_view(True)  # and so it stays for the module's later tests
-    page.page.wait_for_timeout(500)
+    page.drawn_after(session.client)
     shown = canvas_pixels(page)
     page.open_folder("Show")  # collapsed by default
     page.set_checkbox("energy ellipsoid", False)
     assert wait_until(lambda: not session.scene.is_visible(Element.ELLIPSOID), 5)
-    page.page.wait_for_timeout(500)
+    page.drawn_after(session.client)
     hidden = canvas_pixels(page)
     # The semi-transparent amber ellipsoid covers a good part of the view; only it is amber.
     assert amber_fraction(shown) > 0.02, amber_fraction(shown)
@@ -130,7 +134,7 @@ def test_moving_a_slider_changes_the_scene(shared):
     app, page, _ = shared
     session = started(app)
     pause(page, session)
-    page.page.wait_for_timeout(300)
+    page.drawn_after(session.client)
     before_pixels = canvas_pixels(page)
     before_axes = session.scene.geometry.semi_axes.copy()
     generation = session.generation
@@ -143,7 +147,7 @@ def test_moving_a_slider_changes_the_scene(shared):
     # the menu's new label is a message of its own, after the session's change
     assert wait_until(lambda: page.dropdown_value("Preset") == "Custom (edited)", 10)
     assert not np.allclose(session.scene.geometry.semi_axes, before_axes)
-    page.page.wait_for_timeout(500)
+    page.drawn_after(session.client)
     after_pixels = canvas_pixels(page)
     changed = np.mean(np.any(np.abs(after_pixels.astype(int) - before_pixels) > 24, axis=2))
     assert changed > 0.01, f"only {changed:.4f} of the view changed"
@@ -154,7 +158,7 @@ def test_choosing_a_preset_changes_the_scene(shared):
     """After the slider's test: from the edited body (paused) to the sphere."""
     app, page, _ = shared
     session = started(app)
-    page.page.wait_for_timeout(300)
+    page.drawn_after(session.client)
     before = canvas_pixels(page)
     sphere = preset_by_key("sphere")
     page.choose("Preset", sphere.label)
@@ -172,7 +176,7 @@ def test_choosing_a_preset_changes_the_scene(shared):
         assert wait_until(lambda g=gone: page.control_count(g) == 0, 15), gone
     assert page.control_count("|ω₀|") == 1  # declared by the sphere: still there
     assert np.allclose(session.scene.geometry.semi_axes, 1.0)
-    page.page.wait_for_timeout(500)
+    page.drawn_after(session.client)
     after = canvas_pixels(page)
     changed = np.mean(np.any(np.abs(after.astype(int) - before) > 24, axis=2))
     assert changed > 0.01, f"only {changed:.4f} of the view changed"
