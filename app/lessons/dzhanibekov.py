@@ -10,7 +10,7 @@ ln(1/ε). A dropdown takes ε over the decades 1e-1 … 1e-12; the motion is exa
 log₁₀ sin(angle of ω from e₂) against time with the theory's slope σ.
 
 A twin (on by default, ε′ = ε/10; a dropdown takes ε/2 … ε/1000 or none) is the same handle
-started at ε′, drawn in cyan over the first: both exact, it flips later, by t₁(ε′) − t₁(ε) →
+started at ε′, drawn in bluish green over the first: both exact, it flips later, by t₁(ε′) − t₁(ε) →
 ln(ε/ε′)/σ, so ten times closer buys only ln(10)/σ more, whatever ε.
 
 Readouts: the time between flips measured from the motion (the zeros of ω₂) against 2K(k)/λ and
@@ -71,9 +71,9 @@ PLOT_SAMPLES = 800
 GROWTH_WINDOWS = ((math.exp(5.0), 1e-3), (math.exp(3.0), 1e-2), (math.exp(2.0), 5e-2))
 HANDLE_NODE = "/space/body/handle"
 HANDLE = Part("handle", "T-handle (its mesh)", (HANDLE_NODE,), surface=colors.SOLID)
-#: The twin: the same handle started at ε′ = ε/n, overlaid in cyan.
+#: The twin: the same handle started at ε′ = ε/n, overlaid in bluish green.
 TWIN_FRAME, TWIN_NODE = "/space/twin", "/space/twin/handle"
-TWIN = Part("twin-body", "its twin at ε′ (cyan)", (TWIN_FRAME, TWIN_NODE), surface=colors.TWIN)
+TWIN = Part("twin-body", "its twin at ε′", (TWIN_FRAME, TWIN_NODE), surface=colors.TWIN)
 #: The twin's ε/ε′ offered (0: no twin).
 TWIN_OPTIONS = ("no twin", "ε′ = ε/2", "ε′ = ε/10", "ε′ = ε/100", "ε′ = ε/1000")
 TWIN_RATIOS = (0.0, 2.0, 10.0, 100.0, 1000.0)
@@ -277,7 +277,8 @@ SPEC = SceneSpec(
             "twin at ε′ (a second start)",
             TWIN_OPTIONS,
             "ε′ = ε/10",
-            hint="A second handle, in cyan, started at ε′: ten times closer to e₂ flips only "
+            hint="A second handle, in bluish green, started at ε′: ten times closer to e₂ flips "
+            "only "
             "ln(10)/σ later.",
             values=TWIN_RATIOS,
         ),

@@ -243,7 +243,7 @@ SPEC = SceneSpec(
             (ROOT, CONE_NODE, RIM_NODE),
             (colors.PHASE_CONE,),
         ),
-        Part("cap", "its cap Ω (shaded)", (CAP_NODE,), surface=colors.PHASE_CAP),
+        Part("cap", "its cap Ω (shaded)", (CAP_NODE,), surface=colors.PHASE_CAP, translucent=True),
     ),
     controls=(
         Choice(

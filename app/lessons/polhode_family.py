@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from poinsot.app.construction.geometry import POLHODE_INFLATE, Geometry
+from poinsot.app.construction.palette import Entry
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.view import View
 from poinsot.app.lessons.momentum import (
@@ -39,6 +40,7 @@ from poinsot.app.lessons.momentum import (
     family_lines,
     family_segments,
     momentum_nodes,
+    momentum_rows,
 )
 from poinsot.app.lessons.support import colors
 from poinsot.app.lessons.support.base import CONSTRUCTION, PartsDrawing, SceneModel
@@ -293,14 +295,26 @@ SPEC = SceneSpec(
             "polhode family (by kind)",
             (FAMILY_ROOT, *(f"{FAMILY_ROOT}/{kind}" for kind in KINDS)),
             tuple(color for _, color in KINDS.values()),
+            legend=(
+                Entry("polhodes round the minor axis", (colors.MINOR_FAMILY,), "line"),
+                Entry("polhodes round the major axis", (colors.MAJOR_FAMILY,), "line"),
+                Entry("separatrix (thick)", (colors.SEPARATRIX,), "line", "thick"),
+            ),
         ),
-        Part("current", "polhodes of this D", (CURRENT_NODE,), (colors.CURRENT,)),
+        Part(
+            "current",
+            "polhodes of this D",
+            (CURRENT_NODE,),
+            (colors.CURRENT,),
+            legend=(Entry("polhodes of this D (thick)", (colors.CURRENT,), "line", "thick"),),
+        ),
         Part(
             "landau",
             "Landau's view (momentum space)",
             momentum_nodes(LANDAU_ROOT, family=False, current=True, trace=False),
             (colors.CURRENT,),
             surface=colors.SPHERE,
+            legend=momentum_rows(family=False, current=True, trace=False),
         ),
     ),
     controls=(

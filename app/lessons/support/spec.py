@@ -27,6 +27,7 @@ import numpy as np
 import viser
 
 from poinsot.app.construction.geometry import Geometry
+from poinsot.app.construction.palette import Entry, Style
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.view import DEFAULT_VIEW, View
 from poinsot.app.model.elements import Control, Element, Solid
@@ -75,7 +76,10 @@ class Part:
     ``nodes``: the scene node names it creates; ``trails``: those of its nodes that are trail
     groups (their chunks ``<group>/c<n>`` come and go); ``colors``: the colours of its lines,
     drawn unlit in exactly these colours (a picture of the scene shows them); ``surface``: its
-    colour where it is a lit or translucent surface instead (shaded on screen), else None.
+    colour where it is a lit or translucent surface instead (shaded on screen), else None;
+    ``legend``: its rows in the legend where it draws more than one thing (each colour it
+    draws in one of them), else one row of its label is made (:meth:`rows`; ``translucent``:
+    its surface is seen through).
     """
 
     key: str
@@ -84,6 +88,21 @@ class Part:
     colors: tuple[RGB, ...] = ()
     trails: tuple[str, ...] = ()
     surface: RGB | None = None
+    legend: tuple[Entry, ...] = ()
+    translucent: bool = False
+
+    def __post_init__(self) -> None:
+        if not self.legend and len(self.colors) + (self.surface is not None) > 1:
+            raise ValueError(f"part {self.key}: more than one colour needs its legend rows")
+
+    def rows(self) -> tuple[Entry, ...]:
+        """Its rows in the legend: its own, or its label with its one colour."""
+        if self.legend:
+            return self.legend
+        if self.surface is not None:
+            style: Style = "translucent" if self.translucent else "solid"
+            return (Entry(self.label, (self.surface,), "patch", style),)
+        return tuple(Entry(self.label, (color,), "line") for color in self.colors)
 
 
 @dataclasses.dataclass(frozen=True)
