@@ -298,10 +298,10 @@ SPEC = SceneSpec(
             "perturbation",
             "perturbation off e₂ (log scale)",
             "t",
-            "log₁₀ sin(angle from e₂)",
+            "log₁₀ sin ∠(ω, e₂)",
             (
                 ("motion", colors.PLOT_MEASURED),
-                ("ε e^{σt}", colors.PLOT_THEORY),
+                ("theory ε·exp(σt)", colors.PLOT_THEORY),
                 ("twin at ε′", colors.PLOT_TWIN),
             ),
         ),

@@ -126,7 +126,7 @@ class SinkModel(TabulatedModel):
     times: np.ndarray  # (N,) the table's grid
     omega: np.ndarray  # (N, 3) body frame
     quaternions: np.ndarray  # (N, 4) scalar-last
-    D_motion: np.ndarray  # (N,) G²/2T of the motion
+    D_motion: np.ndarray  # (N,) |L|²/2T of the motion
     family: list[PolhodeCurve]
 
     def readouts(self, t: float) -> tuple[Readout, ...]:

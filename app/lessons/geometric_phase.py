@@ -112,7 +112,7 @@ class PhaseModel(SceneModel):
         major, minor = separatrix_solid_angles(INERTIA)
         limit = major if self.D > I2 else minor
         return (
-            Readout.compare("D = |L|²/2T", self.D, D_motion, EXACT, "measured: G²/2T of ω(t)"),
+            Readout.compare("D = |L|²/2T", self.D, D_motion, EXACT, "measured: |L|²/2T of ω(t)"),
             Readout("period P = 4K/λ", number(ph.period), "—"),
             Readout("dynamic part 2TP/|L|", f"{ph.dynamic:.9f} rad", "—"),
             Readout("geometric part −Ω", f"{ph.geometric:.9f} rad", "—"),

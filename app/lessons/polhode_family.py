@@ -1,7 +1,7 @@
 """Scene "polhode-family": the energy ellipsoid carries a whole family of polhodes
 [LL76 §37, Fig. 51; FM06 §7.8, Fig. 7.7; Pars65 §13.12].
 
-What it shows: the polhodes of a 3 × 2 × 1 box for D = G²/2T evenly spread over [I₁, I₃],
+What it shows: the polhodes of a 3 × 2 × 1 box for D = |L|²/2T evenly spread over [I₁, I₃],
 drawn on its energy ellipsoid and coloured by family: closed curves around the minor axis
 (D < I₂), closed curves around the major axis (D > I₂), and the separatrix (D = I₂), the two
 ellipses crossing at ±e₂. The curves of the current D are highlighted, and the body runs on one
@@ -130,7 +130,7 @@ class FamilyModel(SceneModel):
             for c in landau.curves
         )
         return (
-            Readout.compare("D = G²/2T", self.D, D_motion, EXACT, "measured: G²/2T of ω(t)"),
+            Readout.compare("D = |L|²/2T", self.D, D_motion, EXACT, "measured: |L|²/2T of ω(t)"),
             Readout("family", _family(body.regime), _kept_sign(w)),
             Readout("k²", number(body.parameter), "—"),
             _period(body.period, self.measured_period),
@@ -181,7 +181,9 @@ def _wobble(body: FreeRigidBody) -> Readout:
             WOBBLE,
             number(theory),
             number(fit.frequency),
-            f"{formula} holds near the axis only ({tilt})",
+            f"the small-oscillation theory {formula} holds near the axis only, and L "
+            f"is far from it here ({tilt}, beyond {math.degrees(NEAR_AXIS):.0f}°)",
+            applies=False,
         )
     note = f"{formula}; measured: the angle between L and a transverse axis ({tilt})"
     return Readout.compare(WOBBLE, theory, fit.frequency, max(fit.amplitude**2, EXACT), note)
@@ -332,7 +334,7 @@ SPEC = SceneSpec(
     ),
     shared=frozenset({Control.SPEED, Control.PLAYBACK, Control.TRAIL, Control.VISIBILITY}),
     readouts=(
-        "D = G²/2T",
+        "D = |L|²/2T",
         "family",
         "k²",
         "period of ω (4K/λ)",

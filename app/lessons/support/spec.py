@@ -19,7 +19,9 @@ model, and ``advance`` sends poses and trail increments only.
 from __future__ import annotations
 
 import dataclasses
+import html
 import math
+import re
 from collections.abc import Callable, Mapping
 from typing import Protocol
 
@@ -178,6 +180,9 @@ class Readout:
     note: str = ""
     gap: float | None = None
     tolerance: float | None = None
+    #: False where the theory does not hold for this motion (its note says why): the screen
+    #: says so instead of showing a gap.
+    applies: bool = True
 
     @classmethod
     def compare(
@@ -357,6 +362,60 @@ def table(rows: tuple[Readout, ...]) -> str:
     lines = ["| quantity | theory | measured |", "|:--|--:|--:|"]
     lines += [f"| {escape(r.quantity)} | {escape(r.theory)} | {escape(r.measured)} |" for r in rows]
     notes = [f"<small>{r.quantity}: {r.note}</small>" for r in rows if r.note]
+    return "\n".join(lines + ([""] + notes if notes else []))
+
+
+#: Significant figures of a number on screen (the readout table and the CSV keep them all).
+SCREEN_DIGITS = 4
+_NUMBER = re.compile(r"(?<![\w.^₀-₉])[-+−]?\d+\.\d+(?:e[-+]?\d+)?(?![\w.])")
+
+
+def on_screen(text: str) -> str:
+    """``text`` with each decimal number cut to SCREEN_DIGITS significant figures."""
+
+    def cut(match: re.Match[str]) -> str:
+        text = match.group(0)
+        value = float(text.replace("−", "-"))
+        cut = number(float(f"{value:.{SCREEN_DIGITS}g}"), SCREEN_DIGITS)
+        return cut.replace("-", "−", 1) if text.startswith("−") else cut
+
+    return _NUMBER.sub(cut, text)
+
+
+def screen_cells(row: Readout) -> tuple[str, str]:
+    """A row's theory and measured cells as the screen shows them: SCREEN_DIGITS figures, the
+    gap in words (a percentage, or "agrees" within a millionth), and "not valid here" where
+    the theory does not hold."""
+    theory = on_screen(row.theory)
+    measured = on_screen(row.measured.split(" (")[0]) if row.gap is not None else row.measured
+    if row.gap is not None and math.isfinite(row.gap) and row.measured.endswith(")"):
+        size = abs(row.gap)
+        said = "agrees" if size < 1e-6 else f"{100.0 * row.gap:+.2g} %"
+        measured = f"{measured} ({said})"
+    elif row.gap is None:
+        measured = on_screen(row.measured)
+    if not row.applies:
+        theory = f"{theory} (not valid here)"
+    return theory, measured
+
+
+def _full(shown: str, full: str) -> str:
+    """A cell showing ``shown``, with every digit of ``full`` on hover where they differ."""
+    if shown == full:
+        return shown
+    return f'<span title="{html.escape(full)}">{html.escape(shown, quote=False)}</span>'
+
+
+def screen_table(rows: tuple[Readout, ...]) -> str:
+    """Readout rows as the screen shows them (:func:`screen_cells`; every digit on hover),
+    notes below."""
+    escape = lambda text: text.replace("|", "\\|")  # noqa: E731
+    lines = ["| quantity | theory | measured |", "|:--|--:|--:|"]
+    for r in rows:
+        theory, measured = screen_cells(r)
+        cells = (r.quantity, _full(theory, r.theory), _full(measured, r.measured))
+        lines.append("| " + " | ".join(escape(c) for c in cells) + " |")
+    notes = [f"<small>{r.quantity}: {on_screen(r.note)}</small>" for r in rows if r.note]
     return "\n".join(lines + ([""] + notes if notes else []))
 
 

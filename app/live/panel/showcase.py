@@ -33,7 +33,7 @@ from poinsot.app.lessons.support.spec import (
     SceneSpec,
     Slider,
     Value,
-    table,
+    screen_table,
 )
 from poinsot.app.live.panel.motion_window import MotionWindow
 from poinsot.app.live.panel.widgets import Removable, Retirement, Sent, on_user, set_value
@@ -196,7 +196,7 @@ class LiveShowcase:
         PLOT_HZ, sent when they show more samples)."""
         if now - self._last_readout >= 1.0 / READOUT_HZ:
             self._last_readout = now
-            text = table(self.showcase.readouts(t))
+            text = screen_table(self.showcase.readouts(t))
             if text != self._readout_text:
                 self._readout_text = text
                 self.motion.show_readouts(text)
