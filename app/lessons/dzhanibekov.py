@@ -4,7 +4,7 @@ measurement [ACC91; LL76 §37; FM06 Theorem 7.3; DLMF 19.12.1].
 What it shows: the bundled T-handle (its moments from its own mesh through trimesh, uniform
 density) spun at the angle ε from its intermediate axis e₂, in Poinsot's construction. The flips
 come like a clock: every 2K(k)/λ, the first one at (K ± δ)/λ; the perturbation off e₂ first
-grows like e^{σt}; and 2K/λ tends to ln(16/(1 − k²))/λ, so the time between flips grows like
+grows like exp(σt); and 2K/λ tends to ln(16/(1 − k²))/λ, so the time between flips grows like
 ln(1/ε). A dropdown takes ε over the decades 1e-1 … 1e-12; the motion is exact at every one
 (an integrator is not at 1e-12: ``python -m poinsot.physics.models.flip``). A plot shows
 log₁₀ sin(angle of ω from e₂) against time with the theory's slope σ.
@@ -255,7 +255,8 @@ SPEC = SceneSpec(
     source=(
         "[ACC91; LL76 §37; FM06 Theorem 7.3; DLMF 19.12.1]: a T-handle spun at ε from its "
         "intermediate axis flips every 2K(k)/λ → ln(16/(1−k²))/λ; the perturbation first grows "
-        "like e^{σt}, so the flip time grows like ln(1/ε). Dzhanibekov's wing nut, Salyut 7 (1985)."
+        "like exp(σt), so the flip time grows like ln(1/ε). Dzhanibekov's wing nut, Salyut 7 "
+        "(1985)."
     ),
     body="the bundled T-handle mesh (assets/bodies/t_handle.stl), moments by trimesh at "
     "uniform density, normalised to I₃ = 1",

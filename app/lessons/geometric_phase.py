@@ -30,6 +30,7 @@ import numpy as np
 import viser
 
 from poinsot.app.construction.geometry import Geometry
+from poinsot.app.construction.palette import Entry
 from poinsot.app.construction.view import View
 from poinsot.app.lessons.support import colors
 from poinsot.app.lessons.support.base import PartsDrawing, SceneModel
@@ -242,6 +243,7 @@ SPEC = SceneSpec(
             "cone of L in the body",
             (ROOT, CONE_NODE, RIM_NODE),
             (colors.PHASE_CONE,),
+            legend=(Entry("cone of L (body)", (colors.PHASE_CONE,), "line"),),
         ),
         Part("cap", "its cap Ω (shaded)", (CAP_NODE,), surface=colors.PHASE_CAP, translucent=True),
     ),

@@ -272,7 +272,7 @@ SPEC = SceneSpec(
             "mean drift of the axis",
             (DRIFT_NODE, f"{DRIFT_NODE}_label"),
             surface=colors.DRIFT,
-            legend=(Entry("mean drift of the axis", (colors.DRIFT,), "arrow"),),
+            legend=(Entry("drift of the axis", (colors.DRIFT,), "arrow"),),
         ),
         Part(
             "omega",

@@ -101,22 +101,22 @@ def momentum_rows(
 ) -> tuple[Entry, ...]:
     """The legend rows of a :class:`MomentumPicture`: each thing it draws, in its colour."""
     rows = [
-        Entry("momentum sphere |L| = const", (colors.SPHERE,), "patch", "translucent"),
+        Entry("momentum sphere", (colors.SPHERE,), "patch", "translucent"),
         Entry("momentum axes", (colors.GREY,), "axes"),
-        Entry("m = Iω, the tip of L in the body", (colors.MOMENTUM,), "dot"),
+        Entry("m = Iω", (colors.MOMENTUM,), "dot"),
     ]
     if ellipsoid:
         rows.append(Entry("energy ellipsoid", (colors.ELLIPSOID,), "patch", "translucent"))
     if family:
         rows += [
-            Entry("polhodes round the minor axis", (colors.MINOR_FAMILY,), "line"),
-            Entry("polhodes round the major axis", (colors.MAJOR_FAMILY,), "line"),
-            Entry("separatrix (thick)", (colors.SEPARATRIX,), "line", "thick"),
+            Entry("minor-axis polhodes", (colors.MINOR_FAMILY,), "line"),
+            Entry("major-axis polhodes", (colors.MAJOR_FAMILY,), "line"),
+            Entry("separatrix", (colors.SEPARATRIX,), "line", "thick"),
         ]
     if current:
-        rows.append(Entry("polhodes of this D (thick)", (colors.CURRENT,), "line", "thick"))
+        rows.append(Entry("this D's polhodes", (colors.CURRENT,), "line", "thick"))
     if trace:
-        rows.append(Entry("trace of m (thick)", (colors.MOMENTUM_TRACE,), "line", "thick"))
+        rows.append(Entry("trace of m", (colors.MOMENTUM_TRACE,), "line", "thick"))
     return tuple(rows)
 
 

@@ -85,7 +85,7 @@ D_STEP = 0.005
 #: Landau's picture stands this far to the side (space x, display units).
 LANDAU_OFFSET = (2.75, 0.0, 0.1)
 LANDAU_RADIUS = 0.62
-LANDAU_TITLE = "Landau: |L| = G  ∩  Σ Lᵢ²/Iᵢ = 2T"
+LANDAU_TITLE = "Landau: |L| fixed  ∩  Σ Lᵢ²/Iᵢ = 2T"
 ROOT = "/space"
 FAMILY_ROOT = f"{ROOT}/body/family"
 CURRENT_NODE = f"{ROOT}/body/current_polhode"
@@ -285,7 +285,7 @@ SPEC = SceneSpec(
     source=(
         "[LL76 §37, Fig. 51; FM06 §7.8, Fig. 7.7; Pars65 §13.12]: the polhodes of one body fill "
         "its energy ellipsoid, closed around the minor and the major axis, split by the "
-        "separatrix through ±e₂. Landau's view: the sphere |L| = G meets the ellipsoid "
+        "separatrix through ±e₂. Landau's view: the sphere of fixed |L| meets the ellipsoid "
         "Σ Lᵢ²/Iᵢ = 2T along the polhode."
     ),
     body="the presets' homogeneous 3 × 2 × 1 box, I = (1, 2, 2.6)",
@@ -298,9 +298,9 @@ SPEC = SceneSpec(
             (FAMILY_ROOT, *(f"{FAMILY_ROOT}/{kind}" for kind in KINDS)),
             tuple(color for _, color in KINDS.values()),
             legend=(
-                Entry("polhodes round the minor axis", (colors.MINOR_FAMILY,), "line"),
-                Entry("polhodes round the major axis", (colors.MAJOR_FAMILY,), "line"),
-                Entry("separatrix (thick)", (colors.SEPARATRIX,), "line", "thick"),
+                Entry("minor-axis polhodes", (colors.MINOR_FAMILY,), "line"),
+                Entry("major-axis polhodes", (colors.MAJOR_FAMILY,), "line"),
+                Entry("separatrix", (colors.SEPARATRIX,), "line", "thick"),
             ),
         ),
         Part(
@@ -308,7 +308,7 @@ SPEC = SceneSpec(
             "polhodes of this D",
             (CURRENT_NODE,),
             (colors.CURRENT,),
-            legend=(Entry("polhodes of this D (thick)", (colors.CURRENT,), "line", "thick"),),
+            legend=(Entry("this D's polhodes", (colors.CURRENT,), "line", "thick"),),
         ),
         Part(
             "landau",

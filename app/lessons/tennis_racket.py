@@ -235,7 +235,7 @@ SPEC = SceneSpec(
             (colors.HANDLE_PATH, colors.NORMAL_PATH),
             legend=(
                 Entry("the handle's path", (colors.HANDLE_PATH,), "line"),
-                Entry("the head normal's path", (colors.NORMAL_PATH,), "line"),
+                Entry("head normal's path", (colors.NORMAL_PATH,), "line"),
             ),
         ),
     ),

@@ -214,3 +214,14 @@ def test_the_palette_is_okabe_and_itos():
     }
     assert palette.DARK.polhode == palette.OKABE_ITO["reddish purple"]
     assert palette.DARK.omega == palette.OKABE_ITO["yellow"]
+
+
+#: The longest row name the legend's two columns show whole in the 300 px left column at its
+#: 0.78 rem text ("T-handle (its mesh)", 19 characters, was the longest seen whole; "polhodes
+#: round the major axis" was cut).
+NAME_CHARACTERS = 19
+
+
+def test_every_legend_row_name_fits_its_column():
+    long = {row.name for _, _, rows in legends() for row in rows if len(row.name) > NAME_CHARACTERS}
+    assert long == set()

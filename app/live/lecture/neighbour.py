@@ -38,7 +38,7 @@ from poinsot.physics.models.twins import neighbour_start
 
 FOLDER = "Compare with a neighbour"
 #: The neighbour's row in the legend while it is drawn.
-ROW = Entry("neighbour body at ε′", (colors.TWIN,), "patch")
+ROW = Entry("neighbour at ε′", (colors.TWIN,), "patch")
 LABEL = "Neighbour's start ε′"
 OPTIONS = ("no neighbour", "1e-2 rad", "1e-4 rad", "1e-6 rad", "1e-8 rad")
 ANGLES = (0.0, 1e-2, 1e-4, 1e-6, 1e-8)

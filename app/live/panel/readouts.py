@@ -102,7 +102,7 @@ def regime_text(body: FreeRigidBody) -> str:
     so (the T-handle's flip is not a wobble round the major axis)."""
     text = REGIME_TEXT.get(body.regime, str(body.regime))
     if near_middle(body):
-        return f"flipping about the middle axis ({text}, near the separatrix)"
+        return "flipping about the middle axis (near the separatrix)"
     return text
 
 
