@@ -8,6 +8,7 @@ session drew for that time."""
 from __future__ import annotations
 
 import itertools
+import html
 import re
 
 import numpy as np
@@ -146,8 +147,24 @@ def plot_data(probe: Probe, title: str) -> list[np.ndarray]:
 _CELL = re.compile(r"(?<!\\)\|")
 
 
+_HOVER = re.compile(r'<span title="([^"]*)">(.*)</span>')
+
+
+def shown(cell: str) -> str:
+    """A cell's text as shown (a quantity's definition on hover left out)."""
+    match = _HOVER.fullmatch(cell)
+    return html.unescape(match.group(2)) if match else cell
+
+
+def every_digit(cell: str) -> str:
+    """A number cell with every digit the page carries (on hover, where the screen rounds)."""
+    match = _HOVER.fullmatch(cell)
+    return html.unescape(match.group(1)) if match else cell
+
+
 def readout_table(probe: Probe) -> dict[str, tuple[str, str]]:
-    """The readout table as shown: quantity -> (theory, measured)."""
+    """The readout table as shown: quantity -> (theory, measured), every digit the page
+    carries (the screen shows 4 significant figures, the rest on hover)."""
     _, widgets = probe.snapshot()
     for w in widgets.values():
         text = str(w.props.get("_markdown", ""))
@@ -157,7 +174,7 @@ def readout_table(probe: Probe) -> dict[str, tuple[str, str]]:
                 if not line.startswith("|"):
                     break
                 cells = [c.strip().replace("\\|", "|") for c in _CELL.split(line)[1:-1]]
-                rows[cells[0]] = (cells[1], cells[2])
+                rows[shown(cells[0])] = (every_digit(cells[1]), every_digit(cells[2]))
             return rows
     return {}
 

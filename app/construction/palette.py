@@ -1,31 +1,54 @@
-"""Colours and sizes of the scene and its plots, chosen for a dark background on a lecture
-projector, and the :class:`Look` of the scene on each theme.
+"""Colours and sizes of the scene and its plots, and the :class:`Look` of the scene on each
+theme.
 
-Saturated, mutually distinct hues (the axes keep the red/green/blue convention of
-1/2/3), traces brighter than the surfaces they lie on, and line widths in screen pixels so
-that they stay legible from the back of the room at any zoom. The constants below are the
-dark theme's; :func:`look` gives the light theme's and the projector's (high contrast, thick
-lines, large labels), which the scene, the legend and the exports follow.
+The hues are Okabe and Ito's palette for colour vision deficiency [OI08] (its reddish purple,
+sky blue, yellow, vermillion, orange, bluish green and blue), lightened on the dark theme and
+darkened on the light one so that every line, arrow and marker keeps at least 3 : 1 against
+its panel [WCAG21 §1.4.11]. Elements of one kind (the curves, the arrows, the
+surfaces) stay at least CIEDE2000 15 apart for normal vision and under simulated
+deuteranopia, protanopia and tritanopia [MOF09; SWD05]; the whole polhode shares the polhode's hue
+and is told apart by its thinner line, the axes by their labels 1, 2, 3 (each legend row
+declares its cue: :class:`Entry`). Line widths are in screen pixels, so that they stay legible
+from the back of the room at any zoom. The constants below are the dark theme's; :func:`look`
+gives the light theme's and the projector's (thick lines, large labels), which the scene, the
+legend and the exports follow.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from typing import Literal
 
 import viser.uplot
 
 RGB = tuple[int, int, int]
 
-ELLIPSOID: RGB = (255, 179, 71)
+#: Okabe and Ito's eight colours [OI08], as published.
+OKABE_ITO: dict[str, RGB] = {
+    "black": (0, 0, 0),
+    "orange": (230, 159, 0),
+    "sky blue": (86, 180, 233),
+    "bluish green": (0, 158, 115),
+    "yellow": (240, 228, 66),
+    "blue": (0, 114, 178),
+    "vermillion": (213, 94, 0),
+    "reddish purple": (204, 121, 167),
+}
+
+#: The panels' backgrounds the colours are chosen against: viser's dark theme and white.
+DARK_BACKGROUND: RGB = (36, 36, 36)
+LIGHT_BACKGROUND: RGB = (255, 255, 255)
+
+ELLIPSOID: RGB = (180, 130, 30)
 ELLIPSOID_OPACITY = 0.38
-SOLID: RGB = (110, 130, 165)
-AXES: tuple[RGB, RGB, RGB] = ((239, 83, 80), (102, 214, 106), (80, 170, 255))
-POLHODE: RGB = (255, 64, 160)
-POLHODE_FULL: RGB = (185, 100, 150)
-HERPOLHODE: RGB = (0, 229, 255)
-OMEGA: RGB = (255, 238, 70)
-ANGULAR_MOMENTUM: RGB = (200, 150, 255)
-PLANE: RGB = (120, 150, 175)
+SOLID: RGB = (110, 120, 140)
+AXES: tuple[RGB, RGB, RGB] = ((224, 134, 64), (0, 158, 115), (77, 162, 210))
+POLHODE: RGB = OKABE_ITO["reddish purple"]
+POLHODE_FULL: RGB = POLHODE
+HERPOLHODE: RGB = (154, 210, 242)
+OMEGA: RGB = OKABE_ITO["yellow"]
+ANGULAR_MOMENTUM: RGB = OKABE_ITO["vermillion"]
+PLANE: RGB = (179, 179, 179)
 PLANE_OPACITY = 0.18
 PLANE_GRID: RGB = (80, 100, 120)
 PLANE_RIM: RGB = (190, 210, 225)
@@ -38,8 +61,8 @@ BRAND: RGB = (255, 179, 71)
 #: white (the amber gave 1.6 : 1, pale orange text on white).
 BRAND_LIGHT: RGB = (82, 41, 0)
 
-#: The numerical ghost: an ice-blue, distinct from the amber ellipsoid, the traces and the RGB
-#: axes; a faint shell, its principal sections and axes drawn as lines.
+#: The numerical ghost: an ice-blue, distinct from the pale amber ellipsoid and the axes; a faint
+#: shell, its principal sections and axes drawn as lines.
 GHOST: RGB = (150, 205, 255)
 GHOST_OPACITY = 0.16
 
@@ -55,6 +78,28 @@ GHOST_WIDTH_PX = 2.0
 PLOT_SERIES = tuple("#{:02x}{:02x}{:02x}".format(*c) for c in AXES)
 #: The ghost's error plot: ω error, attitude error, energy error.
 GHOST_PLOT_SERIES = ("#ffd84a", "#bfe1ff", "#ff6fb0")
+
+Shape = Literal["line", "arrow", "dot", "patch", "axes"]
+#: How a line is drawn besides its colour: "thin" and "thick" against the traces' width,
+#: "dashed"; "labelled": its parts carry their names in the scene (the axes 1, 2, 3);
+#: "translucent": a surface seen through (an opaque one is "solid").
+Style = Literal["solid", "thin", "thick", "dashed", "labelled", "translucent"]
+
+
+@dataclasses.dataclass(frozen=True)
+class Entry:
+    """One row of a legend: a swatch of ``colors`` drawn as ``shape`` in ``style``, and its
+    name. Two rows whose shape or style differ are told apart without their colours."""
+
+    name: str
+    colors: tuple[RGB, ...]
+    shape: Shape
+    style: Style = "solid"
+
+    @property
+    def cue(self) -> tuple[str, str]:
+        """What tells this row from another one of the same colour: its shape and style."""
+        return self.shape, self.style
 
 
 def brand(dark_mode: bool) -> RGB:
@@ -105,19 +150,20 @@ class Look:
 
 #: The dark theme: the constants above.
 DARK = Look()
-#: The light theme: the hues of the dark one, darkened where they would fade on white (the
-#: cyan herpolhode, the yellow omega, the white contact point, the pale rim).
+#: The light theme: the hues of the dark one, darkened to 3 : 1 or more on white (the sky-blue
+#: herpolhode becomes Okabe and Ito's blue, the yellow omega an olive, the white contact point
+#: black, the pale rim dark).
 LIGHT = dataclasses.replace(
     DARK,
-    ellipsoid=(240, 150, 30),
     ellipsoid_opacity=0.32,
-    axes=((215, 45, 40), (40, 160, 50), (30, 110, 220)),
-    polhode=(225, 0, 120),
-    polhode_full=(170, 70, 130),
-    herpolhode=(0, 150, 200),
-    omega=(205, 150, 0),
-    angular_momentum=(120, 60, 220),
-    plane=(110, 135, 160),
+    solid=(55, 65, 82),
+    axes=((192, 85, 0), (0, 120, 85), (64, 149, 197)),
+    polhode=OKABE_ITO["reddish purple"],
+    polhode_full=OKABE_ITO["reddish purple"],
+    herpolhode=(0, 103, 160),
+    omega=(156, 148, 43),
+    angular_momentum=(106, 47, 0),
+    plane=(115, 115, 115),
     plane_grid=(150, 165, 180),
     plane_rim=(70, 90, 110),
     contact=(30, 30, 30),
@@ -125,14 +171,11 @@ LIGHT = dataclasses.replace(
 )
 
 
-def _projector(base: Look, polhode: RGB, herpolhode: RGB, omega: RGB) -> Look:
-    """A projector in daylight: fully saturated traces, lines twice as thick, labels half again
-    as large (on either theme; the theme's background stays)."""
+def _projector(base: Look) -> Look:
+    """A projector in daylight: the theme's colours (already of full contrast), lines twice as
+    thick, labels half again as large (on either theme; the theme's background stays)."""
     return dataclasses.replace(
         base,
-        polhode=polhode,
-        herpolhode=herpolhode,
-        omega=omega,
         trace_width=7.0,
         full_polhode_width=4.0,
         axis_width=5.0,
@@ -142,8 +185,19 @@ def _projector(base: Look, polhode: RGB, herpolhode: RGB, omega: RGB) -> Look:
     )
 
 
-PROJECTOR_DARK = _projector(DARK, (255, 0, 150), (0, 200, 255), (255, 240, 0))
-PROJECTOR_LIGHT = _projector(LIGHT, (210, 0, 110), (0, 120, 190), (205, 150, 0))
+PROJECTOR_DARK = _projector(DARK)
+PROJECTOR_LIGHT = _projector(LIGHT)
+LOOKS: dict[str, Look] = {
+    "dark": DARK,
+    "light": LIGHT,
+    "projector, dark": PROJECTOR_DARK,
+    "projector, light": PROJECTOR_LIGHT,
+}
+
+
+def background(look: Look) -> RGB:
+    """The panel's background behind ``look``'s legend."""
+    return LIGHT_BACKGROUND if look in (LIGHT, PROJECTOR_LIGHT) else DARK_BACKGROUND
 
 
 def look(dark_mode: bool = True, projector: bool = False) -> Look:

@@ -4,13 +4,13 @@ measurement [ACC91; LL76 §37; FM06 Theorem 7.3; DLMF 19.12.1].
 What it shows: the bundled T-handle (its moments from its own mesh through trimesh, uniform
 density) spun at the angle ε from its intermediate axis e₂, in Poinsot's construction. The flips
 come like a clock: every 2K(k)/λ, the first one at (K ± δ)/λ; the perturbation off e₂ first
-grows like e^{σt}; and 2K/λ tends to ln(16/(1 − k²))/λ, so the time between flips grows like
+grows like exp(σt); and 2K/λ tends to ln(16/(1 − k²))/λ, so the time between flips grows like
 ln(1/ε). A dropdown takes ε over the decades 1e-1 … 1e-12; the motion is exact at every one
 (an integrator is not at 1e-12: ``python -m poinsot.physics.models.flip``). A plot shows
 log₁₀ sin(angle of ω from e₂) against time with the theory's slope σ.
 
 A twin (on by default, ε′ = ε/10; a dropdown takes ε/2 … ε/1000 or none) is the same handle
-started at ε′, drawn in cyan over the first: both exact, it flips later, by t₁(ε′) − t₁(ε) →
+started at ε′, drawn in bluish green over the first: both exact, it flips later, by t₁(ε′) − t₁(ε) →
 ln(ε/ε′)/σ, so ten times closer buys only ln(10)/σ more, whatever ε.
 
 Readouts: the time between flips measured from the motion (the zeros of ω₂) against 2K(k)/λ and
@@ -71,9 +71,9 @@ PLOT_SAMPLES = 800
 GROWTH_WINDOWS = ((math.exp(5.0), 1e-3), (math.exp(3.0), 1e-2), (math.exp(2.0), 5e-2))
 HANDLE_NODE = "/space/body/handle"
 HANDLE = Part("handle", "T-handle (its mesh)", (HANDLE_NODE,), surface=colors.SOLID)
-#: The twin: the same handle started at ε′ = ε/n, overlaid in cyan.
+#: The twin: the same handle started at ε′ = ε/n, overlaid in bluish green.
 TWIN_FRAME, TWIN_NODE = "/space/twin", "/space/twin/handle"
-TWIN = Part("twin-body", "its twin at ε′ (cyan)", (TWIN_FRAME, TWIN_NODE), surface=colors.TWIN)
+TWIN = Part("twin-body", "its twin at ε′", (TWIN_FRAME, TWIN_NODE), surface=colors.TWIN)
 #: The twin's ε/ε′ offered (0: no twin).
 TWIN_OPTIONS = ("no twin", "ε′ = ε/2", "ε′ = ε/10", "ε′ = ε/100", "ε′ = ε/1000")
 TWIN_RATIOS = (0.0, 2.0, 10.0, 100.0, 1000.0)
@@ -255,7 +255,8 @@ SPEC = SceneSpec(
     source=(
         "[ACC91; LL76 §37; FM06 Theorem 7.3; DLMF 19.12.1]: a T-handle spun at ε from its "
         "intermediate axis flips every 2K(k)/λ → ln(16/(1−k²))/λ; the perturbation first grows "
-        "like e^{σt}, so the flip time grows like ln(1/ε). Dzhanibekov's wing nut, Salyut 7 (1985)."
+        "like exp(σt), so the flip time grows like ln(1/ε). Dzhanibekov's wing nut, Salyut 7 "
+        "(1985)."
     ),
     body="the bundled T-handle mesh (assets/bodies/t_handle.stl), moments by trimesh at "
     "uniform density, normalised to I₃ = 1",
@@ -277,7 +278,8 @@ SPEC = SceneSpec(
             "twin at ε′ (a second start)",
             TWIN_OPTIONS,
             "ε′ = ε/10",
-            hint="A second handle, in cyan, started at ε′: ten times closer to e₂ flips only "
+            hint="A second handle, in bluish green, started at ε′: ten times closer to e₂ flips "
+            "only "
             "ln(10)/σ later.",
             values=TWIN_RATIOS,
         ),
@@ -297,10 +299,10 @@ SPEC = SceneSpec(
             "perturbation",
             "perturbation off e₂ (log scale)",
             "t",
-            "log₁₀ sin(angle from e₂)",
+            "log₁₀ sin ∠(ω, e₂)",
             (
                 ("motion", colors.PLOT_MEASURED),
-                ("ε e^{σt}", colors.PLOT_THEORY),
+                ("theory ε·exp(σt)", colors.PLOT_THEORY),
                 ("twin at ε′", colors.PLOT_TWIN),
             ),
         ),

@@ -34,9 +34,16 @@ import numpy as np
 import trimesh
 
 from poinsot.app.construction.geometry import Geometry, triple
+from poinsot.app.construction.palette import Entry
 from poinsot.app.construction.sampled.frames import wxyz_from_xyzw
 from poinsot.app.construction.view import View
-from poinsot.app.lessons.momentum import SPHERE_RADIUS, MomentumPicture, extent, momentum_nodes
+from poinsot.app.lessons.momentum import (
+    SPHERE_RADIUS,
+    MomentumPicture,
+    extent,
+    momentum_nodes,
+    momentum_rows,
+)
 from poinsot.app.lessons.support import colors
 from poinsot.app.lessons.support.base import TabulatedDrawing, TabulatedModel
 from poinsot.app.lessons.support.drawing import THIN_ARROW, arrow_points
@@ -119,7 +126,7 @@ class SinkModel(TabulatedModel):
     times: np.ndarray  # (N,) the table's grid
     omega: np.ndarray  # (N, 3) body frame
     quaternions: np.ndarray  # (N, 4) scalar-last
-    D_motion: np.ndarray  # (N,) G²/2T of the motion
+    D_motion: np.ndarray  # (N,) |L|²/2T of the motion
     family: list[PolhodeCurve]
 
     def readouts(self, t: float) -> tuple[Readout, ...]:
@@ -266,8 +273,20 @@ SPEC = SceneSpec(
     elements=frozenset(),
     parts=(
         Part("satellite", "the satellite", (SATELLITE_NODE,), surface=colors.SOLID),
-        Part("omega", "ω (its direction)", (OMEGA_NODE,), surface=colors.OMEGA),
-        Part("L", "L (fixed)", (L_NODE,), surface=colors.L),
+        Part(
+            "omega",
+            "ω (its direction)",
+            (OMEGA_NODE,),
+            surface=colors.OMEGA,
+            legend=(Entry("ω (its direction)", (colors.OMEGA,), "arrow"),),
+        ),
+        Part(
+            "L",
+            "L (fixed)",
+            (L_NODE,),
+            surface=colors.L,
+            legend=(Entry("L (fixed)", (colors.L,), "arrow"),),
+        ),
         Part(
             "momentum",
             "momentum sphere and family",
@@ -275,6 +294,7 @@ SPEC = SceneSpec(
             (colors.MINOR_FAMILY, colors.MAJOR_FAMILY, colors.SEPARATRIX, colors.MOMENTUM_TRACE),
             trails=(f"{MOMENTUM_ROOT}/trace",),
             surface=colors.SPHERE,
+            legend=momentum_rows(family=True, current=False, trace=True, ellipsoid=False),
         ),
     ),
     controls=(

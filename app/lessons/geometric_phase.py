@@ -30,6 +30,7 @@ import numpy as np
 import viser
 
 from poinsot.app.construction.geometry import Geometry
+from poinsot.app.construction.palette import Entry
 from poinsot.app.construction.view import View
 from poinsot.app.lessons.support import colors
 from poinsot.app.lessons.support.base import PartsDrawing, SceneModel
@@ -112,7 +113,7 @@ class PhaseModel(SceneModel):
         major, minor = separatrix_solid_angles(INERTIA)
         limit = major if self.D > I2 else minor
         return (
-            Readout.compare("D = |L|²/2T", self.D, D_motion, EXACT, "measured: G²/2T of ω(t)"),
+            Readout.compare("D = |L|²/2T", self.D, D_motion, EXACT, "measured: |L|²/2T of ω(t)"),
             Readout("period P = 4K/λ", number(ph.period), "—"),
             Readout("dynamic part 2TP/|L|", f"{ph.dynamic:.9f} rad", "—"),
             Readout("geometric part −Ω", f"{ph.geometric:.9f} rad", "—"),
@@ -242,8 +243,9 @@ SPEC = SceneSpec(
             "cone of L in the body",
             (ROOT, CONE_NODE, RIM_NODE),
             (colors.PHASE_CONE,),
+            legend=(Entry("cone of L (body)", (colors.PHASE_CONE,), "line"),),
         ),
-        Part("cap", "its cap Ω (shaded)", (CAP_NODE,), surface=colors.PHASE_CAP),
+        Part("cap", "its cap Ω (shaded)", (CAP_NODE,), surface=colors.PHASE_CAP, translucent=True),
     ),
     controls=(
         Choice(

@@ -31,6 +31,7 @@ import numpy as np
 
 from poinsot.app.construction import meshes
 from poinsot.app.construction.geometry import Geometry
+from poinsot.app.construction.palette import Entry
 from poinsot.app.construction.sampled.frames import wxyz_from_xyzw
 from poinsot.app.construction.view import View
 from poinsot.app.lessons.support import colors
@@ -264,14 +265,22 @@ SPEC = SceneSpec(
             "torque M (along x₂)",
             (TORQUE_NODE, f"{TORQUE_NODE}_label"),
             surface=colors.TORQUE,
+            legend=(Entry("torque M (along x₂)", (colors.TORQUE,), "arrow"),),
         ),
         Part(
             "drift",
             "mean drift of the axis",
             (DRIFT_NODE, f"{DRIFT_NODE}_label"),
             surface=colors.DRIFT,
+            legend=(Entry("drift of the axis", (colors.DRIFT,), "arrow"),),
         ),
-        Part("omega", "ω", (OMEGA_NODE,), surface=colors.OMEGA),
+        Part(
+            "omega",
+            "ω",
+            (OMEGA_NODE,),
+            surface=colors.OMEGA,
+            legend=(Entry("ω", (colors.OMEGA,), "arrow"),),
+        ),
         Part("path", "path of the axis", (PATH_NODE,), (colors.AXIS_PATH,), trails=(PATH_NODE,)),
     ),
     controls=(

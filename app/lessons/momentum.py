@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike
 
 from poinsot.app.construction import palette
 from poinsot.app.construction.geometry import triple
+from poinsot.app.construction.palette import Entry
 from poinsot.app.lessons.support import colors
 from poinsot.app.lessons.support.drawing import Parts, many_segments, unit_sphere
 from poinsot.physics import Regime
@@ -95,6 +96,30 @@ def current_segments(curves: Iterable[PolhodeCurve], scale: float, momentum: boo
     )
 
 
+def momentum_rows(
+    *, family: bool, current: bool, trace: bool, ellipsoid: bool = True
+) -> tuple[Entry, ...]:
+    """The legend rows of a :class:`MomentumPicture`: each thing it draws, in its colour."""
+    rows = [
+        Entry("momentum sphere", (colors.SPHERE,), "patch", "translucent"),
+        Entry("momentum axes", (colors.GREY,), "axes"),
+        Entry("m = Iω", (colors.MOMENTUM,), "dot"),
+    ]
+    if ellipsoid:
+        rows.append(Entry("energy ellipsoid", (colors.ELLIPSOID,), "patch", "translucent"))
+    if family:
+        rows += [
+            Entry("minor-axis polhodes", (colors.MINOR_FAMILY,), "line"),
+            Entry("major-axis polhodes", (colors.MAJOR_FAMILY,), "line"),
+            Entry("separatrix", (colors.SEPARATRIX,), "line", "thick"),
+        ]
+    if current:
+        rows.append(Entry("this D's polhodes", (colors.CURRENT,), "line", "thick"))
+    if trace:
+        rows.append(Entry("trace of m", (colors.MOMENTUM_TRACE,), "line", "thick"))
+    return tuple(rows)
+
+
 def momentum_nodes(
     root: str, *, family: bool, current: bool, trace: bool, ellipsoid: bool = True
 ) -> tuple[str, ...]:
@@ -151,7 +176,7 @@ class MomentumPicture:
             else None
         )
         self.axes = [
-            parts.lines(part, f"{root}/axis{i + 1}", palette.AXES[i], palette.AXIS_WIDTH_PX)
+            parts.lines(part, f"{root}/axis{i + 1}", colors.GREY, palette.AXIS_WIDTH_PX)
             for i in range(3)
         ]
         self.family = family_lines(parts, part, root) if family else {}

@@ -1,7 +1,7 @@
 """Scene "polhode-family": the energy ellipsoid carries a whole family of polhodes
 [LL76 §37, Fig. 51; FM06 §7.8, Fig. 7.7; Pars65 §13.12].
 
-What it shows: the polhodes of a 3 × 2 × 1 box for D = G²/2T evenly spread over [I₁, I₃],
+What it shows: the polhodes of a 3 × 2 × 1 box for D = |L|²/2T evenly spread over [I₁, I₃],
 drawn on its energy ellipsoid and coloured by family: closed curves around the minor axis
 (D < I₂), closed curves around the major axis (D > I₂), and the separatrix (D = I₂), the two
 ellipses crossing at ±e₂. The curves of the current D are highlighted, and the body runs on one
@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from poinsot.app.construction.geometry import POLHODE_INFLATE, Geometry
+from poinsot.app.construction.palette import Entry
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.view import View
 from poinsot.app.lessons.momentum import (
@@ -39,6 +40,7 @@ from poinsot.app.lessons.momentum import (
     family_lines,
     family_segments,
     momentum_nodes,
+    momentum_rows,
 )
 from poinsot.app.lessons.support import colors
 from poinsot.app.lessons.support.base import CONSTRUCTION, PartsDrawing, SceneModel
@@ -83,7 +85,7 @@ D_STEP = 0.005
 #: Landau's picture stands this far to the side (space x, display units).
 LANDAU_OFFSET = (2.75, 0.0, 0.1)
 LANDAU_RADIUS = 0.62
-LANDAU_TITLE = "Landau: |L| = G  ∩  Σ Lᵢ²/Iᵢ = 2T"
+LANDAU_TITLE = "Landau: |L| fixed  ∩  Σ Lᵢ²/Iᵢ = 2T"
 ROOT = "/space"
 FAMILY_ROOT = f"{ROOT}/body/family"
 CURRENT_NODE = f"{ROOT}/body/current_polhode"
@@ -128,7 +130,7 @@ class FamilyModel(SceneModel):
             for c in landau.curves
         )
         return (
-            Readout.compare("D = G²/2T", self.D, D_motion, EXACT, "measured: G²/2T of ω(t)"),
+            Readout.compare("D = |L|²/2T", self.D, D_motion, EXACT, "measured: |L|²/2T of ω(t)"),
             Readout("family", _family(body.regime), _kept_sign(w)),
             Readout("k²", number(body.parameter), "—"),
             _period(body.period, self.measured_period),
@@ -179,7 +181,9 @@ def _wobble(body: FreeRigidBody) -> Readout:
             WOBBLE,
             number(theory),
             number(fit.frequency),
-            f"{formula} holds near the axis only ({tilt})",
+            f"the small-oscillation theory {formula} holds near the axis only, and L "
+            f"is far from it here ({tilt}, beyond {math.degrees(NEAR_AXIS):.0f}°)",
+            applies=False,
         )
     note = f"{formula}; measured: the angle between L and a transverse axis ({tilt})"
     return Readout.compare(WOBBLE, theory, fit.frequency, max(fit.amplitude**2, EXACT), note)
@@ -281,7 +285,7 @@ SPEC = SceneSpec(
     source=(
         "[LL76 §37, Fig. 51; FM06 §7.8, Fig. 7.7; Pars65 §13.12]: the polhodes of one body fill "
         "its energy ellipsoid, closed around the minor and the major axis, split by the "
-        "separatrix through ±e₂. Landau's view: the sphere |L| = G meets the ellipsoid "
+        "separatrix through ±e₂. Landau's view: the sphere of fixed |L| meets the ellipsoid "
         "Σ Lᵢ²/Iᵢ = 2T along the polhode."
     ),
     body="the presets' homogeneous 3 × 2 × 1 box, I = (1, 2, 2.6)",
@@ -293,14 +297,26 @@ SPEC = SceneSpec(
             "polhode family (by kind)",
             (FAMILY_ROOT, *(f"{FAMILY_ROOT}/{kind}" for kind in KINDS)),
             tuple(color for _, color in KINDS.values()),
+            legend=(
+                Entry("minor-axis polhodes", (colors.MINOR_FAMILY,), "line"),
+                Entry("major-axis polhodes", (colors.MAJOR_FAMILY,), "line"),
+                Entry("separatrix", (colors.SEPARATRIX,), "line", "thick"),
+            ),
         ),
-        Part("current", "polhodes of this D", (CURRENT_NODE,), (colors.CURRENT,)),
+        Part(
+            "current",
+            "polhodes of this D",
+            (CURRENT_NODE,),
+            (colors.CURRENT,),
+            legend=(Entry("this D's polhodes", (colors.CURRENT,), "line", "thick"),),
+        ),
         Part(
             "landau",
             "Landau's view (momentum space)",
             momentum_nodes(LANDAU_ROOT, family=False, current=True, trace=False),
             (colors.CURRENT,),
             surface=colors.SPHERE,
+            legend=momentum_rows(family=False, current=True, trace=False),
         ),
     ),
     controls=(
@@ -318,7 +334,7 @@ SPEC = SceneSpec(
     ),
     shared=frozenset({Control.SPEED, Control.PLAYBACK, Control.TRAIL, Control.VISIBILITY}),
     readouts=(
-        "D = G²/2T",
+        "D = |L|²/2T",
         "family",
         "k²",
         "period of ω (4K/λ)",

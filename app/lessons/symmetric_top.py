@@ -28,6 +28,7 @@ import numpy as np
 import viser
 
 from poinsot.app.construction.geometry import Geometry
+from poinsot.app.construction.palette import Entry
 from poinsot.app.lessons.support import colors
 from poinsot.app.lessons.support.base import CONSTRUCTION, PartsDrawing, SceneModel
 from poinsot.app.lessons.support.drawing import cone_mesh, segments
@@ -197,6 +198,7 @@ SPEC = SceneSpec(
             "body cone (rides with the body)",
             (BODY_CONE, f"{BODY_CONE}_rim"),
             (colors.BODY_CONE,),
+            legend=(Entry("body cone (moves)", (colors.BODY_CONE,), "line"),),
         ),
         Part(
             "space_cone",

@@ -31,6 +31,7 @@ import numpy as np
 
 from poinsot.app.construction import meshes
 from poinsot.app.construction.geometry import Geometry
+from poinsot.app.construction.palette import Entry
 from poinsot.app.construction.view import View
 from poinsot.app.lessons.support import colors
 from poinsot.app.lessons.support.base import OwnSolid, RidingMesh, SceneModel
@@ -232,6 +233,10 @@ SPEC = SceneSpec(
             "handle's and head normal's paths",
             (HANDLE_PATH_NODE, NORMAL_PATH_NODE),
             (colors.HANDLE_PATH, colors.NORMAL_PATH),
+            legend=(
+                Entry("the handle's path", (colors.HANDLE_PATH,), "line"),
+                Entry("head normal's path", (colors.NORMAL_PATH,), "line"),
+            ),
         ),
     ),
     controls=(

@@ -104,7 +104,7 @@ def test_the_D_slider_sweeps_the_family(make_app, make_probe):
         curve = segments(nodes["/space/body/current_polhode"])[:, 0] / POLHODE_INFLATE
         x = body_frame_omega(nodes)
         assert np.min(np.linalg.norm(curve - x, axis=1)) < 0.01
-        assert number_in(rows["D = G²/2T"][0]) == pytest.approx(D, rel=1e-6)
+        assert number_in(rows["D = |L|²/2T"][0]) == pytest.approx(D, rel=1e-6)
 
 
 def test_dzhanibekov_flips_and_growth_read_off_the_plot(make_app, make_probe):

@@ -19,7 +19,9 @@ model, and ``advance`` sends poses and trail increments only.
 from __future__ import annotations
 
 import dataclasses
+import html
 import math
+import re
 from collections.abc import Callable, Mapping
 from typing import Protocol
 
@@ -27,6 +29,7 @@ import numpy as np
 import viser
 
 from poinsot.app.construction.geometry import Geometry
+from poinsot.app.construction.palette import Entry, Style
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.view import DEFAULT_VIEW, View
 from poinsot.app.model.elements import Control, Element, Solid
@@ -75,7 +78,10 @@ class Part:
     ``nodes``: the scene node names it creates; ``trails``: those of its nodes that are trail
     groups (their chunks ``<group>/c<n>`` come and go); ``colors``: the colours of its lines,
     drawn unlit in exactly these colours (a picture of the scene shows them); ``surface``: its
-    colour where it is a lit or translucent surface instead (shaded on screen), else None.
+    colour where it is a lit or translucent surface instead (shaded on screen), else None;
+    ``legend``: its rows in the legend where it draws more than one thing (each colour it
+    draws in one of them), else one row of its label is made (:meth:`rows`; ``translucent``:
+    its surface is seen through).
     """
 
     key: str
@@ -84,6 +90,21 @@ class Part:
     colors: tuple[RGB, ...] = ()
     trails: tuple[str, ...] = ()
     surface: RGB | None = None
+    legend: tuple[Entry, ...] = ()
+    translucent: bool = False
+
+    def __post_init__(self) -> None:
+        if not self.legend and len(self.colors) + (self.surface is not None) > 1:
+            raise ValueError(f"part {self.key}: more than one colour needs its legend rows")
+
+    def rows(self) -> tuple[Entry, ...]:
+        """Its rows in the legend: its own, or its label with its one colour."""
+        if self.legend:
+            return self.legend
+        if self.surface is not None:
+            style: Style = "translucent" if self.translucent else "solid"
+            return (Entry(self.label, (self.surface,), "patch", style),)
+        return tuple(Entry(self.label, (color,), "line") for color in self.colors)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -159,6 +180,9 @@ class Readout:
     note: str = ""
     gap: float | None = None
     tolerance: float | None = None
+    #: False where the theory does not hold for this motion (its note says why): the screen
+    #: says so instead of showing a gap.
+    applies: bool = True
 
     @classmethod
     def compare(
@@ -338,6 +362,60 @@ def table(rows: tuple[Readout, ...]) -> str:
     lines = ["| quantity | theory | measured |", "|:--|--:|--:|"]
     lines += [f"| {escape(r.quantity)} | {escape(r.theory)} | {escape(r.measured)} |" for r in rows]
     notes = [f"<small>{r.quantity}: {r.note}</small>" for r in rows if r.note]
+    return "\n".join(lines + ([""] + notes if notes else []))
+
+
+#: Significant figures of a number on screen (the readout table and the CSV keep them all).
+SCREEN_DIGITS = 4
+_NUMBER = re.compile(r"(?<![\w.^₀-₉])[-+−]?\d+\.\d+(?:e[-+]?\d+)?(?![\w.])")
+
+
+def on_screen(text: str) -> str:
+    """``text`` with each decimal number cut to SCREEN_DIGITS significant figures."""
+
+    def cut(match: re.Match[str]) -> str:
+        text = match.group(0)
+        value = float(text.replace("−", "-"))
+        cut = number(float(f"{value:.{SCREEN_DIGITS}g}"), SCREEN_DIGITS)
+        return cut.replace("-", "−", 1) if text.startswith("−") else cut
+
+    return _NUMBER.sub(cut, text)
+
+
+def screen_cells(row: Readout) -> tuple[str, str]:
+    """A row's theory and measured cells as the screen shows them: SCREEN_DIGITS figures, the
+    gap in words (a percentage, or "agrees" within a millionth), and "not valid here" where
+    the theory does not hold."""
+    theory = on_screen(row.theory)
+    measured = on_screen(row.measured.split(" (")[0]) if row.gap is not None else row.measured
+    if row.gap is not None and math.isfinite(row.gap) and row.measured.endswith(")"):
+        size = abs(row.gap)
+        said = "agrees" if size < 1e-6 else f"{100.0 * row.gap:+.2g} %"
+        measured = f"{measured} ({said})"
+    elif row.gap is None:
+        measured = on_screen(row.measured)
+    if not row.applies:
+        theory = f"{theory} (not valid here)"
+    return theory, measured
+
+
+def _full(shown: str, full: str) -> str:
+    """A cell showing ``shown``, with every digit of ``full`` on hover where they differ."""
+    if shown == full:
+        return shown
+    return f'<span title="{html.escape(full)}">{html.escape(shown, quote=False)}</span>'
+
+
+def screen_table(rows: tuple[Readout, ...]) -> str:
+    """Readout rows as the screen shows them (:func:`screen_cells`; every digit on hover),
+    notes below."""
+    escape = lambda text: text.replace("|", "\\|")  # noqa: E731
+    lines = ["| quantity | theory | measured |", "|:--|--:|--:|"]
+    for r in rows:
+        theory, measured = screen_cells(r)
+        cells = (r.quantity, _full(theory, r.theory), _full(measured, r.measured))
+        lines.append("| " + " | ".join(escape(c) for c in cells) + " |")
+    notes = [f"<small>{r.quantity}: {on_screen(r.note)}</small>" for r in rows if r.note]
     return "\n".join(lines + ([""] + notes if notes else []))
 
 

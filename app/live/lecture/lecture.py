@@ -396,5 +396,5 @@ def add_lecture_controls(session: LectureSession, **kwargs: float) -> LectureCon
     call its ``on_frame(frame)`` after each frame."""
     controls = LectureControls(session, **kwargs)
     controls.challenges = add_challenges(session)
-    controls.neighbour = add_neighbour(session)
+    controls.neighbour = add_neighbour(session, session.panel.motion.legend.show_rows)
     return controls

@@ -1,6 +1,7 @@
 """Compare with a neighbour: any preset's body and a second one started ε′ away from it
 (:func:`poinsot.physics.models.twins.neighbour_start`: ω₀ turned by ε′, the same |ω₀|), drawn over
-the first in cyan with the preset's own solid, both exact.
+the first in bluish green with the preset's own solid (a row of the legend says so), both
+exact.
 
 A dropdown of the control panel chooses ε′ (or no neighbour). Near the intermediate axis the
 folder reads both first flips, (K ± δ)/λ (:func:`poinsot.physics.models.flip.flip_theory`), and the
@@ -14,6 +15,7 @@ choice (one attribute, assigned atomically); the session's frame thread builds t
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from typing import Protocol
 
 import numpy as np
@@ -22,6 +24,7 @@ import viser
 from poinsot.app.construction import updates
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.geometry import triple
+from poinsot.app.construction.palette import Entry
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.sampled.frames import wxyz_from_xyzw
 from poinsot.app.construction.sampled.sampling import MotionSampler, Samples
@@ -34,6 +37,8 @@ from poinsot.physics.models.flip import FlipTheory, flip_theory, measure_flips
 from poinsot.physics.models.twins import neighbour_start
 
 FOLDER = "Compare with a neighbour"
+#: The neighbour's row in the legend while it is drawn.
+ROW = Entry("neighbour at ε′", (colors.TWIN,), "patch")
 LABEL = "Neighbour's start ε′"
 OPTIONS = ("no neighbour", "1e-2 rad", "1e-4 rad", "1e-6 rad", "1e-8 rad")
 ANGLES = (0.0, 1e-2, 1e-4, 1e-6, 1e-8)
@@ -57,15 +62,24 @@ class NeighbourSession(Protocol):
 class Neighbour:
     """The folder, the neighbour's body and its node in one session."""
 
-    def __init__(self, session: NeighbourSession, order: float = FOLDER_ORDER) -> None:
+    def __init__(
+        self,
+        session: NeighbourSession,
+        order: float = FOLDER_ORDER,
+        legend: Callable[[str, Sequence[Entry]], None] | None = None,
+    ) -> None:
+        """``legend``: where the neighbour's row is listed while it is drawn (the legend's
+        :meth:`~poinsot.app.live.panel.legend.Legend.show_rows`)."""
         self.session = session
+        self._legend = legend
         gui = session.client.gui
         with gui.add_folder(FOLDER, order=order, expand_by_default=False):
             self.choice = gui.add_dropdown(
                 LABEL,
                 OPTIONS,
                 initial_value=OPTIONS[0],
-                hint="A second body started ε′ away (ω₀ turned by ε′), drawn in cyan over the "
+                hint="A second body started ε′ away (ω₀ turned by ε′), drawn in bluish green over "
+                "the "
                 "first: near the middle axis, ten times closer flips only ln(10)/σ later.",
             )
             self.readout = gui.add_markdown("")
@@ -134,19 +148,25 @@ class Neighbour:
             receive_shadow=False,
         )
         self.readout.content = readout(body, self.body, angle)
+        self._list(ROW)
 
     def _remove(self) -> None:
-        """Take the neighbour's nodes away (the mesh, then its frame)."""
+        """Take the neighbour's nodes away (the mesh, then its frame), and its legend row."""
         for node in (self.mesh, self.frame):
             if node is not None:
                 node.remove()
         self.frame = self.mesh = None
+        self._list()
+
+    def _list(self, *rows: Entry) -> None:
+        if self._legend is not None:
+            self._legend("neighbour", rows)
 
 
 def readout(first: FreeRigidBody, second: FreeRigidBody, angle: float) -> str:
     """The two first flips and their lag, theory against the motions (markdown)."""
     J = np.asarray(first.inertia)
-    head = f"Neighbour at ε′ = {angle:g} rad from this start, in cyan."
+    head = f"Neighbour at ε′ = {angle:g} rad from this start, in bluish green."
     if not (bool(np.all(np.diff(J) > 0.0)) and _closest_to_middle(first) < NEAR_MIDDLE):
         return head + " It never comes near the middle axis: it stays close (no flip to time)."
     try:
@@ -178,5 +198,7 @@ def _closest_to_middle(body: FreeRigidBody) -> float:
     return float(np.min(np.minimum(angles, math.pi - angles)))
 
 
-def add_neighbour(session: NeighbourSession) -> Neighbour:
-    return Neighbour(session)
+def add_neighbour(
+    session: NeighbourSession, legend: Callable[[str, Sequence[Entry]], None] | None = None
+) -> Neighbour:
+    return Neighbour(session, legend=legend)

@@ -6,20 +6,21 @@ A preset's caption is its own :attr:`~poinsot.app.model.presets.Preset.caption` 
 scene of :mod:`poinsot.app.lessons` sets it there, or calls :meth:`Legend.show_caption` at any
 time), else the one written here for it. The legend lists the elements the scene declares, in the
 colours of the current look (:func:`poinsot.app.construction.palette.look`: theme and projector),
-plus any entries a scene adds for drawings of its own.
+plus the rows of the drawings a scene or a lecture tool adds (:meth:`Legend.show_rows`: a scene's
+parts, the neighbour body). Each row's swatch shows its shape and style too (a thinner or dashed
+line), the cue that tells it from a row of a like colour (:class:`~poinsot.app.construction.
+palette.Entry`).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import html
 from collections.abc import Callable, Iterable, Sequence
-from typing import Literal
 
 import viser
 
 from poinsot.app.construction import palette
-from poinsot.app.construction.palette import RGB, Look
+from poinsot.app.construction.palette import Entry, Look
 from poinsot.app.model.elements import Element
 from poinsot.app.model.presets import Preset
 
@@ -60,16 +61,7 @@ def caption(preset: Preset) -> str:
     return preset.caption or CAPTIONS.get(preset.key, "")
 
 
-Shape = Literal["line", "arrow", "dot", "patch", "axes"]
-
-
-@dataclasses.dataclass(frozen=True)
-class Entry:
-    """One line of the legend: a swatch of ``colors`` drawn as ``shape``, and its name."""
-
-    name: str
-    colors: tuple[RGB, ...]
-    shape: Shape
+__all__ = ["CAPTIONS", "Entry", "Legend", "caption", "entries", "legend_html", "merged"]
 
 
 def entries(elements: Iterable[Element], look: Look) -> list[Entry]:
@@ -80,14 +72,23 @@ def entries(elements: Iterable[Element], look: Look) -> list[Entry]:
         Element.OMEGA: Entry("ω ang. velocity", (look.omega,), "arrow"),
         Element.L: Entry("L ang. momentum", (look.angular_momentum,), "arrow"),
         Element.CONTACT: Entry("contact point", (look.contact,), "dot"),
-        Element.PLANE: Entry("invariable plane", (look.plane,), "patch"),
-        Element.ELLIPSOID: Entry("energy ellipsoid", (look.ellipsoid,), "patch"),
-        Element.POLHODE_FULL: Entry("whole polhode", (look.polhode_full,), "line"),
-        Element.AXES: Entry("axes 1 2 3", look.axes, "axes"),
+        Element.PLANE: Entry("invariable plane", (look.plane,), "patch", "translucent"),
+        Element.ELLIPSOID: Entry("energy ellipsoid", (look.ellipsoid,), "patch", "translucent"),
+        Element.POLHODE_FULL: Entry("whole polhode", (look.polhode_full,), "line", "thin"),
+        Element.AXES: Entry("axes 1 2 3", look.axes, "axes", "labelled"),
         Element.SOLID: Entry("the body", (look.solid,), "patch"),
     }
     declared = set(elements)
     return [entry for element, entry in table.items() if element in declared]
+
+
+#: A line swatch's thickness [em] by style (the traces' 0.32 em; a thin line half as thick).
+_LINE_HEIGHT = {"thin": 0.14, "thick": 0.5}
+
+
+def merged(rows: Iterable[Entry]) -> list[Entry]:
+    """``rows`` once each, in order (two pictures of one thing, one row)."""
+    return list(dict.fromkeys(rows))
 
 
 _OUTLINE = "box-shadow:0 0 0 1px rgba(128,128,128,0.7);"
@@ -101,7 +102,15 @@ def _swatch(entry: Entry) -> str:
     """A small inline picture of the entry's colour(s), about 1.6 em wide."""
     c = [palette.css(rgb) for rgb in entry.colors]
     if entry.shape == "line":
-        return _span(f"width:1.6em;height:0.32em;border-radius:0.16em;background:{c[0]}")
+        height = _LINE_HEIGHT.get(entry.style, 0.32)
+        paint = (
+            f"repeating-linear-gradient(90deg,{c[0]} 0 0.3em,transparent 0.3em 0.5em)"
+            if entry.style == "dashed"
+            else c[0]
+        )
+        return _span(
+            f"width:1.6em;height:{height}em;border-radius:{height / 2:g}em;background:{paint}"
+        )
     if entry.shape == "arrow":
         bar = _span(f"width:1.15em;height:0.22em;background:{c[0]}")
         head = _span(
@@ -115,8 +124,13 @@ def _swatch(entry: Entry) -> str:
             + _OUTLINE
         )
     if entry.shape == "patch":
+        paint = (  # a translucent surface hatched, an opaque one filled
+            f"repeating-linear-gradient(135deg,{c[0]} 0 0.22em,transparent 0.22em 0.36em)"
+            if entry.style == "translucent"
+            else c[0]
+        )
         return _span(
-            f"width:1.6em;height:0.8em;border-radius:0.15em;background:{c[0]};opacity:0.85;"
+            f"width:1.6em;height:0.8em;border-radius:0.15em;background:{paint};opacity:0.85;"
             + _OUTLINE
         )
     bars = "".join(
@@ -128,7 +142,7 @@ def _swatch(entry: Entry) -> str:
 def legend_html(items: Sequence[Entry]) -> str:
     """The legend as HTML: two columns of swatch and name (text in the theme's colour)."""
     cells = "".join(
-        f'<div data-legend="{html.escape(e.name)}" style="white-space:nowrap">'
+        f'<div data-legend="{html.escape(e.name)}" data-cue="{e.style}" style="white-space:nowrap">'
         f'<span style="display:inline-block;width:1.9em">{_swatch(e)}</span>'
         f"{html.escape(e.name)}</div>"
         for e in items
@@ -148,6 +162,8 @@ class Legend:
         self.legend = gui.add_html("", order=order + 0.5)
         self._elements: frozenset[Element] = frozenset()
         self._extra: tuple[Entry, ...] = ()
+        #: Rows of the drawings a scene or a lecture tool adds, by who added them.
+        self._rows: dict[str, tuple[Entry, ...]] = {}
         self._look = palette.DARK
         #: Other places that show the legend too, each with its wrapping (a phone's sheet).
         self._mirrors: list[tuple[viser.GuiHtmlHandle, Callable[[str], str]]] = []
@@ -163,6 +179,17 @@ class Legend:
         self._elements, self._extra = frozenset(elements), tuple(extra)
         self._render()
 
+    def show_rows(self, owner: str, rows: Sequence[Entry]) -> None:
+        """List ``rows`` after the elements' for ``owner``'s drawings (a scene's parts, the
+        neighbour body), replacing what ``owner`` listed before; no rows take them away."""
+        if tuple(rows) == self._rows.get(owner, ()):
+            return
+        if rows:
+            self._rows[owner] = tuple(rows)
+        else:
+            self._rows.pop(owner, None)
+        self._render()
+
     def restyle(self, look: Look) -> None:
         """The scene's colours changed (theme, projector)."""
         self._look = look
@@ -174,7 +201,8 @@ class Legend:
         self._render()
 
     def items(self) -> list[Entry]:
-        return [*entries(self._elements, self._look), *self._extra]
+        added = [row for rows in self._rows.values() for row in rows]
+        return merged([*entries(self._elements, self._look), *self._extra, *added])
 
     def _render(self) -> None:
         items = self.items()

@@ -22,6 +22,7 @@ import viser
 
 from poinsot.app.lessons import SCENES, scene_by_label
 from poinsot.app.lessons.support.spec import SceneSpec
+from poinsot.app.live.panel import readouts
 from poinsot.app.live.panel.body_controls import D_STEP, BodyControls
 from poinsot.app.live.panel.legend import caption
 from poinsot.app.live.panel.motion_window import MotionWindow
@@ -326,7 +327,7 @@ class ControlPanel:
 
     @staticmethod
     def _source_text(preset: Preset) -> str:
-        return f"<small>_Source:_ {preset.source}</small>"
+        return f"<small>_Source:_ {readouts.readable(preset.source)}</small>"
 
     def show_status(self, message: str) -> None:
         text = f"**⚠ {message}**" if message else ""

@@ -23,6 +23,7 @@ from poinsot.app.construction import palette
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.sampled.motion import MotionCache
+from poinsot.app.lessons.support import colors
 from poinsot.app.lessons.support.runtime import Showcase
 from poinsot.app.lessons.support.spec import (
     START_KEY,
@@ -32,7 +33,7 @@ from poinsot.app.lessons.support.spec import (
     SceneSpec,
     Slider,
     Value,
-    table,
+    screen_table,
 )
 from poinsot.app.live.panel.motion_window import MotionWindow
 from poinsot.app.live.panel.widgets import Removable, Retirement, Sent, on_user, set_value
@@ -93,6 +94,7 @@ class LiveShowcase:
             for n, plot in enumerate(spec.plots):
                 self.plots[plot.key] = _add_plot(self.gui, plot, order=10.0 + n)
         self.widgets.extend(self.plots.values())
+        motion.legend.show_rows("scene", [row for part in spec.parts for row in part.rows()])
 
     # -- widgets (callbacks run on viser's threads) --------------------------------------
     def _on_user(self, handle: Any, callback: Callable[[Sent], None]) -> Any:
@@ -194,7 +196,7 @@ class LiveShowcase:
         PLOT_HZ, sent when they show more samples)."""
         if now - self._last_readout >= 1.0 / READOUT_HZ:
             self._last_readout = now
-            text = table(self.showcase.readouts(t))
+            text = screen_table(self.showcase.readouts(t))
             if text != self._readout_text:
                 self._readout_text = text
                 self.motion.show_readouts(text)
@@ -228,6 +230,7 @@ class LiveShowcase:
         self.retirement.retire(self.widgets)
         self.widgets, self.plots = [], {}
         self.motion.show_readouts("")
+        self.motion.legend.show_rows("scene", ())
 
 
 def _add_plot(gui: viser.GuiApi, plot: PlotSpec, order: float) -> viser.GuiUplotHandle:
@@ -235,7 +238,11 @@ def _add_plot(gui: viser.GuiApi, plot: PlotSpec, order: float) -> viser.GuiUplot
     uPlot's x range NaN, see :class:`~poinsot.app.live.panel.motion_window.MotionWindow`)."""
     series = [viser.uplot.Series(label=plot.x_label)]
     for label, stroke in plot.series:
-        series.append(viser.uplot.Series(label=label, stroke=stroke, width=2))
+        # A theory's curve is dashed: told from the motion's without its colour.
+        line = viser.uplot.Series(label=label, stroke=stroke, width=2)
+        if stroke == colors.PLOT_THEORY:
+            line["dash"] = colors.THEORY_DASH
+        series.append(line)
     x_axis, y_axis = palette.plot_axes()
     axes = (
         viser.uplot.Axis(**{**x_axis, "label": plot.x_label}),
