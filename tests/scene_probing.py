@@ -7,8 +7,8 @@ session drew for that time."""
 
 from __future__ import annotations
 
-import itertools
 import html
+import itertools
 import re
 
 import numpy as np

@@ -15,6 +15,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
+from poinsot.app.model import docs_site
 from poinsot.physics import FreeRigidBody, Regime
 from poinsot.physics.models.axis_angles import axis_angles
 from poinsot.physics.models.geometric_phase import montgomery_phase
@@ -178,8 +179,9 @@ def markdown(body: FreeRigidBody) -> str:
     return "\n".join([*lines, "", glossary([label for label, _ in shown])])
 
 
-#: Where the sources are listed in full (a markdown link; the docs site serves the file).
-REFERENCES_URL = "docs/REFERENCES.md"
+#: Where the sources are listed in full: the guide's page of docs/REFERENCES.md, served at
+#: /docs/ by the server (opened beside the scene, so that the session stays).
+REFERENCES_URL = docs_site.PREFIX + "REFERENCES/"
 #: The keys of docs/REFERENCES.md as a reader cites them: authors and year.
 CITATIONS: dict[str, str] = {
     "LL76": "Landau & Lifshitz 1976",
@@ -214,8 +216,9 @@ _CITED = re.compile(r"\[([A-Za-z]+[0-9]*\b[^\]]*)\]")
 
 def readable(source: str) -> str:
     """``source`` with its bracketed keys of docs/REFERENCES.md as authors and year, linked
-    to that list: "[LL76 §37; FM06]" reads "[Landau & Lifshitz 1976, §37; Fasano & Marmi
-    2006](docs/REFERENCES.md)". A bracket that cites no known key is left as it is."""
+    to that list in the guide: "[LL76 §37; FM06]" reads "[Landau & Lifshitz 1976, §37; Fasano &
+    Marmi 2006]", a link to :data:`REFERENCES_URL` opened in a new tab. A bracket that cites no
+    known key is left as it is."""
 
     def cite(match: re.Match[str]) -> str:
         items = [item.strip() for item in match.group(1).split(";")]
@@ -225,7 +228,7 @@ def readable(source: str) -> str:
             if key not in CITATIONS:
                 return match.group(0)
             out.append(CITATIONS[key] + (f", {rest}" if rest else ""))
-        return f"[{'; '.join(out)}]({REFERENCES_URL})"
+        return f'<a href="{REFERENCES_URL}" target="_blank" rel="noopener">[{"; ".join(out)}]</a>'
 
     return _CITED.sub(cite, source)
 
