@@ -315,7 +315,7 @@ def record_frame_times(session: Session) -> list[float]:
     (the time it hands to the frame): the gaps between them show its pacing by its own logic,
     whatever the machine's load."""
     drawn_at: list[float] = []
-    frame_if_taken = session._frame_if_taken
+    frame_if_taken = session.frames.draw
 
     def recording(now: float) -> bool:
         drawn = frame_if_taken(now)
@@ -323,7 +323,7 @@ def record_frame_times(session: Session) -> list[float]:
             drawn_at.append(now)
         return drawn
 
-    session._frame_if_taken = recording  # type: ignore[method-assign]
+    session.frames.draw = recording  # type: ignore[method-assign]
     return drawn_at
 
 

@@ -232,6 +232,39 @@ def test_the_cycle_search_finds_one():
     assert _cycles({"a": {"b"}, "b": set()}) == []
 
 
+def _self_given(source: str) -> list[int]:
+    """Lines where a method hands ``self`` (or a lambda over it) to a call."""
+    lines = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Call):
+            given = [*node.args, *(k.value for k in node.keywords)]
+            if any(isinstance(a, ast.Name) and a.id == "self" for a in given):
+                lines.append(node.lineno)
+    return lines
+
+
+def test_the_session_gives_its_parts_no_self():
+    """The session is composed, not reached through: its builder and the session hand their
+    parts narrow things (the front, the clock, the construction, callbacks), never the
+    session (tests/app/test_session_parts.py walks the parts of a live one)."""
+    session = ROOT / "app" / "live" / "session"
+    given = {
+        f.name: lines for f in sorted(session.glob("*.py")) if (lines := _self_given(f.read_text()))
+    }
+    assert given == {}, given
+    init = ast.parse((session / "session.py").read_text())
+    (cls,) = [n for n in init.body if isinstance(n, ast.ClassDef) and n.name == "Session"]
+    (constructor,) = [
+        n for n in cls.body if isinstance(n, ast.FunctionDef) and n.name == "__init__"
+    ]
+    assert len(constructor.args.args) + len(constructor.args.kwonlyargs) <= 4
+
+
+def test_the_self_search_finds_one():
+    assert _self_given("def f(self):\n    Part(self, 1)\n    Other(x=self)\n") == [2, 3]
+    assert _self_given("def f(self):\n    Part(self.front)\n") == []
+
+
 def test_functions_do_one_step():
     long = {}
     for f in _code_files():

@@ -23,7 +23,7 @@ from poinsot.app.live.hardening.budget import RebuildGate
 from poinsot.app.live.hardening.guard import WireGuard, guarded_viser
 from poinsot.app.live.hardening.pacing import frame_share
 from poinsot.app.live.hardening.upkeep import MemoryTrim, fixed_pool
-from poinsot.app.live.session.session import MAX_FPS, Session
+from poinsot.app.live.session.session import MAX_FPS, Session, SessionOptions
 from poinsot.app.model import docs_site
 from poinsot.app.model.presets import DEFAULT_PRESET, Preset
 from poinsot.app.viser_private import (
@@ -177,15 +177,14 @@ class PoinsotApp:
         if self._stopping.is_set():
             return
         link = links.opening(address, self.preset, self.scene, (self.port, self.landing_port))
-        session = Session(
-            client,
-            link.preset,
+        options = SessionOptions(
             max_fps=self.max_fps,
             budget=self.budget,
             scene=link.scene,
             user_agent=self.guard.user_agent(client.client_id),
             follow=self.follow,
         )
+        session = Session(client, link.preset, options)
         links.apply(session, link)
         with self._connected:
             if self._stopping.is_set():

@@ -26,6 +26,15 @@ OMEGA_NORM_RANGE = (0.2, 4.0)
 SPEED_RANGE = (0.05, 4.0)
 TRAIL_RANGE = (100, 6000)
 
+
+def clamp(value: float, bounds: tuple[float, float]) -> float:
+    """``value`` within ``bounds`` (low, high): the one clamp of a value asked for by code (a
+    link, the lead's state, a script) into a range declared here; a browser's value is clamped
+    into its widget's range by :func:`poinsot.app.live.panel.widgets.checked` instead."""
+    low, high = bounds
+    return min(max(value, low), high)
+
+
 Vector = tuple[float, float, float]
 
 
@@ -96,8 +105,7 @@ class Parameters:
         that moment exactly, the separatrix (a slider's value is only near I₂: D = 2.000 on
         the slider arrived as 1.9999999999999996, a polhode of period 151 around the minor
         axis instead of the separatrix)."""
-        lo, hi = self.D_range
-        D = min(max(float(D), lo), hi)
+        D = clamp(float(D), self.D_range)
         if self.has_separatrix and abs(D - self.intermediate) <= snap:
             D = self.intermediate
         return dataclasses.replace(self, D=D, omega0=None, separatrix=False, D_asked=None)
@@ -142,10 +150,9 @@ class Parameters:
         norm = math.sqrt(sum(x * x for x in w))
         if not (math.isfinite(D) and norm > 0.0):
             return self
-        lo, hi = self.D_range
         return dataclasses.replace(
             self,
-            D=min(max(D, lo), hi),
+            D=clamp(D, self.D_range),
             omega_norm=norm,
             omega0=w,
             D_asked=None,
@@ -158,10 +165,10 @@ class Parameters:
     # -- the body --------------------------------------------------------------------------
     def check(self) -> None:
         """Raise ValueError, with a message for the GUI, if no real body has these values
-        (:func:`poinsot.physics.check_real_body`: the triangle inequality I_i <= I_j + I_k)."""
+        (:func:`poinsot.physics.check_real_body`: the triangle inequality I_i <= I_j + I_k).
+        Every other check of the input is the physics' own, once, as it builds the body
+        (:mod:`poinsot.physics.core.validation`)."""
         check_real_body(self.inertia)
-        if not (math.isfinite(self.omega_norm) and self.omega_norm > 0):
-            raise ValueError("|ω₀| must be positive")
 
     def build(self) -> FreeRigidBody:
         """The body, with L along +z at t = 0. Raises ValueError with a readable message."""

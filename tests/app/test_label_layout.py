@@ -157,7 +157,7 @@ def test_a_frame_carries_at_most_one_of_traces_plot_and_a_layout_step(poinsot_ap
 
         setattr(owner, name, wrapper)
 
-    original_frame = session._frame_if_taken
+    original_frame = session.frames.draw
 
     def frame(now: float) -> bool:
         current.clear()
@@ -171,7 +171,7 @@ def test_a_frame_carries_at_most_one_of_traces_plot_and_a_layout_step(poinsot_ap
     wrap(motion, "send_plot", "plot")
     wrap(motion, "record_plot", "sample", samples)
     wrap(session.scene, "label_steps", "begin", begun)
-    session._frame_if_taken = frame  # type: ignore[method-assign]
+    session.frames.draw = frame  # type: ignore[method-assign]
     assert wait_until(lambda: len(frames) > 240, 30)
     kinds = list(frames)
     assert all("step+" not in f for f in kinds)  # one step a frame at most

@@ -5,9 +5,10 @@ explore from the lecturer's state (the process's :class:`~.follow.FollowHub` lin
   (a new body or scene, a control, play/pause, speed, a jump in time, the camera) is published
   at once, and the state again every :data:`REPUBLISH` seconds.
 - Following: the session shows the lead's state (its link query, :mod:`.links`, opened as a
-  link would be) and takes its time from the hub (:meth:`LeadControls.now`); the browser's
-  changes to the other widgets are refused and put back (:func:`.widgets.hold_input`), said
-  once. "Explore from here" (or unticking "Follow") goes on from exactly that state.
+  link would be) and takes its time from the hub (the session's motion source asks it); the
+  browser's changes to the other widgets are refused and put back
+  (:func:`.widgets.hold_input`), said once. "Explore from here" (or unticking "Follow") goes
+  on from exactly that state.
 
 Threads: GUI callbacks post to the session's queue; the hub's callback only posts; the frame
 thread alone applies a state and publishes one.
@@ -66,26 +67,43 @@ def _camera(client: viser.ClientHandle) -> tuple[tuple[float, ...], ...]:
     )
 
 
-class LeadSession(links.LinkSession, Protocol):
-    """What leading and following use of a session: what a link reads and opens, and its
-    client, playback, scene and body choices."""
+class LeadSession(links.LinkState, Protocol):
+    """What leading and following use of a session's front: what a link reads, its client,
+    clock and construction, and the requests that open the lead's body or scene."""
 
     client: viser.ClientHandle
-    playback: Any
+    clock: Any
+    scene: Any
 
     def report(self, error: BaseException) -> None: ...
-    def regrid(self) -> None: ...
+    def post(self, action: Callable[[], None], key: object = None) -> None: ...
     def edit(self, change: Callable[[Parameters], Parameters]) -> None: ...
     def choose_scene(self, scene: SceneSpec) -> None: ...
     def choose_preset(self, preset: Preset) -> None: ...
 
 
-class LeadControls:
-    """Mounted by the session after its panel; :meth:`on_frame` each frame, :meth:`now` for
-    the frame's time, :meth:`close` when the browser leaves."""
+class Mirror(Protocol):
+    """What a follower changes on its frame thread to show the lead's state: its playback's
+    speed range and trail, the panel's playback and show/hide rows, the motion's grid."""
 
-    def __init__(self, session: LeadSession, hub: FollowHub, order: float = FOLDER_ORDER) -> None:
+    @property
+    def speed_range(self) -> tuple[float, float]: ...
+    def set_trail(self, points: int) -> None: ...
+    def show_playback(self, speed: float, paused: bool, trail: int) -> None: ...
+    def show_visibility(self, visible: Callable[[Element], bool]) -> None: ...
+    def regrid(self) -> None: ...
+
+
+class LeadControls:
+    """Mounted by the session after its panel; :meth:`on_frame` each frame, :meth:`close`
+    when the browser leaves (the frame's time while following: the session's motion source,
+    :mod:`..session.source`). ``mirror``: what a follower changes to show the lead's state."""
+
+    def __init__(
+        self, session: LeadSession, hub: FollowHub, mirror: Mirror, order: float = FOLDER_ORDER
+    ) -> None:
         self.session, self.hub, self.client = session, hub, session.client
+        self.mirror = mirror
         self.mode = "own"  # "lead", "follow" or "own"
         self._published: LeadState | None = None
         self._applied_query: str | None = None
@@ -163,7 +181,8 @@ class LeadControls:
         """Explore from here: the session's own clock goes on from the lead's time."""
         if self.mode != "follow":
             return
-        t = self.now(self.session.clock)
+        lead = self.hub.now()  # the lead's time (None before its first state)
+        t = float(self.session.clock.now()) if lead is None else lead
         self._stop_following()
         self.mode = "own"
         self.session.clock.reset(t)
@@ -208,13 +227,13 @@ class LeadControls:
         clock = session.clock
         if clock.paused != state.paused:
             clock.paused = state.paused
-        lo, hi = session.playback.speed_range
+        lo, hi = self.mirror.speed_range
         if not math.isclose(clock.speed, state.speed) and lo <= state.speed <= hi:
             clock.speed = state.speed
-            session.regrid()  # the worker's shared motion on the new grid
+            self.mirror.regrid()  # the worker's shared motion on the new grid
         clock.reset(state.time(time.monotonic()))
         self._mirror_shown(state)
-        session.panel.show_playback(clock.speed, clock.paused, session.scene.trail_points)
+        self.mirror.show_playback(clock.speed, clock.paused, session.scene.trail_points)
         if self.camera.value and state.camera and state.camera != self._applied_camera:
             self._applied_camera = state.camera
             position, look_at, up = (np.asarray(v, float) for v in state.camera)
@@ -228,7 +247,7 @@ class LeadControls:
         session = self.session
         scene = session.scene
         if state.trail is not None and state.trail != scene.trail_points:
-            session.playback.set_trail(clamp_trail(state.trail))
+            self.mirror.set_trail(clamp_trail(state.trail))
         changed = False
         for element in Element:
             visible = element.name not in state.hidden
@@ -238,7 +257,7 @@ class LeadControls:
                 scene.set_visible(element, visible)
                 changed = True
         if changed:
-            session.panel.show_visibility(scene.is_visible)
+            self.mirror.show_visibility(scene.is_visible)
         if session.showcase is not None:
             session.showcase.show_parts(state.parts)
 
@@ -294,14 +313,6 @@ class LeadControls:
             hidden=tuple(e.name for e in sorted(scene.elements) if not scene.is_visible(e)),
             parts=() if session.showcase is None else session.showcase.hidden_parts(),
         )
-
-    def now(self, clock: Any) -> float:
-        """The frame's simulation time: the lead's while following, else the session's."""
-        if self.mode == "follow":
-            t = self.hub.now()
-            if t is not None:
-                return t
-        return float(clock.now())
 
     def close(self) -> None:
         """The browser left."""

@@ -269,14 +269,8 @@ def _pairs_or_empty(query: str) -> bool:
         return True
 
 
-class LinkSession(Protocol):
-    """What a link opens and reads in a session."""
-
-    clock: Any
-    lecture: Any
-    panel: Any
-    scene: Any
-    follow: Any
+class LinkState(Protocol):
+    """What a link reads of a session (its front): what it shows and the view chosen."""
 
     @property
     def showcase(self) -> Any: ...
@@ -286,12 +280,27 @@ class LinkSession(Protocol):
     def params(self) -> Parameters: ...
     @property
     def frame(self) -> Any: ...
+    @property
+    def clock(self) -> Any: ...
+    @property
+    def camera(self) -> str: ...
+
+
+class Opened(Protocol):
+    """What a link opens in a new session: its lecture tools (the page, the view), panel,
+    clock, construction and "Class" folder, and its queue."""
+
+    clock: Any
+    lecture: Any
+    panel: Any
+    scene: Any
+    follow: Any
 
     def set_speed(self, speed: float) -> None: ...
     def post(self, action: Any, key: object = None) -> None: ...
 
 
-def apply(session: LinkSession, link: Opening) -> None:
+def apply(session: Opened, link: Opening) -> None:
     """The clock, view and message of ``link`` in a new session (before its thread starts:
     the session was built with ``link.preset`` or ``link.scene``)."""
     session.lecture.page = link.page
@@ -320,7 +329,7 @@ def _text(value: float) -> str:
     return format(value, ".10g")
 
 
-def query_of(session: LinkSession) -> str:
+def query_of(session: LinkState) -> str:
     """The query of what ``session`` shows (its frame thread: it reads the session's state)."""
     pairs: list[tuple[str, str]] = []
     showcase = session.showcase
@@ -341,8 +350,8 @@ def query_of(session: LinkSession) -> str:
     clock = session.clock
     t = session.frame.t if session.frame is not None else clock.now()
     pairs.append(("t", format(max(t, 0.0), ".6g")))
-    if session.lecture.camera != "default":
-        pairs.append(("view", session.lecture.camera))
+    if session.camera != "default":
+        pairs.append(("view", session.camera))
     if not math.isclose(clock.speed, speed, rel_tol=1e-9):
         pairs.append(("speed", _text(clock.speed)))
     if clock.paused:
@@ -367,7 +376,8 @@ def _settings(spec: SceneSpec, desired: Mapping[str, Value]) -> list[tuple[str, 
     return out
 
 
-def link_of(session: LinkSession) -> str:
-    """The link of what ``session`` shows: its page's address (as the browser sees it: through
-    a landing or a proxy) and the query; the query alone if the page's address is unknown."""
-    return f"{session.lecture.page}?{query_of(session)}"
+def link_of(session: LinkState, page: str) -> str:
+    """The link of what ``session`` shows on ``page`` (its page's address as the browser sees
+    it: through a landing or a proxy, :attr:`Opening.page`) and the query; the query alone if
+    the page's address is unknown."""
+    return f"{page}?{query_of(session)}"

@@ -50,6 +50,7 @@ from poinsot.app.live.lecture.video_export import VideoExport, browser_view
 from poinsot.app.live.panel.clock import SimClock
 from poinsot.app.live.panel.motion_window import MotionWindow
 from poinsot.app.live.panel.widgets import Sent, on_user, set_value
+from poinsot.app.model.parameters import Parameters
 from poinsot.app.model.presets import Preset
 from poinsot.app.viser_private import copy_to_clipboard
 from poinsot.physics import FreeRigidBody
@@ -66,7 +67,9 @@ CAMERA_HOTKEYS: tuple[Literal["1", "2", "3", "4"], ...] = ("1", "2", "3", "4")
 
 
 class LectureSession(ChallengeSession, Protocol):
-    """What the lecture controls use of a session (and the challenges they mount)."""
+    """What the lecture controls use of a session's front (and the challenges, the neighbour
+    and the link they mount): its client, clock and construction, what it shows, and its
+    queue."""
 
     client: viser.ClientHandle
     clock: SimClock
@@ -79,20 +82,21 @@ class LectureSession(ChallengeSession, Protocol):
     @property
     def frame(self) -> Frame | None: ...
     @property
-    def panel(self) -> HasMotion: ...
+    def showcase(self) -> object | None: ...
+    @property
+    def params(self) -> Parameters: ...
+    @property
+    def camera(self) -> str: ...
 
     def toggle_pause(self) -> None: ...
     def post(self, action: Callable[[], None], key: object = None) -> None: ...
-
-
-class HasMotion(Protocol):
-    motion: MotionWindow
 
 
 class LectureControls:
     def __init__(
         self,
         session: LectureSession,
+        motion: MotionWindow,
         *,
         render_timeout: float = RENDER_TIMEOUT,
         order: float = FOLDER_ORDER,
@@ -114,7 +118,7 @@ class LectureControls:
         self.page = self.last_link = ""
         with self.client.gui.add_folder("Lecture: views and export", order=order):
             self._add_widgets(self.client.gui)
-        self.display = Display(session.client, session.scene, session.panel.motion, self.style)
+        self.display = Display(session.client, session.scene, motion, self.style)
         # Browser changes only, each value checked against its widget first (:func:`on_user`).
         for handle, callback in (
             (self.views, self._on_view),
@@ -239,7 +243,7 @@ class LectureControls:
     def copy_link(self) -> str:
         """(The session's frame thread) the link of what is on screen, shown under the tools
         and put on the browser's clipboard."""
-        link = link_of(self.session)  # type: ignore[arg-type]
+        link = link_of(self.session, self.page)
         self.last_link = link
         copy_to_clipboard(self.client, link)
         self.show(f"Link to this state (copied to the clipboard):\n\n`{link}`")
@@ -389,12 +393,15 @@ class LectureControls:
             return None
 
 
-def add_lecture_controls(session: LectureSession, **kwargs: float) -> LectureControls:
-    """Mount the lecture folder and hotkeys on ``session``'s panel, the challenges
+def add_lecture_controls(
+    session: LectureSession, motion: MotionWindow, **kwargs: float
+) -> LectureControls:
+    """Mount the lecture folder and hotkeys on the panel of the session whose front is
+    ``session`` (``motion``: its "Motion" window, which the display restyles), the challenges
     (:mod:`~poinsot.app.live.lecture.challenges`, as ``.challenges``) and the neighbour
     (:mod:`~poinsot.app.live.lecture.neighbour`, as ``.neighbour``); keep the returned object and
     call its ``on_frame(frame)`` after each frame."""
-    controls = LectureControls(session, **kwargs)
+    controls = LectureControls(session, motion, **kwargs)
     controls.challenges = add_challenges(session)
-    controls.neighbour = add_neighbour(session, session.panel.motion.legend.show_rows)
+    controls.neighbour = add_neighbour(session, motion.legend.show_rows)
     return controls

@@ -57,6 +57,8 @@ class FilmedSession(Protocol):
     def scene(self) -> PoinsotScene: ...
     @property
     def preset(self) -> Preset: ...
+    @property
+    def params(self) -> Parameters: ...
 
 
 class Filming(Protocol):
@@ -144,7 +146,7 @@ class VideoExport:
         if showcase is not None:
             spec, settings = showcase.spec, dict(showcase.showcase.settings)
             return lambda client_of: SceneStage(spec, settings, dark_mode=dark, client_of=client_of)
-        params: Parameters = session.params  # type: ignore[attr-defined]
+        params: Parameters = session.params
         preset = session.preset
         if preset is CUSTOM:
             solid = drawn_solid(params.inertia, CUSTOM, params.inertia)

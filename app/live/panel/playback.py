@@ -11,7 +11,7 @@ from collections.abc import Callable
 
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.live.panel.clock import SimClock
-from poinsot.app.model.parameters import SPEED_RANGE, TRAIL_RANGE
+from poinsot.app.model.parameters import SPEED_RANGE, TRAIL_RANGE, clamp
 
 #: "Step" advances this many wall seconds' worth of simulation time.
 STEP_SECONDS = 0.1
@@ -19,7 +19,7 @@ STEP_SECONDS = 0.1
 
 def clamp_trail(points: int) -> int:
     """A trail length within :data:`~poinsot.app.model.parameters.TRAIL_RANGE`."""
-    return min(max(int(points), TRAIL_RANGE[0]), TRAIL_RANGE[1])
+    return int(clamp(int(points), TRAIL_RANGE))
 
 
 class Playback:
@@ -44,8 +44,7 @@ class Playback:
 
     def clamp_speed(self, speed: float) -> float:
         """(Any thread) a speed within the current range."""
-        low, high = self.speed_range
-        return min(max(float(speed), low), high)
+        return clamp(float(speed), self.speed_range)
 
     def take(
         self, speed: float, trail: int, speed_range: tuple[float, float] = SPEED_RANGE

@@ -61,10 +61,9 @@ WORKERS = ThreadPoolExecutor(max_workers=2, thread_name_prefix="poinsot-upload")
 
 
 class Host(Protocol):
-    """What the uploads ask of their session."""
+    """What the uploads ask of their session's front: its client and queue, and a preset."""
 
     client: viser.ClientHandle
-    panel: ControlPanel
 
     def post(self, action: Callable[[], None]) -> None: ...
     def choose_preset(self, preset: Preset) -> None: ...
@@ -105,14 +104,15 @@ def _status_text(status: str) -> str:
 class UploadControls:
     """The uploads of one session. Widgets and state change on the frame thread only."""
 
-    def __init__(self, host: Host) -> None:
-        self.host = host
+    def __init__(self, host: Host, panel: ControlPanel) -> None:
+        """``panel``: the session's, which builds the toss and mesh folders when declared."""
+        self.host, self.panel = host, panel
         self.toss: FittedToss | None = None
         self.toss_preset: Preset | None = None
         self.mesh: MeshBody | None = None
         self.mesh_preset: Preset | None = None
-        self.toss_lines = _Folder(Control.TOSS, host.panel)
-        self.mesh_lines = _Folder(Control.MESH, host.panel)
+        self.toss_lines = _Folder(Control.TOSS, panel)
+        self.mesh_lines = _Folder(Control.MESH, panel)
         #: Uploads finished (shown or refused); tests wait on it.
         self.finished = 0
         self._latest = {"toss": 0, "mesh": 0}
@@ -120,8 +120,8 @@ class UploadControls:
         self._kinds: dict[str, str] = {}  # upload button id -> "toss" or "mesh"
         self._lock = threading.Lock()
         self.guard = TransferGuard(host.client, self._refused_in_transit)
-        host.panel.extend(Control.TOSS, self._build_toss)
-        host.panel.extend(Control.MESH, self._build_mesh)
+        panel.extend(Control.TOSS, self._build_toss)
+        panel.extend(Control.MESH, self._build_mesh)
 
     def resolve(self, preset: Preset) -> Preset:
         """The session's own toss or mesh body for their menu entries (if it has one)."""
@@ -270,7 +270,7 @@ class UploadControls:
         if kind == "toss":
             toss: FittedToss = result
             self.toss, self.toss_preset = toss, preset
-            motion = self.host.panel.motion
+            motion = self.panel.motion
             motion.show_measured(Measured(toss.tau, toss.measured, toss.exact, toss.bound))
             self.toss_lines.show(status="", readout=own_bodies.toss_markdown(toss))
         else:

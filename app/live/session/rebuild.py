@@ -20,7 +20,6 @@ import viser
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.sampled.motion import Motion
-from poinsot.app.live.classroom.lead import LeadControls
 from poinsot.app.live.hardening.budget import RebuildGate
 from poinsot.app.live.hardening.pacing import SessionStats
 from poinsot.app.live.panel import readouts
@@ -28,6 +27,7 @@ from poinsot.app.live.panel.ghost_controls import GhostControls
 from poinsot.app.live.panel.panel import ControlPanel
 from poinsot.app.live.panel.playback import Playback
 from poinsot.app.live.panel.showcase import LiveShowcase
+from poinsot.app.live.session.source import MotionSource
 from poinsot.app.model.elements import Solid
 from poinsot.app.model.parameters import Parameters, drawn_solid
 from poinsot.app.model.presets import Preset
@@ -36,7 +36,9 @@ from poinsot.physics import FreeRigidBody
 
 class BodyBuild:
     """The body a session shows, rebuilt by :meth:`rebuild` when :attr:`dirty`. ``say`` sets the
-    session's status line; ``post`` queues an action on its frame thread (the readouts)."""
+    session's status line; ``post`` queues an action on its frame thread (the readouts);
+    ``source`` says where the motion comes from (:mod:`.source`: the session's own or the
+    lead's)."""
 
     def __init__(
         self,
@@ -47,14 +49,14 @@ class BodyBuild:
         playback: Playback,
         panel: ControlPanel,
         ghost: GhostControls,
-        follow: LeadControls,
+        source: MotionSource,
         budget: RebuildGate,
         stats: SessionStats,
         say: Callable[[str], None],
         post: Callable[[Callable[[], None], object], None],
     ) -> None:
         self.client, self.scene, self.playback, self.panel = client, scene, playback, panel
-        self.ghost, self.follow, self.budget, self.stats = ghost, follow, budget, stats
+        self.ghost, self.source, self.budget, self.stats = ghost, source, budget, stats
         self._say, self._post = say, post
         self.base = preset  # the last named preset: it supplies the solid
         self.params = self.desired = Parameters.from_preset(preset)
@@ -90,13 +92,11 @@ class BodyBuild:
     # -- the rebuild -----------------------------------------------------------------------
     def rebuild(self, showcase: LiveShowcase | None) -> None:
         """Load ``showcase`` (the chosen scene) if any, else build the body of the desired
-        parameters; on a ValueError keep the last valid scene and say why. A session's own
-        rebuild holds the other sessions' frames (:class:`RebuildGate`: the student who moved a
-        slider sees the new body at once); a follower's does not: it mirrors the lead's move,
-        whose rebuild took precedence where the lead is, and a class of followers rebuilding
-        one after the other would hold each other's frames for the whole round."""
-        own = self.follow.mode != "follow"
-        with self.budget.rebuild() if own else contextlib.nullcontext():
+        parameters; on a ValueError keep the last valid scene and say why. The rebuild holds
+        the other sessions' frames (:class:`RebuildGate`) if the source says so
+        (:attr:`~.source.MotionSource.holds_others`: a session's own, not a follower's)."""
+        gated = self.source.holds_others
+        with self.budget.rebuild() if gated else contextlib.nullcontext():
             start = time.perf_counter()
             desired = self.desired
             self.dirty = False
@@ -130,9 +130,8 @@ class BodyBuild:
     def _load_scene(self, showcase: LiveShowcase) -> None:
         """Load the scene's desired settings at t = 0 (ValueError: the last scene is kept)."""
         self.playback.clock.reset(0.0)
-        follow = self.follow  # a follower's scene: the process's one model and motion
-        shared = follow.hub.scenes if follow.mode == "follow" else None
-        self.frame = showcase.load(self.playback.frame_time, shared)
+        # A follower's scene: the process's one model and motion (None: its own).
+        self.frame = showcase.load(self.playback.frame_time, self.source.scenes)
         self.body = showcase.body
         self.panel.motion.clear_plot()
         self._say("")
@@ -169,11 +168,11 @@ class BodyBuild:
     def shared_motion(self, params: Parameters, solid: Solid | None) -> Motion | None:
         """While following: the process's one motion of this body, on the grid of this frame
         time from t = 0 (the first follower to ask builds it); else None."""
-        follow = self.follow
-        if follow.mode != "follow":
+        motions = self.source.motions
+        if motions is None:
             return None
         frame_time = self.playback.frame_time
-        return follow.hub.motions.get(
+        return motions.get(
             (params, solid, frame_time), lambda: Motion.prepare(params.build(), solid, frame_time)
         )
 
