@@ -12,7 +12,7 @@ SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # again (about 12 core-seconds of the suite on a 2-core machine).
 unexport PYTHONDONTWRITEBYTECODE
 
-.PHONY: run test test-fast install install-test chromium bench bench-compare load lint clean
+.PHONY: run test test-busy test-fast install install-test chromium bench bench-compare load lint clean
 
 $(VENV)/bin/activate:
 	$(PYTHON) -m venv $(VENV)
@@ -64,6 +64,13 @@ test: install-test chromium
 	$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not serial" || status=1; \
 	$(PY) -m pytest -m serial $(SERIAL_FILES) || status=1; \
 	exit $$status
+
+# The suite as `make test` runs it, beside two busy loops (tests/busy.py starts them and stops
+# them however the suite ends, Ctrl-C included): a student's laptop or a shared CI runner is
+# busy too. Its status is the suite's.
+BUSY_LOOPS ?= 2
+test-busy: install-test chromium
+	$(PY) tests/busy.py --loops $(BUSY_LOOPS) -- $(MAKE) --no-print-directory test
 
 # The inner loop: no browser, no live server, nothing slow (physics, report, the app's logic).
 # These tests compute rather than wait: a worker more than the cores, no more (each worker

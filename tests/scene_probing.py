@@ -7,6 +7,7 @@ session drew for that time."""
 
 from __future__ import annotations
 
+import itertools
 import re
 
 import numpy as np
@@ -192,10 +193,10 @@ def construction_nodes() -> dict:
         probe = Probe(server.get_port())
         scene = PoinsotScene(server.scene, frozenset())
         scene.load(Parameters.from_preset(DEFAULT_PRESET).build(), DEFAULT_PRESET.solid)
-        base = _settled_names(probe, scene, frozenset())
+        base = _drawn_names(server, probe, scene, frozenset())
         nodes = {}
         for element in Element:
-            names = _settled_names(probe, scene, frozenset({element}))
+            names = _drawn_names(server, probe, scene, frozenset({element}))
             nodes[element] = {n for n in names - base if not _is_chunk(n)}
         probe.close()
         return nodes
@@ -208,19 +209,29 @@ def _is_chunk(name: str) -> bool:
     return tail.startswith("c") and tail[1:].isdigit()
 
 
-def _settled_names(probe: Probe, scene, elements) -> set[str]:
-    """Declare ``elements``, draw a frame, and return the node names once they stop changing."""
-    import time
+#: The name of the marks :func:`received_names` sends after what it waits for, and their count.
+MARK = "/received-mark"
+_MARKS = itertools.count()
 
+
+def _drawn_names(server, probe: Probe, scene, elements) -> set[str]:
+    """Declare ``elements``, draw a frame, and return the node names the probe has then."""
     scene.declare(elements)
     scene.advance(0.5)
     scene.flush_trails()
-    previous: set[str] = set()
-    for _ in range(50):
-        time.sleep(0.1)
+    return received_names(server, probe)
+
+
+def received_names(server, probe: Probe, timeout: float = 60.0) -> set[str]:
+    """The node names ``probe`` has once everything ``server`` queued before this call reached
+    it: a mark node added now, after them, has arrived (a connection's messages arrive in the
+    order they were queued; viser drops a queued message only for a later one on the same
+    node). The event to wait for, not a quiet period: a loaded machine delivers late."""
+    mark = f"{MARK}/{next(_MARKS)}"
+    handle = server.scene.add_frame(mark, show_axes=False)
+    try:
+        assert probe.wait_for(lambda p: mark in p.nodes, timeout), "the mark never arrived"
         nodes, _ = probe.snapshot()
-        current = set(nodes)
-        if current == previous:
-            return current
-        previous = current
-    return previous
+    finally:
+        handle.remove()
+    return {name for name in nodes if not name.startswith(MARK)}

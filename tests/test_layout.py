@@ -196,7 +196,6 @@ CLOCK_ALLOWED: dict[tuple[str, str], str] = {
 #: wait on the event it stands for (``wait_until``, ``probe.wait_for``, ``after_frames``).
 SLEEPS_ALLOWED: dict[tuple[str, str], str] = {
     ("tests/conftest.py", "wait_until"): "the poll period of the one waiting primitive",
-    ("tests/scene_probing.py", "_settled_names"): "the poll period while node names settle",
     ("tests/app/test_server.py", "test_random_input_never_raises_nor_sends_nan"): (
         "the storm's irregular rhythm of input, not a wait"
     ),
