@@ -443,6 +443,20 @@ class BrowserPage:
         if on:
             assert wait_until(lambda: self.frames_drawn() >= drawn + 2, 30), "no frame drawn"
 
+    def drawn_after(self, client) -> None:
+        """Return once the page has drawn everything sent to ``client`` (its viser client)
+        before this call: a render asked of the page now comes back once the page has applied
+        the messages in front of it (viser answers a render request after them, in order); the
+        live view, if on (:meth:`set_live_view`), then draws two more frames. The events a
+        picture of the page waits for, not a fixed wait nor two screenshots alike (a paused
+        page draws about a frame a second: on a loaded machine two screenshots can agree
+        between two frames, not all drawn yet)."""
+        client.get_render(8, 8, timeout=60.0)
+        if self.page.evaluate("() => window.__poinsotParked === true"):
+            return
+        drawn = self.frames_drawn()
+        assert wait_until(lambda: self.frames_drawn() >= drawn + 2, 30), "no frame drawn"
+
     def frames_drawn(self) -> int:
         """The frames the page's 3D view has drawn (three.js counts them; viser exposes its
         renderer's counters for browser tests)."""

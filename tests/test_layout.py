@@ -203,9 +203,6 @@ SLEEPS_ALLOWED: dict[tuple[str, str], str] = {
         "two equal windows, quiet and flooded, in which the frames are counted and compared"
     ),
     ("tests/app/test_wire.py", "poll"): "the sampling period of a peak-memory poller",
-    ("tests/app/test_ghost.py", "test_the_ghost_shows_a_second_ellipsoid_in_the_browser"): (
-        "a software-WebGL render: no page event says the picture shows the new state"
-    ),
 }
 #: Browser tests: the same reason as above, for each module (the page gives no "drawn" event).
 SLEEPS_ALLOWED_IN = {

@@ -437,12 +437,12 @@ def test_the_ghost_shows_a_second_ellipsoid_in_the_browser(poinsot_app, open_pag
     assert wait_until(lambda: session.clock.paused, 5)
     page.set_live_view(True)
     page.page.mouse.move(300, 60)  # no tooltip over the scene
-    page.page.wait_for_timeout(1500)
+    page.drawn_after(session.client)
     with_ghost = page.screenshot_rgb().astype(int)
     page.set_checkbox(CHECKBOX, False)
     assert wait_until(lambda: session.ghost.ghost is None, 5)
     page.page.mouse.move(300, 60)
-    page.page.wait_for_timeout(1500)
+    page.drawn_after(session.client)
     without = page.screenshot_rgb().astype(int)
     # The 3D view between the "Motion" window (left) and the control panel (right).
     h, w, _ = without.shape

@@ -66,7 +66,7 @@ def shared(make_module_app, open_module_page):
 def test_page_loads_without_console_errors(shared):
     app, page, session = shared
     started(app, frames=60)
-    page.page.wait_for_timeout(1000)
+    page.drawn_after(session.client)
     assert page.errors == []
     assert session.stats.errors == 0, session.stats.last_error
     assert page.page.get_by_text("Stable about the major axis").count() >= 1
@@ -107,12 +107,12 @@ def test_canvas_shows_the_ellipsoid(shared):
     session = started(app)
     pause(page, session)
     page.set_live_view(True)  # and so it stays for the module's later tests
-    page.page.wait_for_timeout(500)
+    page.drawn_after(session.client)
     shown = canvas_pixels(page)
     page.open_folder("Show")  # collapsed by default
     page.set_checkbox("energy ellipsoid", False)
     assert wait_until(lambda: not session.scene.is_visible(Element.ELLIPSOID), 5)
-    page.page.wait_for_timeout(500)
+    page.drawn_after(session.client)
     hidden = canvas_pixels(page)
     # The semi-transparent amber ellipsoid covers a good part of the view; only it is amber.
     assert amber_fraction(shown) > 0.02, amber_fraction(shown)
@@ -130,7 +130,7 @@ def test_moving_a_slider_changes_the_scene(shared):
     app, page, _ = shared
     session = started(app)
     pause(page, session)
-    page.page.wait_for_timeout(300)
+    page.drawn_after(session.client)
     before_pixels = canvas_pixels(page)
     before_axes = session.scene.geometry.semi_axes.copy()
     generation = session.generation
@@ -143,7 +143,7 @@ def test_moving_a_slider_changes_the_scene(shared):
     # the menu's new label is a message of its own, after the session's change
     assert wait_until(lambda: page.dropdown_value("Preset") == "Custom (edited)", 10)
     assert not np.allclose(session.scene.geometry.semi_axes, before_axes)
-    page.page.wait_for_timeout(500)
+    page.drawn_after(session.client)
     after_pixels = canvas_pixels(page)
     changed = np.mean(np.any(np.abs(after_pixels.astype(int) - before_pixels) > 24, axis=2))
     assert changed > 0.01, f"only {changed:.4f} of the view changed"
@@ -154,7 +154,7 @@ def test_choosing_a_preset_changes_the_scene(shared):
     """After the slider's test: from the edited body (paused) to the sphere."""
     app, page, _ = shared
     session = started(app)
-    page.page.wait_for_timeout(300)
+    page.drawn_after(session.client)
     before = canvas_pixels(page)
     sphere = preset_by_key("sphere")
     page.choose("Preset", sphere.label)
@@ -172,7 +172,7 @@ def test_choosing_a_preset_changes_the_scene(shared):
         assert wait_until(lambda g=gone: page.control_count(g) == 0, 15), gone
     assert page.control_count("|ω₀|") == 1  # declared by the sphere: still there
     assert np.allclose(session.scene.geometry.semi_axes, 1.0)
-    page.page.wait_for_timeout(500)
+    page.drawn_after(session.client)
     after = canvas_pixels(page)
     changed = np.mean(np.any(np.abs(after.astype(int) - before) > 24, axis=2))
     assert changed > 0.01, f"only {changed:.4f} of the view changed"

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import colorsys
 import re
-import time
 
 import numpy as np
 import pytest
@@ -147,7 +146,7 @@ def set_theme(page, session, theme: str) -> None:
     if session.lecture.display.style.dark is not dark:
         page.set_checkbox("Dark theme", dark)
         assert wait_until(lambda: session.lecture.display.style.dark is dark, 10)
-        page.page.wait_for_timeout(800)
+        page.drawn_after(session.client)
 
 
 def pause(page, session) -> None:
@@ -312,7 +311,7 @@ def test_the_herpolhode_is_legible_in_the_default_view(pages, size, theme):
     assert wait_until(lambda: session.frame is not None and session.frame.t > 2.2 * 8.921, 30)
     pause(page, session)
     page.set_live_view(True)
-    page.page.wait_for_timeout(1000)
+    page.drawn_after(session.client)
     rgb, box = canvas_slice(page)
     x0, x1 = int(box["x"]), int(box["x"] + box["width"])
     # The 3D view lies between the two docked columns: no panel over it.
@@ -433,7 +432,7 @@ def test_the_sphere_shows_omega_and_L_apart(pages):
     started(session)
     page.choose("Preset", preset_by_key("sphere").label)
     assert wait_until(lambda: session.preset.key == "sphere" and session.body is not None, 10)
-    page.page.wait_for_timeout(1500)
+    page.drawn_after(session.client)
     rgb, box = canvas_slice(page)
     view = rgb[:, int(box["x"]) : int(box["x"] + box["width"])]
     look = session.scene.look
@@ -538,8 +537,8 @@ def test_sphere_and_custom_alternate_without_console_errors(pages):
             else:
                 page.choose("Preset", preset.label)
             assert wait_until(lambda p=preset: session.preset is p, 10)
-            page.page.wait_for_timeout(300)
-    page.page.wait_for_timeout(2500)
+            page.page.wait_for_timeout(300)  # the next switch while this one is under way
+    page.drawn_after(session.client)  # every switch's messages applied (an error is logged)
     assert page.errors == []
     assert session.stats.errors == 0, session.stats.last_error
 
@@ -609,7 +608,7 @@ def test_projector_mode_folds_the_panels_and_thickens_the_picture(pages):
     session.set_speed(4.0)
     assert wait_until(lambda: session.frame is not None and session.frame.t > 6.0, 30)
     pause(page, session)
-    page.page.wait_for_timeout(800)
+    page.drawn_after(session.client)
     before_box = page.canvas_box()
     before = line_thickness(hue_mask(page.screenshot_rgb(), session.scene.look.herpolhode))
     root = "parseFloat(getComputedStyle(document.documentElement).fontSize)"
@@ -673,13 +672,12 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     # dock): the layout's pixels are those of the camera reported.
     page.settled_canvas(session.client)
     lay_out_on_the_frame_thread(session)
-    page.page.wait_for_timeout(800)
-    shown = settled_screenshot(page)
+    shown = drawn_screenshot(page, session.client)
     handles = label_handles(session)
     assert len(handles) == 7
     for handle in handles:
         handle.visible = False
-    hidden = settled_screenshot(page, unlike=shown)
+    hidden = drawn_screenshot(page, session.client)
     for handle in handles:
         handle.visible = True
     box = page.canvas_box()
@@ -709,19 +707,10 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     assert page.errors == []
 
 
-def settled_screenshot(page, unlike: np.ndarray | None = None, timeout: float = 30.0) -> np.ndarray:
-    """The page's pixels once two screenshots in a row agree (and differ from ``unlike``: a
-    change sent to the page has been drawn), as ints."""
-    deadline = time.monotonic() + timeout
-    previous = page.screenshot_rgb().astype(int)
-    while time.monotonic() < deadline:
-        current = page.screenshot_rgb().astype(int)
-        if np.array_equal(current, previous) and (
-            unlike is None or not np.array_equal(current, unlike)
-        ):
-            return current
-        previous = current
-    raise AssertionError("the page's picture did not settle")
+def drawn_screenshot(page, client) -> np.ndarray:
+    """The page's pixels, as ints, once it has drawn what was sent to ``client`` before."""
+    page.drawn_after(client)
+    return page.screenshot_rgb().astype(int)
 
 
 def handle_world(session, handle) -> np.ndarray:
