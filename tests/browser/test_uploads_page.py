@@ -99,7 +99,7 @@ def test_an_uploaded_mesh_becomes_the_body(shared):
         page.click_button("Pause")
     assert wait_until(lambda: session.clock.paused, 5)
     page.set_live_view(True)
-    page.page.wait_for_timeout(500)
+    page.drawn_after(session.client)
     before = page.screenshot_rgb()
     finished = session.uploads.finished
     choose_file(page, MESH, book)
@@ -111,7 +111,7 @@ def test_an_uploaded_mesh_becomes_the_body(shared):
     for label, moment in zip(SLIDERS, measured.ratios, strict=True):
         assert wait_until(lambda la=label, m=moment: abs(page.slider_value(la) - m) < 1e-6, 10)
     page.page.get_by_text("book.stl", exact=False).first.wait_for(timeout=10000)
-    page.page.wait_for_timeout(800)
+    page.drawn_after(session.client)
     after = page.screenshot_rgb()
     view = slice(None), slice(0, int(before.shape[1] * 0.6))
     changed = np.mean(np.any(np.abs(after[view].astype(int) - before[view]) > 24, axis=2))
