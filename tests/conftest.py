@@ -276,8 +276,10 @@ def run_command(argv: list[str], timeout: float = 900.0) -> subprocess.Completed
     )
 
 
-def session_of(app: PoinsotApp, count: int = 1, timeout: float = 10.0) -> Session:
-    """The newest session of ``app`` (waiting until ``count`` sessions exist)."""
+def session_of(app: PoinsotApp, count: int = 1, timeout: float = 60.0) -> Session:
+    """The newest session of ``app`` (waiting until ``count`` sessions exist: a condition the
+    app notifies, so the timeout only bounds a failure; at load 18, a session took over 10 s
+    to be built)."""
     sessions = app.wait_for_sessions(count, timeout)
     assert len(sessions) >= count, f"only {len(sessions)} sessions"
     return max(sessions, key=lambda s: s.client.client_id)

@@ -32,11 +32,11 @@ def start(make_app, make_probe, spec) -> tuple[PoinsotApp, Session, Probe]:
     app = make_app(scene=spec)
     probe = make_probe(app)
     session = session_of(app)
-    assert wait_until(lambda: session.running and session.stats.frames > 3, 20), "no frames"
-    assert wait_until(lambda: session.showcase is not None and session.showcase.loaded, 20)
+    assert wait_until(lambda: session.running and session.stats.frames > 3, 30), "no frames"
+    assert wait_until(lambda: session.showcase is not None and session.showcase.loaded, 30)
     # The scene's controls as the probe has them (sent before the frames, read after them).
     labels = {control.label for control in spec.controls}
-    assert probe.wait_for(lambda p: labels <= set(p.labels()), 20), (labels, probe.labels())
+    assert probe.wait_for(lambda p: labels <= set(p.labels()), 30), (labels, probe.labels())
     return app, session, probe
 
 
@@ -49,7 +49,7 @@ def sent_at(session: Session, probe: Probe, t: float) -> tuple[Frame, dict[str, 
         frame = session.frame
         return frame is not None and t - 0.06 < frame.t <= t + 1e-9
 
-    assert wait_until(drawn, 10), f"the session did not draw t = {t}"
+    assert wait_until(drawn, 30), f"the session did not draw t = {t}"
     frame = session.frame
     assert frame is not None
     assert probe.wait_for(
@@ -57,7 +57,7 @@ def sent_at(session: Session, probe: Probe, t: float) -> tuple[Frame, dict[str, 
             "/space/body" in p.nodes
             and np.allclose(p.nodes["/space/body"].wxyz, frame.wxyz, atol=1e-9)
         ),
-        10,
+        30,
     ), "the pose never arrived"
     nodes, _ = probe.snapshot()
     return frame, nodes
@@ -95,7 +95,7 @@ def drawn_traces(session: Session, probe: Probe) -> dict[str, np.ndarray]:
     """Every trace of the scene as sent (by group name), once all the points the session has
     drawn have reached the probe: the traces are sent every few frames, and paused, the last
     points go out with the next frame drawn (for traces not yet trimmed to their length)."""
-    assert wait_until(lambda: session.scene.traces_complete, 10), "the traces were not all sent"
+    assert wait_until(lambda: session.scene.traces_complete, 30), "the traces were not all sent"
     drawn = {
         trail.group.name: len(trail.points())
         for element in Element
@@ -105,7 +105,7 @@ def drawn_traces(session: Session, probe: Probe) -> dict[str, np.ndarray]:
     def arrived(p: Probe) -> bool:
         return all(len(trail_points(p.nodes, name)) == n for name, n in drawn.items())
 
-    assert probe.wait_for(arrived, 10), f"the traces never arrived in full: {drawn}"
+    assert probe.wait_for(arrived, 30), f"the traces never arrived in full: {drawn}"
     nodes, _ = probe.snapshot()
     return {name: trail_points(nodes, name) for name in drawn}
 

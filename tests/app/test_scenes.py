@@ -72,7 +72,7 @@ def common_labels(make_app, make_probe) -> set[str]:
     assert wait_until(lambda: session.stats.frames > 3, 30)
     received = len(probe.batches)
     after_frames(session)  # the panel was built before the first frame; these reached the probe
-    assert probe.wait_for(lambda p: len(p.batches) >= received + 5, 15)
+    assert probe.wait_for(lambda p: len(p.batches) >= received + 5, 30)
     own = {ELEMENT_LABELS[e] for e in sphere.elements}
     for control in sphere.controls:
         own |= SHARED_LABELS.get(control, set())
@@ -86,11 +86,11 @@ def test_each_scene_creates_only_what_it_declares(spec, make_app, make_probe, el
     _, session, probe = start(make_app, make_probe, spec)
     expected = expected_nodes(spec, element_nodes)
     trails = trails_of(spec)
-    assert probe.wait_for(lambda p: scene_node_names(p, trails) == expected, 15), (
+    assert probe.wait_for(lambda p: scene_node_names(p, trails) == expected, 30), (
         scene_node_names(probe, trails) ^ expected
     )
     labels = expected_labels(spec)
-    assert probe.wait_for(lambda p: labels <= visible_labels(p), 10), labels - visible_labels(probe)
+    assert probe.wait_for(lambda p: labels <= visible_labels(p), 30), labels - visible_labels(probe)
     extra = visible_labels(probe) - labels - common
     assert extra == set(), f"undeclared widgets: {extra}"
     assert plot_titles(probe) == {p.title for p in spec.plots}
@@ -127,24 +127,24 @@ def test_the_menu_switches_scenes_and_presets_exactly(
                 and session.showcase.spec is s
                 and session.showcase.loaded
             ),
-            15,
+            30,
         )
         expected, trails = expected_nodes(spec, element_nodes), trails_of(spec)
-        assert probe.wait_for(lambda p, e=expected, t=trails: scene_node_names(p, t) == e, 15), (
+        assert probe.wait_for(lambda p, e=expected, t=trails: scene_node_names(p, t) == e, 30), (
             scene_node_names(probe, trails) ^ expected
         )
-        assert probe.wait_for(lambda p, s=spec: plot_titles(p) == {x.title for x in s.plots}, 10)
+        assert probe.wait_for(lambda p, s=spec: plot_titles(p) == {x.title for x in s.plots}, 30)
     preset = preset_by_key("t_handle")
     probe.set_value(uuid, preset.label)
-    assert wait_until(lambda: session.showcase is None and session.preset is preset, 15)
+    assert wait_until(lambda: session.showcase is None and session.preset is preset, 30)
     names = set(ALWAYS)
     for element in preset.elements:
         names |= element_nodes[element]
-    assert probe.wait_for(lambda p: scene_node_names(p, CONSTRUCTION_TRAILS) == names, 15), (
+    assert probe.wait_for(lambda p: scene_node_names(p, CONSTRUCTION_TRAILS) == names, 30), (
         scene_node_names(probe, CONSTRUCTION_TRAILS) ^ names
     )
-    assert probe.wait_for(lambda p: plot_titles(p) == {"ω in the body frame"}, 10)
-    assert wait_until(lambda: session.body is not None and session.body.inertia[2] > 3.0, 10)
+    assert probe.wait_for(lambda p: plot_titles(p) == {"ω in the body frame"}, 30)
+    assert wait_until(lambda: session.body is not None and session.body.inertia[2] > 3.0, 30)
     assert session.stats.errors == 0, session.stats.last_error
     assert viser_warnings(recwarn, caplog) == []
 
@@ -159,22 +159,22 @@ def test_bad_input_keeps_the_last_scene_and_says_why(make_app, make_probe):
     uuid, _ = probe.widget("spin ω₃")
     # From the wire, a value below the slider's range is clamped into it, as the browser would.
     probe.set_value(uuid, 0.0)
-    assert wait_until(lambda: session.generation > generation, 10)
+    assert wait_until(lambda: session.generation > generation, 30)
     assert session.status == "" and showcase.showcase.model is not model
-    assert wait_until(lambda: showcase.showcase.settings["spin"] == 0.5, 10)
+    assert wait_until(lambda: showcase.showcase.settings["spin"] == 0.5, 30)
     model, generation = showcase.showcase.model, session.generation
     # A value the model refuses (here from the server's side) keeps the scene and says why.
     session.configure_scene("spin", 0.0)
-    assert wait_until(lambda: session.generation > generation, 10)
+    assert wait_until(lambda: session.generation > generation, 30)
     assert "a gyroscope must spin" in session.status
     assert showcase.showcase.model is model  # the last valid scene is kept
     said = "a gyroscope must spin"
     assert probe.wait_for(
-        lambda p: any(said in str(w.props.get("_markdown", "")) for w in p.widgets.values()), 5
+        lambda p: any(said in str(w.props.get("_markdown", "")) for w in p.widgets.values()), 30
     )
     generation = session.generation
     probe.set_value(uuid, 2.0)
-    assert wait_until(lambda: session.generation > generation and session.status == "", 10)
+    assert wait_until(lambda: session.generation > generation and session.status == "", 30)
     assert showcase.showcase.model is not model
     assert session.stats.errors == 0, session.stats.last_error
 
@@ -199,7 +199,7 @@ def test_per_frame_only_poses_and_trail_increments(name, make_app, make_probe):
     assert wait_until(lambda: session.stats.frames > 30, 30)
     start_batch, frames = len(probe.batches), session.stats.frames
     after_frames(session, 90)
-    assert probe.wait_for(lambda p: len(p.batches) >= start_batch + 45, 10)
+    assert probe.wait_for(lambda p: len(p.batches) >= start_batch + 45, 30)
     assert session.stats.frames - frames >= 90
     for batch in probe.batches[start_batch:]:
         for kind, node in zip(batch.types, batch.names, strict=True):
