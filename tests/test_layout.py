@@ -206,11 +206,8 @@ SLEEPS_ALLOWED: dict[tuple[str, str], str] = {
 }
 #: Browser tests: the same reason as above, for each module (the page gives no "drawn" event).
 SLEEPS_ALLOWED_IN = {
-    "tests/browser/test_exports_page.py",
-    "tests/browser/test_live_page.py",
     "tests/browser/test_loopback.py",
     "tests/browser/test_picture_page.py",
-    "tests/browser/test_scenes_page.py",
     # Not a test: the script that makes the README's phone and drag pictures; its pauses let
     # the traces grow for the picture.
     "tests/browser/touch_pictures.py",

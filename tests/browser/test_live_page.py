@@ -91,14 +91,18 @@ def test_the_omega_plot_draws_its_three_components(shared):
     started(app, frames=30)
     plot = page.page.locator(".uplot-container").first
     plot.wait_for(state="visible", timeout=20000)
-    page.page.wait_for_timeout(2500)  # a couple of seconds of samples
     import io
 
-    rgb = np.asarray(Image.open(io.BytesIO(plot.screenshot())).convert("RGB")).astype(int)
-    for hex_color in palette.PLOT_SERIES:
-        color = np.array([int(hex_color[i : i + 2], 16) for i in (1, 3, 5)])
-        near = np.sum(np.abs(rgb - color).sum(axis=2) < 60)
-        assert near > 40, (hex_color, near)
+    colors = [np.array([int(c[i : i + 2], 16) for i in (1, 3, 5)]) for c in palette.PLOT_SERIES]
+    near: list[int] = []
+
+    def three_curves() -> bool:
+        # The event: the plot shows its samples (as many as a loaded machine has drawn by then).
+        rgb = np.asarray(Image.open(io.BytesIO(plot.screenshot())).convert("RGB")).astype(int)
+        near[:] = [int(np.sum(np.abs(rgb - color).sum(axis=2) < 60)) for color in colors]
+        return all(n > 40 for n in near)
+
+    assert wait_until(three_curves, 30, poll=0.5), dict(zip(palette.PLOT_SERIES, near, strict=True))
     assert page.errors == []
 
 
