@@ -11,6 +11,7 @@ a SIGTERM to this script); exits with the command's status.
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import subprocess
 import sys
@@ -41,15 +42,15 @@ def main(argv: list[str] | None = None) -> int:
 
 def run(command: list[str]) -> int:
     """``command``'s status (128 + the signal's number if one ended it), once it has ended.
-    Ctrl-C at the terminal reaches it (and the loops) as it reaches this script, which only
-    waits for its end; a SIGTERM sent to this script is passed on to it."""
-    child = subprocess.Popen(command)
+    It runs in a process group of its own: Ctrl-C or a SIGTERM sent to this script is passed
+    on to the whole group (make, pytest and its workers), not to make alone."""
+    child = subprocess.Popen(command, start_new_session=True)
 
     def pass_on(signum: int, _frame: object) -> None:
         if child.poll() is None:
-            child.send_signal(signum)
+            os.killpg(child.pid, signum)
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGINT, pass_on)
     signal.signal(signal.SIGTERM, pass_on)
     status = child.wait()
     return 128 - status if status < 0 else status  # killed by a signal: as a shell says it
