@@ -142,3 +142,28 @@ def copy_to_clipboard(client: viser.ClientHandle, text: str) -> None:
     the caller also shows the text)."""
     _run_javascript(client, _COPY_JS % json.dumps(text))
     client.flush()
+
+
+_SHOW_BUTTON_JS = """
+(() => {
+  const label = %s;
+  const until = Date.now() + %d;
+  const show = () => {
+    const button = [...document.querySelectorAll("button")].find(
+      (b) => b.textContent.trim() === label && b.getClientRects().length > 0);
+    if (button) {
+      button.scrollIntoView({block: "nearest", behavior: "smooth"});
+    } else if (Date.now() < until) {
+      setTimeout(show, 100);
+    }
+  };
+  show();
+})();
+"""
+
+
+def scroll_to_button(client: viser.ClientHandle, label: str, wait_ms: int = 5000) -> None:
+    """Scroll the panel holding the button labelled ``label`` until the button (and what stands
+    above it) is on screen, as soon as the page shows it (looked for during ``wait_ms``)."""
+    _run_javascript(client, _SHOW_BUTTON_JS % (json.dumps(label), int(wait_ms)))
+    client.flush()

@@ -49,6 +49,7 @@ from poinsot.app.live.lecture.strobe_shot import strobe_render
 from poinsot.app.live.lecture.video_export import VideoExport, browser_view
 from poinsot.app.live.panel.clock import SimClock
 from poinsot.app.live.panel.motion_window import MotionWindow
+from poinsot.app.live.panel.panel import ControlPanel
 from poinsot.app.live.panel.widgets import Sent, on_user, set_value
 from poinsot.app.model.presets import Preset
 from poinsot.app.viser_private import copy_to_clipboard
@@ -79,7 +80,7 @@ class LectureSession(ChallengeSession, Protocol):
     @property
     def frame(self) -> Frame | None: ...
     @property
-    def panel(self) -> HasMotion: ...
+    def panel(self) -> ControlPanel: ...
 
     def toggle_pause(self) -> None: ...
     def post(self, action: Callable[[], None], key: object = None) -> None: ...

@@ -216,10 +216,18 @@ class Session:
         self.post(lambda: self.playback.set_speed(speed), "speed")
 
     def toggle_pause(self) -> None:
-        self.post(self.playback.toggle_pause)
+        self.post(lambda: self._unless_withheld(self.playback.toggle_pause))
 
     def step(self) -> None:
-        self.post(self.playback.step)
+        self.post(lambda: self._unless_withheld(self.playback.step))
+
+    def _unless_withheld(self, action: Callable[[], None]) -> None:
+        """Run ``action`` (play, step) unless a challenge's body waits for its answer."""
+        if self.preset.withheld:
+            self._set_status("Answer the challenge first: its motion plays with the answer.")
+            self.playback.show()  # the button as the clock is: paused
+            return
+        action()
 
     def reset(self) -> None:
         self.post(self._reset)
