@@ -146,12 +146,19 @@ def copy_to_clipboard(client: viser.ClientHandle, text: str) -> None:
 
 _SHOW_BUTTON_JS = """
 (() => {
-  const label = %s;
+  const label = %s, folder = %s;
   const until = Date.now() + %d;
+  let opened = false;
   const show = () => {
     const button = [...document.querySelectorAll("button")].find(
-      (b) => b.textContent.trim() === label && b.getClientRects().length > 0);
-    if (button) {
+      (b) => b.textContent.trim() === label);
+    const shown = button && button.getBoundingClientRect().height > 0;
+    if (button && !shown && !opened && folder) {  // in a folded folder: open it, as a click does
+      const header = [...document.querySelectorAll("div")].find(
+        (e) => e.style.cursor === "pointer" && e.textContent.trim() === folder);
+      if (header) { header.click(); opened = true; }
+    }
+    if (shown) {
       button.scrollIntoView({block: "nearest", behavior: "smooth"});
     } else if (Date.now() < until) {
       setTimeout(show, 100);
@@ -162,8 +169,12 @@ _SHOW_BUTTON_JS = """
 """
 
 
-def scroll_to_button(client: viser.ClientHandle, label: str, wait_ms: int = 5000) -> None:
+def scroll_to_button(
+    client: viser.ClientHandle, label: str, folder: str = "", wait_ms: int = 5000
+) -> None:
     """Scroll the panel holding the button labelled ``label`` until the button (and what stands
-    above it) is on screen, as soon as the page shows it (looked for during ``wait_ms``)."""
-    _run_javascript(client, _SHOW_BUTTON_JS % (json.dumps(label), int(wait_ms)))
+    above it) is on screen, as soon as the page shows it (looked for during ``wait_ms``); if it
+    is in the folded folder titled ``folder``, that folder is opened first (one click on its
+    title, as a user's)."""
+    _run_javascript(client, _SHOW_BUTTON_JS % (json.dumps(label), json.dumps(folder), int(wait_ms)))
     client.flush()

@@ -128,15 +128,17 @@ class ChallengeControls:
         self.started = self.revealed = False
         gui = session.client.gui
         with gui.add_folder(FOLDER, order=order, expand_by_default=False):
+            # The question, then what answers it: a refusal, or the verdict and "Next", where
+            # the answer's widgets were (on screen where the student just pressed).
             self.question = gui.add_markdown(INTRO)
             self.start = gui.add_button(START, icon=viser.Icon.PLAYER_PLAY)
+            self.message = gui.add_markdown("")
             self.reveal = gui.add_markdown("")
             self.next = gui.add_button(NEXT, visible=False)
             self.outcome = gui.add_dropdown("Flip or stay?", (CHOOSE, *OUTCOMES), visible=False)
             self.axis = gui.add_dropdown("About which axis?", (CHOOSE, *AXES), visible=False)
             self.time = gui.add_text(ANSWER, "", visible=False)
             self.play = gui.add_button(PLAY, icon=viser.Icon.PLAYER_PLAY, visible=False)
-            self.message = gui.add_markdown("")
             self.scoreboard = gui.add_markdown("")
         on_user(self.start, lambda _: self.begin(), self._report)
         on_user(self.play, lambda _: self.answer(), self._report)
@@ -156,7 +158,7 @@ class ChallengeControls:
             self.started = True
             self._show_question()
             self._load(self.current, revealed=self.revealed)
-        scroll_to_button(self.session.client, NEXT if self.revealed else PLAY)
+        scroll_to_button(self.session.client, NEXT if self.revealed else PLAY, FOLDER)
 
     def _show_question(self) -> None:
         c = self.current
@@ -213,7 +215,7 @@ class ChallengeControls:
             )
             self._show_question()
             self._load(c, revealed=True)
-        scroll_to_button(self.session.client, NEXT)
+        scroll_to_button(self.session.client, NEXT, FOLDER)
 
     def _load(self, challenge: Challenge, revealed: bool) -> None:
         """The challenge's body at t = 0 (every choice of a preset rebuilds it from t = 0):
@@ -240,7 +242,7 @@ class ChallengeControls:
             self.revealed = False
             self._show_question()
             self._load(self.current, revealed=False)
-        scroll_to_button(self.session.client, PLAY)
+        scroll_to_button(self.session.client, PLAY, FOLDER)
 
 
 def add_challenges(session: ChallengeSession) -> ChallengeControls:
