@@ -158,7 +158,7 @@ class ChallengeControls:
             self.started = True
             self._show_question()
             self._load(self.current, revealed=self.revealed)
-        scroll_to_button(self.session.client, NEXT if self.revealed else PLAY, FOLDER)
+        self._scroll_to(NEXT if self.revealed else PLAY)
 
     def _show_question(self) -> None:
         c = self.current
@@ -215,7 +215,7 @@ class ChallengeControls:
             )
             self._show_question()
             self._load(c, revealed=True)
-        scroll_to_button(self.session.client, NEXT, FOLDER)
+        self._scroll_to(NEXT)
 
     def _load(self, challenge: Challenge, revealed: bool) -> None:
         """The challenge's body at t = 0 (every choice of a preset rebuilds it from t = 0):
@@ -227,6 +227,12 @@ class ChallengeControls:
             number = self.index + 1
             session.choose_preset(body_preset(challenge, number, revealed))
         session.post(lambda: self._run(not revealed))
+
+    def _scroll_to(self, button: str) -> None:
+        """The page scrolls ``button`` into view, after the widgets the body's choice adds
+        above it (posted behind it: the session's queue runs in order)."""
+        client = self.session.client
+        self.session.post(lambda: scroll_to_button(client, button, FOLDER))
 
     def _run(self, paused: bool) -> None:
         """(Session thread) The clock paused or playing, as the playback buttons show."""
@@ -242,7 +248,7 @@ class ChallengeControls:
             self.revealed = False
             self._show_question()
             self._load(self.current, revealed=False)
-        scroll_to_button(self.session.client, PLAY, FOLDER)
+        self._scroll_to(PLAY)
 
 
 def add_challenges(session: ChallengeSession) -> ChallengeControls:
