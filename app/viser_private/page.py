@@ -186,11 +186,11 @@ def scroll_to_button(
     wait_ms: int = 5000,
     hold_ms: int = 3000,
 ) -> None:
-    """Scroll the panel holding the button labelled ``label`` until the button is in the middle of
-    the screen (what stands above it, too), as soon as the page shows it (looked for during ``wait_ms``), and
-    keep it there for ``hold_ms`` (what loads with it may push it down), unless the user
-    scrolls, types or clicks meanwhile; if it is in the folded folder titled ``folder``, that
-    folder is opened first (one click on its title, as a user's)."""
+    """Scroll the panel holding the button labelled ``label`` until the button is in the middle
+    of the screen (what stands above it, too), as soon as the page shows it (looked for during
+    ``wait_ms``), and keep it there for ``hold_ms`` (what loads with it may push it down), unless
+    the user scrolls, types or clicks meanwhile; if it is in the folded folder titled
+    ``folder``, that folder is opened first (one click on its title, as a user's)."""
     args = (json.dumps(label), json.dumps(folder), int(wait_ms), int(hold_ms))
     _run_javascript(client, _SHOW_BUTTON_JS % args)
     client.flush()

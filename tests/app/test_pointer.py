@@ -12,8 +12,8 @@ from conftest import session_of, wait_until
 from poinsot.app.construction.sampled.frames import rotation_from_wxyz
 from poinsot.app.live.panel.panel import POINTING_HINT
 from poinsot.app.live.pointing.pointer import MISSED, SNAP_PX
-from poinsot.app.model.elements import OWN_BODY_CONTROLS
 from poinsot.app.live.session.session import Session
+from poinsot.app.model.elements import OWN_BODY_CONTROLS
 from poinsot.physics import FreeRigidBody, Regime
 
 
