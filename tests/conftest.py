@@ -37,7 +37,9 @@ from poinsot.app import viser_private
 from poinsot.app.cli.main import main as cli_main
 from poinsot.app.devtools.probe import Probe
 from poinsot.app.exports.chromium import CHROMIUM_ARGS, CHROMIUM_ENV, DEFAULT_CHROMIUM
+from poinsot.app.lessons import SCENES
 from poinsot.app.live.lecture.lecture import LectureControls
+from poinsot.app.live.panel.panel import shown_label
 from poinsot.app.live.server import PoinsotApp
 from poinsot.app.live.session.session import Session
 from poinsot.app.model.presets import DEFAULT_PRESET, Preset
@@ -407,12 +409,16 @@ class BrowserPage:
         return float(value)
 
     def choose(self, label: str, option: str) -> None:
-        """Pick ``option`` in the dropdown labelled ``label``."""
+        """Pick ``option`` in the dropdown labelled ``label`` (a menu entry by its value: the
+        menu shows a scene's under its heading, without "Scene: ")."""
         self.page.locator(f"[id='{self.widget_id(label)}']").click()
-        self.page.get_by_role("option", name=option, exact=True).click()
+        self.page.get_by_role("option", name=shown_label(option), exact=True).click()
 
     def dropdown_value(self, label: str) -> str:
-        return self.page.locator(f"[id='{self.widget_id(label)}']").input_value()
+        """The value chosen (a menu entry's, as :meth:`choose` takes it)."""
+        shown = self.page.locator(f"[id='{self.widget_id(label)}']").input_value()
+        scene = next((s.label for s in SCENES if shown_label(s.label) == shown), None)
+        return shown if scene is None or label != "Preset" else scene
 
     def click_button(self, text: str) -> None:
         self.page.get_by_role("button", name=text, exact=True).click()

@@ -50,6 +50,12 @@ class Preset:
     #: One or two sentences saying what the picture shows, over the legend (a scene sets its
     #: own here; empty: :mod:`poinsot.app.live.panel.legend` has the presets' captions).
     caption: str = ""
+    #: A challenge's body (:mod:`poinsot.app.live.lecture.challenges`): its start is the
+    #: question's (a click on the ellipsoid does not move it).
+    challenge: bool = False
+    #: What would tell a challenge's answer (the readouts' regime, period and constants; the
+    #: clock's play and step) is withheld while it is shown.
+    withheld: bool = False
 
     def __post_init__(self) -> None:
         if self.pole_sign not in (1, -1):
@@ -107,7 +113,7 @@ PRESETS: tuple[Preset, ...] = (
     ),
     Preset(
         key="t_handle",
-        label="Intermediate-axis flip (T-handle)",
+        label="Dzhanibekov flip (T-handle)",
         source="Dzhanibekov effect (Salyut 7, 1985); Ashbaugh, Chicone & Cushman, "
         "J. Dyn. Diff. Eq. 3 (1991) 67; Landau Sec. 37 problem 2: a spin close to the "
         "intermediate axis flips periodically. T-handle bar 2.0 x r 0.14, stem 0.9 x r 0.14",
@@ -176,15 +182,16 @@ PRESETS: tuple[Preset, ...] = (
     ),
 )
 
-#: What a body edited by hand shows: everything, with the controls that bring a body of one's
-#: own (an uploaded toss or mesh).
+#: What a body edited by hand shows: everything. The controls that bring a body of one's own
+#: (an uploaded toss or mesh) come with the entries below; a hand edit keeps those the preset
+#: edited had (:meth:`poinsot.app.live.session.choice.Choice.edit`), and adds none.
 CUSTOM = Preset(
     key="custom",
     label="Custom (edited)",
     source="your own choice of moments and energy",
     inertia=_BOX_INERTIA,
     D=2.45,
-    controls=ALL_CONTROLS,
+    controls=STANDARD_CONTROLS,
 )
 
 # The entries for a body of one's own. Until something is uploaded they show these stand-ins

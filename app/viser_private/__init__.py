@@ -44,6 +44,10 @@ Inventory (section, private name, what it is used for):
   - ``ClientHandle._websock_connection``'s ``register_handler``/``queue_message`` with a class
     of ``viser._messages``: a handler of a client's messages after viser's own, and a message
     to that client (:func:`on_client_message`, :func:`send_to_client`).
+  - ``handle._impl.gui_api._websock_interface`` with ``viser._messages.GuiUpdateMessage``: a
+    dropdown's options sent to the browser in groups (Mantine's ``Select`` takes
+    ``{group, items: [{value, label}]}``; viser 1.1 types its options as plain strings), the
+    handle keeping its flat options for the server's checks (:func:`set_dropdown_groups`).
 
 *Scene* (:mod:`poinsot.app.viser_private.scene`)
   - ``SceneNodeHandle._impl`` (``name``, ``wxyz``, ``position``, ``props``, ``removed``,
@@ -107,6 +111,7 @@ from poinsot.app.viser_private.page import (
     fold_bottom_sheet,
     handshake_origin,
     page_address,
+    scroll_to_button,
 )
 from poinsot.app.viser_private.scene import (
     CACHED_HINTS,
@@ -172,6 +177,7 @@ __all__ = [
     "client_message",
     "copy_to_clipboard",
     "fold_bottom_sheet",
+    "scroll_to_button",
     "handshake_origin",
     "hooked_server",
     "message_type",
@@ -272,6 +278,29 @@ def set_slider_marks(
     ``add_slider``; a handle's ``marks`` attribute is not sent, the ``_marks`` property is."""
     slider._marks = tuple(
         _messages.GuiSliderMark(value=float(v), label=label) for v, label in marks
+    )
+
+
+def set_dropdown_groups(
+    dropdown: viser.GuiDropdownHandle[str],
+    groups: Iterable[tuple[str, Iterable[tuple[str, str]]]],
+) -> None:
+    """Show ``dropdown``'s options in the browser as labelled groups: ``(group label, [(value,
+    shown label), ...])``. The browser's Select renders a heading per group and sends the
+    value; the handle keeps its flat ``options`` (the values, checked on arrival), which must
+    hold every value given here."""
+    data: list[dict[str, Any]] = [
+        {"group": name, "items": [{"value": v, "label": label} for v, label in items]}
+        for name, items in groups
+    ]
+    values = {item["value"] for group in data for item in group["items"]}
+    if not values <= set(dropdown.options):
+        raise ValueError(
+            f"values not among the dropdown's options: {values - set(dropdown.options)}"
+        )
+    impl = dropdown._impl
+    impl.gui_api._websock_interface.queue_message(
+        _messages.GuiUpdateMessage(impl.uuid, {"options": data})
     )
 
 

@@ -142,3 +142,55 @@ def copy_to_clipboard(client: viser.ClientHandle, text: str) -> None:
     the caller also shows the text)."""
     _run_javascript(client, _COPY_JS % json.dumps(text))
     client.flush()
+
+
+_SHOW_BUTTON_JS = """
+(() => {
+  const label = %s, folder = %s;
+  const until = Date.now() + %d, hold = %d;
+  let opened = false, held = 0, left = false;
+  const stop = () => { left = true; };
+  for (const e of ["wheel", "touchstart", "keydown", "pointerdown"]) {
+    window.addEventListener(e, stop, {once: true, passive: true, capture: true});
+  }
+  const find = () => [...document.querySelectorAll("button")].find(
+      (b) => b.textContent.trim() === label);
+  const show = () => {
+    if (left) return;  // the user scrolls, types or clicks: the page is theirs again
+    const button = find();
+    const box = button && button.getBoundingClientRect();
+    const shown = box && box.height > 0;
+    if (button && !shown && !opened && folder) {  // in a folded folder: open it, as a click does
+      const header = [...document.querySelectorAll("div")].find(
+        (e) => e.style.cursor === "pointer" && e.textContent.trim() === folder);
+      if (header) { header.click(); opened = true; }
+    }
+    if (shown && (box.top < 0 || box.bottom > window.innerHeight)) {
+      button.scrollIntoView({block: "center"});
+    }
+    if (shown) held = held || Date.now();
+    // Kept in view a moment after it first shows (what loads with it may push it down).
+    if ((!held && Date.now() < until) || (held && Date.now() < held + hold)) {
+      setTimeout(show, 100);
+    }
+  };
+  show();
+})();
+"""
+
+
+def scroll_to_button(
+    client: viser.ClientHandle,
+    label: str,
+    folder: str = "",
+    wait_ms: int = 5000,
+    hold_ms: int = 3000,
+) -> None:
+    """Scroll the panel holding the button labelled ``label`` until the button is in the middle
+    of the screen (what stands above it, too), as soon as the page shows it (looked for during
+    ``wait_ms``), and keep it there for ``hold_ms`` (what loads with it may push it down), unless
+    the user scrolls, types or clicks meanwhile; if it is in the folded folder titled
+    ``folder``, that folder is opened first (one click on its title, as a user's)."""
+    args = (json.dumps(label), json.dumps(folder), int(wait_ms), int(hold_ms))
+    _run_javascript(client, _SHOW_BUTTON_JS % args)
+    client.flush()

@@ -5,8 +5,11 @@
   the theory's, checked here by independent means: flip or stay against DOP853 (does the
   spin's component change sign), the first flip against DOP853's, the twin's lag against the
   two exact motions.
-* An answer that is not a number is answered with a message and the challenge stays; a right
-  answer loads the challenge's motion at t = 0, reveals the theory and counts in the score.
+* No flip-or-stay question names its axis or its outcome.
+* "Start the challenge" loads the challenge's own body paused at t = 0, with the readouts, the
+  plot and the I₂ mark withheld and play refused; an answer not chosen (or not typed, or not a
+  number) is answered with a message and the challenge stays; a right answer loads the
+  challenge's motion at t = 0, reveals the theory and counts in the score.
 """
 
 from __future__ import annotations
@@ -17,7 +20,17 @@ from conftest import session_of, wait_until
 from scipy.integrate import solve_ivp
 
 from poinsot.app.live.lecture import challenges
-from poinsot.app.live.lecture.challenge_set import AXES, OUTCOMES, challenge_set, parse_time
+from poinsot.app.live.lecture.challenge_set import (
+    AXES,
+    CHOOSE,
+    OUTCOMES,
+    challenge_set,
+    parse_time,
+)
+from poinsot.app.live.session.rebuild import WITHHELD
+from poinsot.app.model.elements import Control, Plot
+from poinsot.app.model.parameters import drawn_solid
+from poinsot.app.model.presets import T_HANDLE
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.models.flip import integrated_flip_times
 from poinsot.physics.models.twins import measured_lag
@@ -78,13 +91,44 @@ def test_a_time_is_read_as_people_type_it() -> None:
             parse_time(bad)
 
 
+def _markdowns(probe) -> str:
+    return "\n".join(str(w.props.get("_markdown", "")) for w in probe.widgets.values())
+
+
+def _settled(session) -> None:
+    """Every action posted so far has run, and the rebuild it asked for."""
+    marker: list[bool] = []
+    session.post(lambda: marker.append(True))
+    assert wait_until(lambda: marker == [True] and not session.build.dirty, 20)
+
+
+def test_the_questions_name_neither_their_axis_nor_their_outcome() -> None:
+    for seed in (0, 7):
+        for c in challenge_set(seed):
+            text = f"{c.title} {c.prompt} {c.body}".lower()
+            for giveaway in ("largest", "smallest", "middle axis", "intermediate", "flips"):
+                if c.kind == "axis":
+                    assert giveaway not in text, (c.title, giveaway)
+            assert "stable" not in text and "dzhanibekov" not in text, c.title
+
+
 def test_answer_then_play_in_a_session(poinsot_app, probe) -> None:
     session = session_of(poinsot_app)
-    assert probe.wait_for(lambda p: challenges.NEXT in p.labels(), 15)
+    assert probe.wait_for(lambda p: challenges.START in p.labels(), 15)
     folder = session.lecture.challenges
     assert folder is not None
+    probe.set_value(probe.widget(challenges.START)[0], True)
+    assert wait_until(lambda: folder.started, 10)
+    _settled(session)
     first = folder.current
     assert first.kind == "axis"
+    assert session.preset.withheld and session.clock.paused and session.frame.t == 0.0
+    assert session.panel.motion.readouts.content == WITHHELD
+    assert probe.wait_for(lambda p: p.widget("Flip or stay?")[1].value == CHOOSE, 10)
+    # Answer without a choice: refused, with a message, not scored
+    probe.set_value(probe.widget(challenges.PLAY)[0], True)
+    assert wait_until(lambda: "choose an outcome" in folder.message.content.lower(), 10)
+    assert not folder.revealed and folder.answered == 0
     flips, axis = first.answer  # type: ignore[misc]
     probe.set_value(probe.widget("Flip or stay?")[0], OUTCOMES[0 if flips else 1])
     probe.set_value(probe.widget("About which axis?")[0], AXES[axis])
@@ -97,7 +141,9 @@ def test_answer_then_play_in_a_session(poinsot_app, probe) -> None:
     )
     assert folder.score == folder.answered == 1
     assert wait_until(lambda: session.params == first.params, 10)  # its motion plays
-    assert not session.clock.paused
+    assert wait_until(lambda: not session.clock.paused and not session.preset.withheld, 10)
+    readouts = session.panel.motion.readouts
+    assert wait_until(lambda: "regime" in readouts.content, 30)
     # the next three, all answered "it stays, about e₁": the score counts the right ones
     for n in range(2, 5):
         probe.set_value(probe.widget(challenges.NEXT)[0], True)
@@ -116,8 +162,43 @@ def test_answer_then_play_in_a_session(poinsot_app, probe) -> None:
     probe.set_value(probe.widget(challenges.NEXT)[0], True)
     assert wait_until(lambda: not folder.revealed, 10)
     assert folder.current.kind == "time"
+    probe.set_value(probe.widget(challenges.PLAY)[0], True)  # nothing typed: refused
+    assert wait_until(lambda: "type a time first" in folder.message.content.lower(), 10)
     probe.set_value(probe.widget(challenges.ANSWER)[0], "soon")
     probe.set_value(probe.widget(challenges.PLAY)[0], True)
     assert wait_until(lambda: "not a number" in folder.message.content, 10)
     assert not folder.revealed and folder.answered == 4
+    assert session.stats.errors == 0, session.stats.last_error
+
+
+def test_each_challenge_draws_its_body_paused_at_zero_and_keeps_its_secret(
+    poinsot_app, probe
+) -> None:
+    session = session_of(poinsot_app)
+    folder = session.lecture.challenges
+    assert folder is not None
+    folder.begin()
+    for n, c in enumerate(folder.challenges):
+        _settled(session)
+        assert folder.index == n and not folder.revealed
+        shown = session.preset
+        assert shown.withheld and shown.label == challenges.LABEL, n
+        assert session.clock.paused and session.frame is not None and session.frame.t == 0.0
+        assert session.params == c.params
+        expected = c.solid if c.solid is not None else drawn_solid(c.params.inertia, shown, ())
+        assert session.build.solid == expected, c.title
+        if "T-handle" in c.title:
+            assert session.build.solid is T_HANDLE
+        assert Plot.OMEGA not in session.panel.groups  # no plot to read the answer off
+        assert not ({Control.ENERGY, Control.INERTIA} & session.panel.groups)  # no I₂ mark
+        assert session.panel.motion.readouts.content == WITHHELD
+        assert probe.wait_for(lambda p: WITHHELD in _markdowns(p), 10)
+        page = _markdowns(probe)
+        for secret in (c.explanation, c.shown(), "regime", "Your own body", "Custom (edited)"):
+            assert secret not in page, (c.title, secret)
+        session.toggle_pause()  # play is refused until the answer is in
+        _settled(session)
+        assert session.clock.paused and "Answer the challenge first" in session.status
+        folder.revealed = True  # as an answer does (the reveal itself is tested above)
+        folder.go_on()
     assert session.stats.errors == 0, session.stats.last_error

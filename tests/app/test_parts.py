@@ -93,7 +93,7 @@ def test_a_body_without_a_preset_solid_is_drawn_as_the_physics_box(make_app, mak
 
 
 def test_presets_are_found_by_key_and_label():
-    assert preset_by_key("t_handle").label == "Intermediate-axis flip (T-handle)"
+    assert preset_by_key("t_handle").label == "Dzhanibekov flip (T-handle)"
     assert preset_by_label(CUSTOM.label) is CUSTOM
     with pytest.raises(KeyError, match="no preset named"):
         preset_by_key("nope")

@@ -1,6 +1,7 @@
 """A start pointed at on the live ellipsoid (app/live/pointing/pointer.py): a click sets it, a drag
-draws the polhode through it and starts there on release, the separatrix is reached by hand, a miss
-does nothing."""
+draws the polhode through it and starts there on release, the separatrix is reached by hand, the
+Scene folder says that the ellipsoid can be clicked, and a miss changes nothing but says so in one
+line; a click adds no folder to the panel, and the ω plot restarts with the motion."""
 
 from __future__ import annotations
 
@@ -9,8 +10,10 @@ import pytest
 from conftest import session_of, wait_until
 
 from poinsot.app.construction.sampled.frames import rotation_from_wxyz
-from poinsot.app.live.pointing.pointer import SNAP_PX
+from poinsot.app.live.panel.panel import POINTING_HINT
+from poinsot.app.live.pointing.pointer import MISSED, SNAP_PX
 from poinsot.app.live.session.session import Session
+from poinsot.app.model.elements import OWN_BODY_CONTROLS
 from poinsot.physics import FreeRigidBody, Regime
 
 
@@ -90,15 +93,46 @@ def test_the_pointer_reaches_the_exact_separatrix(poinsot_app, probe) -> None:
     assert session.body.D == sorted(body.inertia)[1]
 
 
-def test_a_ray_that_misses_does_nothing_and_says_nothing(poinsot_app, probe) -> None:
+def test_a_ray_that_misses_changes_nothing_and_says_so(poinsot_app, probe) -> None:
     session = session_of(poinsot_app)
+    hint = f"<small>{POINTING_HINT.format(verb='Click')}</small>"
+    assert probe.wait_for(lambda p: hint in _texts(p), 10)  # the ellipsoid says it is clickable
     body, status = session.body, session.status
     generation = session.generation
     session.post(lambda: session.pointer.release(((0.0, 0.0, 9.0), (1.0, 0.0, 0.0))))
     session.post(lambda: session.pointer.drag(((0.0, 0.0, 9.0), (0.0, 0.0, 1.0))))
+    session.post(lambda: session.pointer.beside(((0.0, 0.0, 9.0), (0.0, 1.0, 0.0))))
     marker = []
     session.post(lambda: marker.append(True))
     assert wait_until(lambda: marker == [True])
     assert session.body is body and session.status == status == ""
     assert session.generation == generation and session.pointer.previews == 0
+    assert session.pointer.misses == 2  # the release and the click beside the body
+    missed = f"<small>{MISSED.format(verb='click')}</small>"
+    assert probe.wait_for(lambda p: missed in _texts(p), 10)
     assert session.stats.errors == 0
+
+
+def test_a_click_adds_no_folder_and_restarts_the_plot(poinsot_app, probe) -> None:
+    session = session_of(poinsot_app)
+    plot = session.panel.motion.plot
+    assert plot is not None
+    assert wait_until(lambda: len(plot.data[0]) > 3, 20)  # an old curve on screen
+    _set(session, lambda: setattr(session.clock, "paused", True))  # it stays, paused
+    groups = session.panel.groups
+    body = session.body
+    assert body is not None
+    target = np.asarray(body.omega(0.3))
+    target[0] *= -1.0
+    _set(session, lambda: session.pointer.release(_ray_at(session, target)))
+    assert session.preset.key == "custom"
+    assert not (OWN_BODY_CONTROLS & session.panel.groups)  # no upload folder came
+    assert session.panel.groups == groups
+    assert session.clock.paused
+    # the rebuild sent the new motion's start alone (a point at t = 0), not the old curve
+    np.testing.assert_array_equal(np.asarray(plot.data[0], dtype=float), [0.0, 0.0])
+    np.testing.assert_allclose(np.asarray(plot.data[1], dtype=float), session.body.omega0[0])
+
+
+def _texts(probe) -> list[str]:
+    return [w.props.get("_markdown", "") for w in probe.widgets.values()]

@@ -119,15 +119,21 @@ def mesh_page(poinsot_app, probe):
 
 
 # -- declared like every control ------------------------------------------------------------
-def test_only_the_own_body_entries_and_custom_have_the_upload_folders(poinsot_app, probe):
+def test_only_the_own_body_entries_have_the_upload_folders(poinsot_app, probe):
     session = session_of(poinsot_app)
     assert not ({RECORDING, MESH, "Bundled body"} & set(probe.labels()))  # never made
     assert Control.TOSS not in DEFAULT_PRESET.controls
-    for key in ("fitted_toss", "mesh_body", "custom"):
+    for key in ("fitted_toss", "mesh_body"):
         choose(probe, session, preset_by_key(key).label)
         assert probe.wait_for(lambda p: {RECORDING, MESH} <= shown_labels(p), 10), key
     choose(probe, session, preset_by_key("t_handle").label)
     assert probe.wait_for(lambda p: not ({RECORDING, MESH} & shown_labels(p)), 10)
+    # a body edited by hand (a slider, a click) keeps the folders it had, and adds none
+    session.edit(lambda p: p.with_inertia(0, 1.1))
+    assert wait_until(lambda: session.preset.key == "custom" and not session.build.dirty, 10)
+    assert not ({Control.TOSS, Control.MESH} & session.panel.groups)
+    choose(probe, session, preset_by_key("custom").label)
+    assert not ({Control.TOSS, Control.MESH} & session.panel.groups)
 
 
 # -- a recording ----------------------------------------------------------------------------

@@ -97,6 +97,19 @@ JUNK = [math.nan, math.inf, -math.inf, 1e300, -1e300, 99_999_999, "abc", None, [
 INPUTS = ("GuiSliderMessage", "GuiNumberMessage", "GuiDropdownMessage", "GuiButtonGroupMessage")
 
 
+def _values(options: list[Any]) -> list[Any]:
+    """A dropdown's values, its options plain or in groups ({group, items: [{value, label}]})."""
+    values: list[Any] = []
+    for option in options:
+        if isinstance(option, dict) and "items" in option:
+            values += [
+                item["value"] if isinstance(item, dict) else item for item in option["items"]
+            ]
+        else:
+            values.append(option)
+    return values
+
+
 def _inputs(probe: Probe) -> dict[str, Any]:
     _, widgets = probe.snapshot()
     return {uuid: w for uuid, w in widgets.items() if w.type in INPUTS}
@@ -167,7 +180,7 @@ def test_junk_values_are_clamped_or_refused_and_the_session_keeps_running(
     def in_range(widget: Any) -> bool:
         if "min" in widget.props and widget.value is not None:
             return bool(widget.props["min"] <= widget.value <= widget.props["max"])
-        return "options" not in widget.props or widget.value in widget.props["options"]
+        return "options" not in widget.props or widget.value in _values(widget.props["options"])
 
     # A widget's new range and its new value are two messages: wait for both to arrive.
     def all_in_range(p: Probe) -> bool:

@@ -3,7 +3,8 @@ theory gives and a sentence a first-year student can follow [LL76 §37; ACC91; F
 7.3].
 
 Three kinds of question: does the body flip or stay, and about which axis was it spun (the
-presets' boxes and T-handle, a random body near a random axis); when comes the first flip (the
+presets' box and T-handle, a random body near a random axis: the body is drawn at t = 0, and
+no title or question names the axis or the outcome); when comes the first flip (the
 T-handle and a random body near the middle axis, ``(K ± δ)/λ``); how much later does a twin
 started n times closer flip (``t₁(ε′) − t₁(ε)``, near ``ln(n)/σ``). :func:`challenge_set`
 draws one set from a seed (one per session); every answer comes from :mod:`poinsot.physics`.
@@ -18,8 +19,9 @@ import random
 import numpy as np
 
 from poinsot.app.lessons import dzhanibekov
+from poinsot.app.model.elements import Solid
 from poinsot.app.model.parameters import Parameters
-from poinsot.app.model.presets import preset_by_key
+from poinsot.app.model.presets import T_HANDLE, preset_by_key
 from poinsot.physics.models.axis_angles import wobble_theory
 from poinsot.physics.models.flip import flip_initial_omega, flip_theory, measure_flips
 from poinsot.physics.models.twins import twin_clock
@@ -29,13 +31,20 @@ TIME_TOLERANCE = 0.2
 #: The axes as the student picks them.
 AXES = ("e₁ (smallest moment)", "e₂ (middle moment)", "e₃ (largest moment)")
 OUTCOMES = ("it flips", "it stays")
+#: The first entry of each answer's list: nothing chosen yet.
+CHOOSE = "choose…"
+#: What each challenge draws.
+BOX = "a homogeneous 3 × 2 × 1 box"
+HANDLE = "a T-handle (bar 2.0, stem 0.9)"
+RANDOM = "a box of random moments"
 
 
 @dataclasses.dataclass(frozen=True)
 class Challenge:
     """One question: ``kind`` is "axis" (flip or stay, about which axis), "time" (the first
     flip) or "lag" (the twin's lag); ``answer`` is (flips, axis) or a time; ``params`` the motion
-    that plays; ``twin_ratio`` n for a lag (the twin at ε/n)."""
+    that plays; ``twin_ratio`` n for a lag (the twin at ε/n); ``body`` says what is drawn,
+    ``solid`` is drawn (None: the box of the same moments)."""
 
     title: str
     prompt: str
@@ -44,6 +53,8 @@ class Challenge:
     answer: tuple[bool, int] | float
     explanation: str
     twin_ratio: float = 0.0
+    body: str = RANDOM
+    solid: Solid | None = None
 
     def judge(self, guess: tuple[bool, int] | float) -> bool:
         """Whether ``guess`` is right: the same outcome and axis, or a time within 20 %."""
@@ -69,7 +80,16 @@ def _params(inertia: tuple[float, float, float], omega0: np.ndarray) -> Paramete
     return Parameters(inertia, D, 1, float(np.linalg.norm(omega0)), omega0=w)
 
 
-def _axis_challenge(title: str, params: Parameters) -> Challenge:
+#: The question of every flip-or-stay challenge: it names neither the axis nor the outcome.
+AXIS_PROMPT = (
+    "The body is drawn at t = 0, paused; ω (the arrow) starts close to one of its principal "
+    "axes. About which axis is it spun, and does it flip over or stay?"
+)
+
+
+def _axis_challenge(
+    title: str, params: Parameters, drawn: str = RANDOM, solid: Solid | None = None
+) -> Challenge:
     """Flip or stay: the axis is the one L starts closest to; it flips if ω along it changes
     sign within one period of the exact motion."""
     body = params.build()
@@ -96,8 +116,8 @@ def _axis_challenge(title: str, params: Parameters) -> Challenge:
             f"to {name}, which only wobbles around it, about every {2 * math.pi / wobble:.3g} "
             f"time units (small oscillations, Ω = {wobble:.3g} rad per time unit)."
         )
-    prompt = "Does it flip or stay, and about which axis was it spun?"
-    return Challenge(title, prompt, "axis", params, (flips, sorted_axis), text)
+    answer = (flips, sorted_axis)
+    return Challenge(title, AXIS_PROMPT, "axis", params, answer, text, body=drawn, solid=solid)
 
 
 def _random_moments(rng: random.Random) -> tuple[float, float, float]:
@@ -108,7 +128,13 @@ def _random_moments(rng: random.Random) -> tuple[float, float, float]:
             return (J[0], J[1], J[2])
 
 
-def _time_challenge(title: str, inertia: tuple[float, float, float], eps: float) -> Challenge:
+def _time_challenge(
+    title: str,
+    inertia: tuple[float, float, float],
+    eps: float,
+    body: str = RANDOM,
+    solid: Solid | None = None,
+) -> Challenge:
     spin = 2.0
     w0 = flip_initial_omega(eps, spin)
     theory = flip_theory(inertia, w0)
@@ -124,11 +150,17 @@ def _time_challenge(title: str, inertia: tuple[float, float, float], eps: float)
         "first flip (a time)?"
     )
     params = _params(inertia, w0)
-    return Challenge(title, prompt, "time", params, theory.first_flip_time, text)
+    answer = theory.first_flip_time
+    return Challenge(title, prompt, "time", params, answer, text, body=body, solid=solid)
 
 
 def _lag_challenge(
-    title: str, inertia: tuple[float, float, float], eps: float, n: float
+    title: str,
+    inertia: tuple[float, float, float],
+    eps: float,
+    n: float,
+    body: str = RANDOM,
+    solid: Solid | None = None,
 ) -> Challenge:
     spin = 2.0
     clock = twin_clock(inertia, eps, eps / n, spin)
@@ -143,7 +175,7 @@ def _lag_challenge(
         "much later does the second one flip (a time)?"
     )
     params = _params(inertia, flip_initial_omega(eps, spin))
-    return Challenge(title, prompt, "lag", params, clock.lag, text, twin_ratio=n)
+    return Challenge(title, prompt, "lag", params, clock.lag, text, n, body, solid)
 
 
 def challenge_set(seed: int) -> list[Challenge]:
@@ -157,16 +189,16 @@ def challenge_set(seed: int) -> list[Challenge]:
     tilt = rng.uniform(0.03, 0.1)
     w0[axis], w0[(axis + 1) % 3] = 2.0 * math.cos(tilt), 2.0 * math.sin(tilt)
     K = _random_moments(rng)
+    box = preset_by_key("major").solid
+    flip = flip_initial_omega(0.05, 2.0)
     return [
-        _axis_challenge("A box spun near its largest moment", _preset("major")),
-        _axis_challenge("A box spun near its smallest moment", _preset("minor")),
-        _axis_challenge(
-            "A T-handle spun near its middle axis", _params(handle, flip_initial_omega(0.05, 2.0))
-        ),
-        _axis_challenge("A random body", _params(J, w0)),
-        _time_challenge("The T-handle's first flip", handle, 1e-3),
+        _axis_challenge("A 3 × 2 × 1 box", _preset("major"), BOX, box),
+        _axis_challenge("The same box, spun another way", _preset("minor"), BOX, box),
+        _axis_challenge("A T-handle", _params(handle, flip), HANDLE, T_HANDLE),
+        _axis_challenge("A body of random shape", _params(J, w0)),
+        _time_challenge("The T-handle's first flip", handle, 1e-3, HANDLE, T_HANDLE),
         _time_challenge("A random body's first flip", K, 10.0 ** -rng.randint(2, 7)),
-        _lag_challenge("Twins: ten times closer", handle, 1e-3, 10.0),
+        _lag_challenge("Twins: ten times closer", handle, 1e-3, 10.0, HANDLE, T_HANDLE),
         _lag_challenge("Twins: a thousand times closer", K, 10.0 ** -rng.randint(2, 5), 1000.0),
     ]
 
@@ -178,6 +210,8 @@ def _preset(key: str) -> Parameters:
 def parse_time(text: str) -> float:
     """A time the student typed ("3.2", "3,2", "1e1"), else ValueError with a message."""
     cleaned = text.strip().replace(",", ".")
+    if not cleaned:
+        raise ValueError("type a time first, e.g. 7.5")
     try:
         value = float(cleaned)
     except ValueError:

@@ -136,17 +136,37 @@ class MotionWindow:
         if len(self._t) > PLOT_SAMPLES:
             del self._t[0], self._omega[0], self._wxyz[0]
 
+    def restart_plot(self, t: float, omega: np.ndarray, wxyz: np.ndarray | None = None) -> None:
+        """A new motion from ``t``: the plot holds its first sample alone, sent at once (the
+        old curve does not stay on screen, even while the clock is paused)."""
+        self.clear_plot()
+        self.record_plot(t, omega, wxyz)
+        self.send_plot()
+
     def send_plot(self) -> bool:
-        if self.plot is None or len(self._t) < 2:
+        """Send the samples kept (a single one drawn as a point: the plot of a new motion)."""
+        if self.plot is None or not self._t:
             return False
+        single = len(self._t) == 1
+        if single:  # uPlot draws no line of one point: the sample twice, as a dot
+            self._t.append(self._t[0])
+            self._omega.append(self._omega[0])
+            self._wxyz.append(self._wxyz[0])
+        try:
+            return self._send(self.plot)
+        finally:
+            if single:
+                del self._t[1:], self._omega[1:], self._wxyz[1:]
+
+    def _send(self, plot: viser.GuiUplotHandle) -> bool:
         w = np.asarray(self._omega)
         y = w
         if not self._with_measured:
-            y = plots.values(self.choice.apply(self.plot), self.body, w, np.asarray(self._wxyz))
+            y = plots.values(self.choice.apply(plot), self.body, w, np.asarray(self._wxyz))
         data: tuple[np.ndarray, ...] = (np.asarray(self._t), *(y[:, i].copy() for i in range(3)))
         if self._with_measured:
             data = merge(data[0], w, self.measured)
         if all(np.all(np.isfinite(a)) for a in data[:4]):  # measured NaN: no sample there
-            self.plot.data = data
+            plot.data = data
             return True
         return False

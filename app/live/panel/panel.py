@@ -43,8 +43,8 @@ from poinsot.app.model.parameters import (
     TRAIL_RANGE,
     Parameters,
 )
-from poinsot.app.model.presets import MENU, Preset
-from poinsot.app.viser_private import gui_event_loop
+from poinsot.app.model.presets import FITTED_TOSS, MENU, PRESETS, Preset
+from poinsot.app.viser_private import gui_event_loop, set_dropdown_groups
 
 ELEMENT_LABELS: dict[Element, str] = {
     Element.ELLIPSOID: "energy ellipsoid",
@@ -72,6 +72,39 @@ _ORDER: dict[str | Group, float] = {
     "readouts": 50.0,
     Plot.OMEGA: 60.0,
 }
+
+#: The menu's groups, in order: (heading, the labels in it). The browser shows each label whole
+#: under its heading (:func:`menu_groups`); a scene's label is shown without "Scene: ".
+MENU_PRESETS = "Presets"
+MENU_SCENES = "Textbook scenes"
+MENU_OWN = "Your own body"
+#: The menu's hint (a tooltip) and the line under it naming the choice whole.
+MENU_HINT = (
+    "Presets: classical cases. Textbook scenes: a lecture's pictures, theory against the "
+    "motion. Your own body: a gyroscope recording, a mesh, or a body edited by hand."
+)
+
+
+#: The line that says the ellipsoid can be pointed at (``verb``: "Click" or "Tap").
+POINTING_HINT = "_{verb} the ellipsoid to start ω there._"
+#: The same line for a challenge's body, whose start is the question's.
+FIXED_HINT = "_A challenge's body: its start is fixed._"
+
+
+def menu_groups() -> list[tuple[str, list[str]]]:
+    """The menu's labels under their headings: presets, textbook scenes, your own body."""
+    own = MENU[MENU.index(FITTED_TOSS) :]
+    return [
+        (MENU_PRESETS, [p.label for p in PRESETS]),
+        (MENU_SCENES, [s.label for s in SCENES]),
+        (MENU_OWN, [p.label for p in own]),
+    ]
+
+
+def shown_label(label: str) -> str:
+    """A menu label as the menu shows it under its heading."""
+    return label.removeprefix("Scene: ")
+
 
 #: A widget whose changes the panel listens to.
 H = TypeVar(
@@ -113,18 +146,26 @@ class ControlPanel:
         self._elements: frozenset[Element] = frozenset()
         #: Builders of groups that other modules add (uploads: the toss and mesh folders).
         self._extensions: dict[Group, Callable[[], list[Removable]]] = {}
+        #: The menu's groups, and entries other modules add (:meth:`add_entry`).
+        self._groups_shown = menu_groups()
+        self._entries: dict[str, Callable[[], None]] = {}
         with gui.add_folder("Scene", order=_ORDER["scene"]) as folder:
             self._folders["scene"] = folder
             self.preset = gui.add_dropdown(
                 "Preset",
-                [*(p.label for p in MENU), *(s.label for s in SCENES)],
+                [label for _, labels in self._groups_shown for label in labels],
                 initial_value=preset.label,
-                hint="Start from a classical case; editing a slider turns it into 'Custom'.",
+                hint=MENU_HINT,
             )
+            self._send_groups()
             self.source = gui.add_markdown(self._source_text(preset))
             #: The guide's page for what is shown (served at /docs/: :mod:`...docs_site`).
             self.help = gui.add_markdown(help_markdown(preset.key))
+            #: What a click (a tap) on the ellipsoid does, and what the last one did.
+            self.pointing = gui.add_markdown("")
             self.status = gui.add_markdown("")
+        #: "Click" or "Tap" (the pointer's, for a touch screen).
+        self.pointing_verb = "Click"
         self.motion = MotionWindow(gui, order=_ORDER["readouts"])
         #: The body's groups (moments, D, side and pole, |ω₀|).
         self.body = BodyControls(gui, actions.edit, self.widgets, self._folder, self._on_user)
@@ -139,7 +180,26 @@ class ControlPanel:
         viser's event loop: the panel's callbacks only post to the session's queue."""
         return on_user(handle, callback, self.actions.report, inline=True)
 
+    def _send_groups(self) -> None:
+        groups = [
+            (name, [(label, shown_label(label)) for label in labels])
+            for name, labels in self._groups_shown
+        ]
+        set_dropdown_groups(self.preset, groups)
+
+    def add_entry(self, group: str, label: str, choose: Callable[[], None]) -> None:
+        """A menu entry of another module's (the challenges'): ``choose()`` runs on viser's
+        event loop when the browser picks it (it must only post)."""
+        self._entries[label] = choose
+        self._groups_shown.append((group, [label]))
+        self.preset.options = [label for _, labels in self._groups_shown for label in labels]
+        self._send_groups()
+
     def _choose_preset(self, handle: Sent) -> None:
+        entry = self._entries.get(handle.value)
+        if entry is not None:
+            entry()
+            return
         for p in MENU:
             if p.label == handle.value:
                 self.actions.choose_preset(p)
@@ -323,11 +383,29 @@ class ControlPanel:
         write_unless_newer(self.preset, preset.label, self.menu, menu_count, self._loop)
         self.source.content = self._source_text(preset)
         self.help.content = help_markdown(preset.key)
+        self.show_hint(preset)
         self.motion.legend.show_caption(caption(preset))
 
     @staticmethod
     def _source_text(preset: Preset) -> str:
-        return f"<small>_Source:_ {readouts.readable(preset.source)}</small>"
+        """The choice's whole name (the menu's field may cut a long one), and its source."""
+        name = shown_label(preset.label)
+        return f"**{name}**<br><small>_Source:_ {readouts.readable(preset.source)}</small>"
+
+    def show_hint(self, preset: Preset) -> None:
+        """Say that the ellipsoid can be clicked, where a click starts the motion there (not on
+        a scene of its own; a challenge's body says that its start is fixed)."""
+        if preset.challenge:
+            self.show_pointing(FIXED_HINT)
+            return
+        pointable = Element.ELLIPSOID in preset.elements and scene_by_label(preset.label) is None
+        self.show_pointing(POINTING_HINT.format(verb=self.pointing_verb) if pointable else "")
+
+    def show_pointing(self, text: str) -> None:
+        """The line under the source saying what a click on the ellipsoid does (or did)."""
+        text = f"<small>{text}</small>" if text else ""
+        if self.pointing.content != text:
+            self.pointing.content = text
 
     def show_status(self, message: str) -> None:
         text = f"**⚠ {message}**" if message else ""

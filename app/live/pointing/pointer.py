@@ -11,9 +11,12 @@ it is the exact separatrix (as the D slider's I₂ mark gives).
 
 While a drag lasts the motion stands still and the polhode through the pointed start is drawn
 (body frame, so it lies on the ellipsoid); on release the body is rebuilt from the last start
-drawn and plays (unless it was paused before). A click is a drag's release at once. A ray that
-misses the ellipsoid does nothing and says nothing; so does one while a scene of its own (which
-draws no construction of a free body) is shown.
+drawn and plays (unless it was paused before). A click is a drag's release at once. The Scene
+folder says that the ellipsoid can be clicked (:data:`~poinsot.app.live.panel.panel.POINTING_HINT`);
+a click that misses it (beside the body, or on the rim where the drawn mesh and the exact
+ellipsoid part) is told so there, in one short line (the panel does not move); a click on a
+challenge's body is told that its start is fixed. A click while a scene of its own (which draws
+no construction of a free body) is shown does nothing.
 
 :class:`StartPointer` is the drag and the release of any pointable surface (this ellipsoid, and
 Landau's sphere: :mod:`.sphere_pointer`): a drag update only meets the ray, evaluates the one
@@ -41,9 +44,11 @@ from poinsot.app.construction.nodes import Drawing, Ellipsoid
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.sampled.frames import rotation_from_wxyz
 from poinsot.app.live.panel.clock import SimClock
+from poinsot.app.live.panel.panel import POINTING_HINT
 from poinsot.app.live.panel.widgets import refuse_held
 from poinsot.app.model.elements import Element
 from poinsot.app.model.parameters import Parameters, Vector
+from poinsot.app.model.presets import Preset
 from poinsot.physics import FreeRigidBody
 from poinsot.physics.models.pointing import snap_to_separatrix, start_from_ray
 
@@ -55,6 +60,10 @@ PREVIEW_POINTS = 240
 DEFAULT_HEIGHT_PX = 800.0
 #: Drag updates whose server time is kept (:attr:`StartPointer.server_seconds`).
 KEPT_TIMES = 2000
+#: What the Scene folder says after a click that missed the ellipsoid (``verb``: click, tap),
+#: and after one on a challenge's body: one short line each, as the hint.
+MISSED = "**Missed the ellipsoid:** {verb} on its surface."
+FIXED = "**A challenge's body: its start is fixed.**"
 
 Ray = tuple[tuple[float, float, float], tuple[float, float, float]]
 Start = tuple[Vector, bool]  # (a point: ω0 or L, snapped onto the separatrix)
@@ -82,8 +91,12 @@ class PointerSession(BaseSession, Protocol):
     def frame(self) -> Frame | None: ...
     @property
     def showcase(self) -> object | None: ...
+    @property
+    def preset(self) -> Preset: ...
 
     def edit(self, change: Callable[[Parameters], Parameters]) -> None: ...
+    def set_pointing_verb(self, verb: str) -> None: ...
+    def show_pointing(self, text: str) -> None: ...
 
 
 class StartPointer(Generic[S]):
@@ -169,14 +182,19 @@ class StartPointer(Generic[S]):
     def release(self, ray: Ray) -> None:
         """Start the motion from the start under the pointer (or, off the surface, the one
         drawn last while dragging)."""
+        self._release(ray)
+
+    def _release(self, ray: Ray) -> bool:
+        """:meth:`release`; False if there was no start."""
         start = self.start_of(ray) or self.last
         for handle in self.previews_drawn:
             handle.visible = False
         self.cancel()
         if start is None:
-            return
+            return False
         self.starts += 1
         self.commit(start)
+        return True
 
     def cancel(self) -> None:
         """End a drag without a start: the clock as it was before it."""
@@ -208,10 +226,60 @@ class Pointer(StartPointer[PointerSession]):
 
     def __init__(self, session: PointerSession, drag: bool = True) -> None:
         super().__init__(session, drag)
+        #: Clicks that missed the ellipsoid, and were told so (tests).
+        self.misses = 0
+        self._on_node = False  # the click being dispatched met the ellipsoid's mesh
+        self.verb = "Click" if drag else "Tap"
+        session.set_pointing_verb(self.verb)  # the hint in the verb of this screen
         session.scene.on_create = self._bind
         drawing = session.scene.drawing(Element.ELLIPSOID)
         if drawing is not None:
             self._bind(Element.ELLIPSOID, drawing)
+        # viser awaits a coroutine callback (its types name only plain ones)
+        session.client.scene.on_click()(self._on_scene_click)  # type: ignore[arg-type]
+
+    async def _on_click(self, event: viser.SceneNodePointerEvent) -> None:
+        self._on_node = True  # the scene-wide click of the same gesture follows
+        await super()._on_click(event)
+
+    async def _on_scene_click(self, event: viser.SceneClickEvent) -> None:
+        """A click anywhere (after the mesh's own, if it met the mesh): one beside the body
+        is told that it missed."""
+        on_node, self._on_node = self._on_node, False
+        if on_node or refuse_held(event.client):
+            return
+        ray: Ray = (event.ray_origin, event.ray_direction)
+        self.session.post(lambda: self.beside(ray))
+
+    def beside(self, ray: Ray) -> None:
+        """A click that did not meet the ellipsoid's mesh (session thread): said, unless the
+        exact ellipsoid is under it after all, or a scene of its own is shown."""
+        s = self.session
+        if s.showcase is not None or Element.ELLIPSOID not in s.preset.elements:
+            return
+        if s.preset.challenge:
+            self._say(FIXED)
+        elif self.start_of(ray) is None:
+            self._missed()
+
+    def release(self, ray: Ray) -> None:
+        """As :meth:`StartPointer.release`; the Scene folder says what came of it."""
+        if self.session.preset.challenge:  # a challenge's body: its start is the question's
+            self.cancel()
+            for handle in self.previews_drawn:
+                handle.visible = False
+            self._say(FIXED)
+        elif self._release(ray):
+            self._say(POINTING_HINT.format(verb=self.verb))
+        elif self.session.showcase is None:
+            self._missed()
+
+    def _missed(self) -> None:
+        self.misses += 1
+        self._say(MISSED.format(verb=self.verb.lower()))
+
+    def _say(self, text: str) -> None:
+        self.session.show_pointing(text)
 
     @property
     def preview(self) -> viser.LineSegmentsHandle | None:
@@ -228,6 +296,8 @@ class Pointer(StartPointer[PointerSession]):
         s = self.session
         body, geometry, frame = s.body, s.scene.geometry, s.frame
         if s.showcase is not None or body is None or geometry is None or frame is None:
+            return None
+        if s.preset.challenge:  # a challenge's body: its start is the question's
             return None
         attitude = rotation_from_wxyz(frame.wxyz)
         origin, direction = ray

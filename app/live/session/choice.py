@@ -97,11 +97,13 @@ class Choice:
         if not self.build.want(new):
             return
         if self.preset is not CUSTOM and not new.matches(self.preset):
-            # Edited by hand: the scene becomes "Custom", which declares everything. Only
-            # additions happen here, so the slider being dragged stays in place.
+            # Edited by hand: the scene becomes "Custom", which declares everything, and keeps
+            # the controls the preset had (a toss's upload folder). Only additions happen here,
+            # so the slider being dragged, or the ellipsoid clicked, stays in place.
+            controls = CUSTOM.controls | self.preset.controls
             self.preset = CUSTOM
             self.scene.declare(ALL_ELEMENTS)
-            self._declare(CUSTOM.controls, CUSTOM.plots, CUSTOM.elements, new)
+            self._declare(controls, CUSTOM.plots, CUSTOM.elements, new)
             self.panel.show_preset(CUSTOM, menu_count)
 
     def _declare(

@@ -165,10 +165,38 @@ class Front:
         self.post(lambda: playback.set_speed(speed), "speed")
 
     def toggle_pause(self) -> None:
-        self.post(self._parts()[2].toggle_pause)
+        self.post(lambda: self._unless_withheld(self._parts()[2].toggle_pause))
 
     def step(self) -> None:
-        self.post(self._parts()[2].step)
+        self.post(lambda: self._unless_withheld(self._parts()[2].step))
+
+    def _unless_withheld(self, action: Action) -> None:
+        """Run ``action`` (play, step) unless a challenge's body waits for its answer."""
+        if self.preset.withheld:
+            self.status.say("Answer the challenge first: its motion plays with the answer.")
+            self._parts()[2].show()  # the button as the clock is: paused
+            return
+        action()
+
+    # -- the panel's entries and lines that tools write --------------------------------------
+    def add_menu_entry(self, group: str, label: str, choose: Callable[[], None]) -> None:
+        """A menu entry of another module's (the challenges'): ``choose()`` runs on viser's
+        event loop when the browser picks it (it must only post)."""
+        self._parts()[1].add_entry(group, label, choose)
+
+    def show_playback(self) -> None:
+        """Show the playback widgets as the clock is (frame thread)."""
+        self._parts()[2].show()
+
+    def set_pointing_verb(self, verb: str) -> None:
+        """How this screen points ("Click", "Tap"), and the hint said in it."""
+        panel = self._parts()[1]
+        panel.pointing_verb = verb
+        panel.show_hint(self.preset)
+
+    def show_pointing(self, text: str) -> None:
+        """The line saying what a click on the ellipsoid does, or what the last one did."""
+        self._parts()[1].show_pointing(text)
 
     def reset(self) -> None:
         self.post(self._reset)

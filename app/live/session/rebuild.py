@@ -33,6 +33,9 @@ from poinsot.app.model.parameters import Parameters, drawn_solid
 from poinsot.app.model.presets import Preset
 from poinsot.physics import FreeRigidBody
 
+#: The readouts of a challenge's body, until the answer is in.
+WITHHELD = "_The readouts are hidden until you answer the challenge._"
+
 
 class BodyBuild:
     """The body a session shows, rebuilt by :meth:`rebuild` when :attr:`dirty`. ``say`` sets the
@@ -148,8 +151,7 @@ class BodyBuild:
         self.panel.show_parameters(params)
         motion = self.panel.motion
         motion.set_body(body)
-        motion.clear_plot()
-        motion.record_plot(0.0, frame.omega, frame.wxyz)
+        motion.restart_plot(0.0, frame.omega, frame.wxyz)  # the old curve goes with its motion
         self._say("")
         # The readouts' table just after the new body has gone out (Montgomery's phase is
         # measured over a period: half a millisecond that the redraw need not wait for).
@@ -157,6 +159,9 @@ class BodyBuild:
 
     def _show_readouts(self, body: FreeRigidBody, shared: Motion | None) -> None:
         if body is not self.body:  # a newer body came meanwhile: its own readouts follow
+            return
+        if self.base.withheld:  # a challenge's body: the readouts would tell the answer
+            self.panel.motion.show_readouts(WITHHELD)
             return
         if shared is None:
             text = readouts.markdown(body)
