@@ -96,10 +96,15 @@ def _markdowns(probe) -> str:
 
 
 def _settled(session) -> None:
-    """Every action posted so far has run, and the rebuild it asked for."""
-    marker: list[bool] = []
-    session.post(lambda: marker.append(True))
-    assert wait_until(lambda: marker == [True] and not session.build.dirty, 20)
+    """Every action posted so far has run, and the rebuild it asked for: the frame thread
+    reads, in order behind them, whether a rebuild is due and how many were applied; if one is
+    due, the count must pass that (a rebuild counts once it is applied, not as it begins)."""
+    marker: list[tuple[bool, int]] = []
+    session.post(lambda: marker.append((session.build.dirty, session.build.generation)))
+    assert wait_until(lambda: bool(marker), 20)
+    due, applied = marker[0]
+    if due:
+        assert wait_until(lambda: session.build.generation > applied, 20)
 
 
 def test_the_questions_name_neither_their_axis_nor_their_outcome() -> None:
