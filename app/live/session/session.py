@@ -297,6 +297,8 @@ class Session:
         self.follow.on_frame(now)  # a lead publishes its state
         busy = self.scene.sent_traces or self.lecture.display.laid_out_now  # a layout step
         self.refresh.after_frame(now, self.frame, self.clock.paused, busy)
+        if self.layout is not None and self.frame is not None:  # a phone's sheet: t, regime
+            self.layout.show_header(now, self.frame.t)
         if self.showcase is not None and self.frame is not None:
             self.showcase.refresh(now, self.frame.t)  # its readouts and plots, at their rates
 
