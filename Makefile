@@ -12,7 +12,7 @@ SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # again (about 12 core-seconds of the suite on a 2-core machine).
 unexport PYTHONDONTWRITEBYTECODE
 
-.PHONY: run test test-fast install install-test chromium bench bench-compare load lint clean
+.PHONY: run test test-fast install install-test chromium pictures bench bench-compare load lint clean
 
 $(VENV)/bin/activate:
 	$(PYTHON) -m venv $(VENV)
@@ -71,6 +71,11 @@ test: install-test chromium
 FAST_JOBS ?= 3
 test-fast: install-test
 	$(PY) -m pytest -n $(FAST_JOBS) --dist loadgroup --no-loadscope-reorder -m "not browser and not server and not slow"
+
+# The README's pictures of the page (assets/page/: every size and theme, assets/drag_1280x800.png),
+# made again in headless Chromium; NAMES picks some, e.g. make pictures NAMES="dark_390x844".
+pictures: install-test chromium
+	$(PY) tests/browser/page_pictures.py $(NAMES)
 
 bench: install
 	$(PY) -m poinsot.physics.tools.benchmark

@@ -13,6 +13,9 @@ the component order.
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -120,6 +123,17 @@ def body_and_traces(
     radius = max(float(herpolhode_radius), MIN_TRACE_RING)
     ring = _ring(n) * radius + [0.0, 0.0, plane_height]
     return np.concatenate([sphere_points((0.0, 0.0, 0.0), 1.0, n), ring, [[0.0, 0.0, arrow_top]]])
+
+
+def framed_above(view: View, width: float, height: float, bar: float, points: np.ndarray) -> View:
+    """:func:`framed` for the part of a ``width`` x ``height`` picture above a ``bar`` at its
+    bottom (a phone's bottom sheet): framed for that part's field of view and shape, then moved
+    so that the part's middle is the picture's centre of what it frames."""
+    inner = math.tan(math.radians(view.fov_degrees) / 2.0) * (height - bar) / height
+    narrow = dataclasses.replace(view, fov_degrees=2.0 * math.degrees(math.atan(inner)))
+    chosen = framed(narrow, width / (height - bar), points)
+    chosen = dataclasses.replace(chosen, fov_degrees=view.fov_degrees)
+    return shifted_up(chosen, bar / 2.0, height)
 
 
 def shifted_up(view: View, pixels: float, height: float) -> View:

@@ -106,11 +106,17 @@ def shot(browser, name: str, dark: bool) -> None:
     app = PoinsotApp("127.0.0.1", 0)
     try:
         page = _open(browser, app, width, height, agent)
-        session = app.wait_for_sessions(1)[0]
+        session = app.wait_for_sessions(1, 120)[0]
         assert wait_until(lambda: session.running, 60)
         _style(session, dark, switch)
-        if agent:
-            assert wait_until(lambda: session.layout.framings >= 1, 60)
+        if agent:  # framed for the canvas's final size (its column folded to a rail)
+
+            def framed_for_canvas() -> bool:
+                box = page.canvas_box()
+                size = (round(box["width"]), round(box["height"]))
+                return session.layout.size == size and session.layout.framings >= 1
+
+            assert wait_until(framed_for_canvas, 60)
         time.sleep(TRACE_SECONDS)
         theme = "dark" if dark else "light"
         save(page.page.screenshot(), PAGES / f"{theme}_{name}.png")
@@ -122,7 +128,7 @@ def drag(browser) -> None:
     app = PoinsotApp("127.0.0.1", 0)
     try:
         page = _open(browser, app, 1280, 800, "")
-        session = app.wait_for_sessions(1)[0]
+        session = app.wait_for_sessions(1, 120)[0]
         time.sleep(2.0)
         x, y = screen_point(session, page, np.zeros(3))
         mouse = page.page.mouse

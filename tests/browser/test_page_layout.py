@@ -69,7 +69,7 @@ TRACKS_JS = """() => [...document.querySelectorAll('.mantine-Slider-track')]
 
 def test_large_text_at_1920_cuts_no_text_and_grows_the_labels(poinsot_app, open_page):
     page = open_page(poinsot_app.url, 1920, 1080, live_view=False)
-    session = session_of(poinsot_app)
+    session = session_of(poinsot_app, timeout=60)
     assert wait_until(lambda: session.running and session.lecture is not None, 30)
     labels = label_handles(session)
     normal = [handle.font_screen_scale for handle in labels]
@@ -94,12 +94,12 @@ def test_large_text_at_1920_cuts_no_text_and_grows_the_labels(poinsot_app, open_
 
 def test_the_projector_keeps_a_compact_legend_and_t(poinsot_app, open_page):
     page = open_page(poinsot_app.url, 1920, 1080, live_view=False)
-    session = session_of(poinsot_app)
+    session = session_of(poinsot_app, timeout=60)
     assert wait_until(lambda: session.running and session.lecture is not None, 30)
     before = page.canvas_box()["width"]
     page.set_checkbox("Projector mode", True)
     assert wait_until(lambda: session.lecture.display.style.projector, 20)
-    assert wait_until(lambda: page.canvas_box()["width"] > before + 150, 20), page.canvas_box()
+    assert wait_until(lambda: page.canvas_box()["width"] > before + 100, 20), page.canvas_box()
     legend = page.page.locator('[data-legend="herpolhode (plane)"]').first
     assert wait_until(legend.is_visible, 20)
     time = page.page.locator("p").filter(has_text=re.compile(r"t = +\d")).first
@@ -111,7 +111,7 @@ def test_the_projector_keeps_a_compact_legend_and_t(poinsot_app, open_page):
     assert page.errors == []
 
 
-#: The touch targets of the page shown [CSS px high], by kind.
+#: The touch targets of the page laid out (in the sheet, scrolled to or not) [CSS px high].
 TARGETS_JS = """() => {
   const kinds = {
     button: 'button', option: '[role=option]', field: 'input.mantine-Input-input',
@@ -120,7 +120,7 @@ TARGETS_JS = """() => {
   const out = {};
   for (const [kind, selector] of Object.entries(kinds)) {
     out[kind] = [...document.querySelectorAll(selector)].map((e) => e.getBoundingClientRect())
-      .filter((r) => r.width > 0 && r.height > 0 && r.bottom > 0 && r.top < innerHeight)
+      .filter((r) => r.width > 0 && r.height > 0)
       .map((r) => r.height);
   }
   return out;
@@ -131,7 +131,7 @@ def test_a_phone_s_sheet_is_full_width_with_t_and_the_regime_and_44_px_targets(
     poinsot_app, open_page
 ):
     page = open_device(open_page, poinsot_app.url, "phone-portrait")
-    session = session_of(poinsot_app)
+    session = session_of(poinsot_app, timeout=60)
     assert wait_until(lambda: session.layout is not None and session.layout.compact, 30)
     sheet = page.page.locator('.mantine-Paper-root[style*="bottom: 0px"]').first
     box = sheet.bounding_box()

@@ -41,7 +41,12 @@ from typing import Protocol
 import numpy as np
 import viser
 
-from poinsot.app.construction.cameras import body_and_traces, framed, shifted_up, sphere_points
+from poinsot.app.construction.cameras import (
+    body_and_traces,
+    framed,
+    framed_above,
+    sphere_points,
+)
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.geometry import L_OVERSHOOT
 from poinsot.app.construction.view import DEFAULT_VIEW
@@ -219,12 +224,11 @@ class Layout:
         if showcase is not None:
             points += [sphere_points(centre, radius) for centre, radius in showcase.spec.beside]
         width, height = self.size if self.size is not None else (0, 0)
-        bar = SHEET_BAR_PX if 0 < width < SHEET_BREAKPOINT_PX and height > 4 * SHEET_BAR_PX else 0
-        if bar:
-            aspect = width / (height - bar)
-        chosen = framed(view, aspect, np.concatenate(points))
-        if bar:
-            chosen = shifted_up(chosen, bar / 2.0, height)
+        every = np.concatenate(points)
+        if 0 < width < SHEET_BREAKPOINT_PX and height > 4 * SHEET_BAR_PX:
+            chosen = framed_above(view, width, height, SHEET_BAR_PX, every)
+        else:
+            chosen = framed(view, aspect, every)
         chosen.apply(self.session.client.camera)
         self.framings += 1
 

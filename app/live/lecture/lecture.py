@@ -153,8 +153,7 @@ class LectureControls:
             "Picture size",
             tuple(SIZE_CHOICES),
             initial_value=DEFAULT_PICTURE_SIZE,
-            hint="Pixels of the PNG (1920×1080, a slide's, unless chosen); 'current view' is "
-            "the size of the 3D view.",
+            hint="Pixels of the PNG (a slide's unless chosen); 'current view': the 3D view's.",
         )
         self.transparent = gui.add_checkbox(
             "Transparent PNG", False, hint="Leave the background transparent (for slides)."
