@@ -87,11 +87,11 @@ SHEET_CSS = f"""<style>
 </style>"""
 #: Touch targets, on a compact page only (a desktop's mouse keeps viser's dense panel).
 TOUCH_CSS = f"""<style>
-.mantine-Button-root, .mantine-Combobox-option, .mantine-Input-input,
+.mantine-Button-root, [role="option"], .mantine-Input-input,
 .mantine-Slider-root, .mantine-Checkbox-root, .mantine-ActionIcon-root {{
   min-height: {TOUCH_TARGET_PX}px !important;
 }}
-.mantine-Combobox-option {{ display: flex; align-items: center; }}
+[role="option"] {{ display: flex; align-items: center; }}
 .mantine-Slider-root, .mantine-Checkbox-root {{ display: flex; align-items: center; }}
 .mantine-Checkbox-body {{ align-items: center; }}
 .mantine-ActionIcon-root {{ min-width: {TOUCH_TARGET_PX}px !important; }}
