@@ -104,6 +104,7 @@ def save(png: bytes, path: Path) -> None:
 def shot(browser, name: str, dark: bool) -> None:
     width, height, agent, switch = SHOTS[name]
     app = PoinsotApp("127.0.0.1", 0)
+    page = None
     try:
         page = _open(browser, app, width, height, agent)
         session = app.wait_for_sessions(1, 120)[0]
@@ -118,9 +119,13 @@ def shot(browser, name: str, dark: bool) -> None:
 
             assert wait_until(framed_for_canvas, 60)
         time.sleep(TRACE_SECONDS)
+        session.toggle_pause()  # a paused page draws a frame a second: a busy machine's
+        assert wait_until(lambda: session.clock.paused, 60)  # screenshot comes sooner
         theme = "dark" if dark else "light"
         save(page.page.screenshot(), PAGES / f"{theme}_{name}.png")
     finally:
+        if page is not None:
+            page.page.context.close()  # its page stops drawing: the next picture has the cores
         app.stop()
 
 
@@ -139,6 +144,7 @@ def drag(browser) -> None:
         time.sleep(1.0)
         save(page.page.screenshot(), ASSETS / "drag_1280x800.png")
         mouse.up()
+        page.page.context.close()
     finally:
         app.stop()
 
@@ -161,9 +167,16 @@ def main(names: list[str]) -> None:
     PAGES.mkdir(exist_ok=True)
     with sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
+        failed = []
         for name in names or list(todo):
-            todo[name](browser)
+            try:
+                todo[name](browser)
+            except Exception as exc:  # the others are still made; this one is named below
+                print(f"{name}: failed ({type(exc).__name__}: {str(exc)[:200]})")
+                failed.append(name)
         browser.close()
+    if failed:
+        raise SystemExit(f'not made: {" ".join(failed)} (make pictures NAMES="..." again)')
 
 
 if __name__ == "__main__":
