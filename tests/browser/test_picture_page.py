@@ -644,7 +644,7 @@ def test_projector_mode_folds_the_control_panel_and_thickens_the_picture(pages):
     page.page.mouse.click(640, 790)
     page.page.keyboard.press("p")
     assert wait_until(lambda: not session.lecture.display.style.projector, 10)
-    assert wait_until(lambda: page.canvas_box()["width"] < 0.6 * 1280, 10)
+    assert wait_until(lambda: page.canvas_box()["width"] < 0.6 * 1280, 10), page.canvas_box()
     assert PROJECTOR_TEXT_PERCENT >= 140
     assert page.errors == []
 

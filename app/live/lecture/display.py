@@ -121,7 +121,11 @@ def column_widths(style: Style) -> tuple[int, int]:
     left = PROJECTOR_LEGEND_WIDTH if style.projector else WINDOW_WIDTH
     # The control panel's rows hold more fixed padding per text (its buttons' 40 px): a
     # little more than in proportion (at 130 %, a button's "Mesh: ... (GLB)" was 2 px short).
-    return round(left * scale), round(MAIN_WIDTH * (1.0 + MAIN_GROWTH * (scale - 1.0)))
+    main = round(MAIN_WIDTH * (1.0 + MAIN_GROWTH * (scale - 1.0)))
+    if style.projector:  # opened from its strip beside the legend, at 1280 px the picture
+        # between them stays wider than half its height (else the page is laid out compact)
+        main = min(main, column_widths(Style(large_text=True))[1])
+    return round(left * scale), main
 
 
 def scene_look(style: Style) -> palette.Look:
