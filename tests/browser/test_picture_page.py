@@ -663,7 +663,8 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     page.click_button(view)
     # The layout is for the camera the browser reports: wait until the view has settled there
     # (under load the animation to it outlasts any fixed wait).
-    target, camera_handle = VIEWS[view], session.client.camera
+    # (the side and along-L views framed for this page's view: the view the lecture sent)
+    target, camera_handle = session.lecture.view(view), session.client.camera
     assert wait_until(
         lambda: (
             np.allclose(camera_handle.position, target.position, atol=1e-3)
