@@ -113,8 +113,9 @@ docs: $(VENV)/.installed-docs
 	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict
 
 # The pictures of the README and the guide, made again by Poinsot's own commands (headless
-# Chromium: `make chromium`). Minutes of software rendering; not part of CI.
-pictures: install chromium
+# Chromium: `make chromium`), the page's at every size and theme among them (assets/page/).
+# Minutes of software rendering; not part of CI.
+pictures: install-test chromium
 	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" sh docs/pictures.sh
 
 clean:

@@ -11,6 +11,6 @@ for scene in polhode-family dzhanibekov symmetric-top gyroscope-torque long-cyli
     explorer-1 geometric-phase tennis-racket; do
     poinsot screenshot --scene "$scene" --size 1280x800 --out "assets/scenes/$scene.png"
 done
-python tests/browser/touch_pictures.py     # assets/phone_390x844.png, assets/drag_1280x800.png
+python tests/browser/page_pictures.py      # assets/page/*.png (every size, both themes), assets/drag_1280x800.png
 poinsot report --quick --out build/pictures-report
 cp build/pictures-report/work_precision.png assets/report/work_precision.png

@@ -339,9 +339,11 @@ SLEEPS_ALLOWED: dict[tuple[str, str], str] = {
 SLEEPS_ALLOWED_IN = {
     "tests/browser/test_loopback.py",
     "tests/browser/test_picture_page.py",
-    # Not a test: the script that makes the README's phone and drag pictures; its pauses let
-    # the traces grow for the picture.
-    "tests/browser/touch_pictures.py",
+    "tests/browser/test_scenes_page.py",
+    "tests/browser/test_uploads_page.py",
+    # Not a test: the script that makes the README's pictures of the page (`make pictures`);
+    # its pauses let the traces grow for the picture.
+    "tests/browser/page_pictures.py",
 }
 
 

@@ -13,6 +13,9 @@ the component order.
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -104,6 +107,53 @@ def construction_points(
     the turning ellipsoid (radius 1), the plane's disc at ``plane_height`` and L's tip."""
     disc = _ring(n) * plane_radius + [0.0, 0.0, plane_height]
     return np.concatenate([sphere_points((0.0, 0.0, 0.0), 1.0, n), disc, [[0.0, 0.0, arrow_top]]])
+
+
+#: The smallest ring a framing keeps around L's axis [display units]: a herpolhode that is
+#: almost a point (a spin near an axis) still leaves the plane's middle in frame.
+MIN_TRACE_RING = 0.5
+
+
+def body_and_traces(
+    plane_height: float, herpolhode_radius: float, arrow_top: float, n: int = 48
+) -> np.ndarray:
+    """Points that bound what a student watches (display units): the sphere that holds the
+    turning ellipsoid (radius 1), the herpolhode's ring on the plane and L's tip; not the whole
+    plane's disc, whose rim would leave the body small in its view."""
+    radius = max(float(herpolhode_radius), MIN_TRACE_RING)
+    ring = _ring(n) * radius + [0.0, 0.0, plane_height]
+    return np.concatenate([sphere_points((0.0, 0.0, 0.0), 1.0, n), ring, [[0.0, 0.0, arrow_top]]])
+
+
+def framed_above(view: View, width: float, height: float, bar: float, points: np.ndarray) -> View:
+    """:func:`framed` for the part of a ``width`` x ``height`` picture above a ``bar`` at its
+    bottom (a phone's bottom sheet): framed for that part's field of view and shape, then moved
+    so that the part's middle is the picture's centre of what it frames."""
+    inner = math.tan(math.radians(view.fov_degrees) / 2.0) * (height - bar) / height
+    narrow = dataclasses.replace(view, fov_degrees=2.0 * math.degrees(math.atan(inner)))
+    chosen = framed(narrow, width / (height - bar), points)
+    chosen = dataclasses.replace(chosen, fov_degrees=view.fov_degrees)
+    return shifted_up(chosen, bar / 2.0, height)
+
+
+def shifted_up(view: View, pixels: float, height: float) -> View:
+    """``view`` moved down in its screen plane so that what it centred is drawn ``pixels``
+    higher in a picture ``height`` pixels high (a sheet covers the bottom of a phone's
+    screen: the picture is centred in the part above it)."""
+    forward = np.subtract(view.look_at, view.position)
+    distance = float(np.linalg.norm(forward))
+    forward /= distance
+    right = np.cross(forward, view.up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    world_per_px = 2.0 * distance * np.tan(np.radians(view.fov_degrees) / 2.0) / height
+    step = -up * pixels * world_per_px
+    return View(
+        position=triple(np.add(view.position, step)),
+        look_at=triple(np.add(view.look_at, step)),
+        up=view.up,
+        fov_degrees=view.fov_degrees,
+    )
 
 
 def sphere_points(centre: ArrayLike, radius: float, n: int = 48) -> np.ndarray:

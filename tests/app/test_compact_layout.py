@@ -9,10 +9,17 @@ import numpy as np
 import pytest
 from conftest import session_of, wait_until
 
-from poinsot.app.construction.cameras import construction_points, framed, sphere_points
+from poinsot.app.construction.cameras import (
+    body_and_traces,
+    construction_points,
+    framed,
+    framed_above,
+    sphere_points,
+)
 from poinsot.app.construction.view import DEFAULT_VIEW, View
 from poinsot.app.lessons import scene_by_name
-from poinsot.app.live.lecture.layout import compact_aspect, touch_agent
+from poinsot.app.live.lecture.display import Style, column_widths, scene_look
+from poinsot.app.live.lecture.layout import compact_aspect, header_text, touch_agent
 from poinsot.app.model.presets import DEFAULT_PRESET
 
 
@@ -43,6 +50,44 @@ def test_the_framed_view_holds_the_whole_construction_and_no_more(aspect: float)
     d0 = np.subtract(DEFAULT_VIEW.look_at, DEFAULT_VIEW.position)
     d1 = np.subtract(view.look_at, view.position)
     assert np.allclose(d0 / np.linalg.norm(d0), d1 / np.linalg.norm(d1))
+
+
+def test_a_phone_s_view_frames_the_body_and_its_traces_above_the_sheet() -> None:
+    """390 x 844, a 56 px bar at the bottom: the body, the herpolhode's ring and L's tip fill
+    the part above the bar (to its margin), and none of them is under it."""
+    width, height, bar = 390.0, 844.0, 56.0
+    points = body_and_traces(0.8, 1.2, 1.45)
+    view = framed_above(DEFAULT_VIEW, width, height, bar, points)
+    tx, ty = _projected(view, points)
+    half = math.tan(math.radians(view.fov_degrees) / 2.0)
+    # Screen pixels, y down, of every point.
+    x = width / 2 + tx / half * height / 2
+    y = height / 2 - ty / half * height / 2
+    assert x.min() >= 0 and x.max() <= width
+    assert y.min() >= 0 and y.max() <= height - bar
+    # Filling it: across, the tightest edge at the margin (the body no longer 50 px wide).
+    assert (x.max() - x.min()) >= 0.9 * width
+    # Not the plane's whole disc: its rim is out of frame.
+    rim = construction_points(0.8, 1.75, 1.45)
+    rx, _ = _projected(view, rim)
+    assert np.max(np.abs(rx)) > half * width / height
+
+
+def test_large_text_widens_the_columns_and_the_labels_with_it() -> None:
+    normal, large, projector = Style(), Style(large_text=True), Style(projector=True)
+    assert column_widths(normal) == (300, 320)
+    left, main = column_widths(large)
+    assert left >= 1.3 * 300 and main >= 1.3 * 320
+    assert scene_look(large).label_scale == pytest.approx(1.3 * scene_look(normal).label_scale)
+    # The projector's left column: a compact legend, no wider than large text's.
+    assert column_widths(projector)[0] <= 1.5 * 300
+
+
+def test_the_sheet_s_header_gives_t_and_the_regime_when_shown() -> None:
+    assert header_text(13.62, "polhode around the major axis") == (
+        "t = 13.6 · polhode around the major axis"
+    )
+    assert header_text(0.0, "") == "t = 0.0"
 
 
 def test_phones_and_tablets_and_odd_shapes_are_compact_desktops_are_not() -> None:
@@ -102,7 +147,9 @@ def test_a_phone_that_chooses_a_scene_sees_the_picture_drawn_beside_it(make_app,
     assert np.allclose(_direction(view), _direction(spec.view), atol=1e-9)
     for points in desktop:
         assert _in_frame(view, points, aspect), spec.beside
-    assert _in_frame(view, construction_points(1.0, 1.75, 1.45), aspect)
+    geometry = session.scene.geometry
+    h = geometry.plane_height
+    assert _in_frame(view, body_and_traces(h, geometry.herpolhode_radius, h + 0.65), aspect)
     framings = layout.framings
     probe.set_value(probe.widget("Preset")[0], DEFAULT_PRESET.label)
     assert wait_until(lambda: session.showcase is None and layout.framings > framings, 20)

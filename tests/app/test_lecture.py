@@ -175,4 +175,11 @@ def test_a_view_chosen_during_a_ride_along_frame_is_the_last_camera_sent(live, m
     stepping.join(10)
     chooser.join(10)
     assert controls.camera == "side"
-    assert np.allclose(sent[-1].position, space_view("side").position), sent[-1]
+    side = controls.view("side")  # the side view, framed for this browser's view
+    assert np.allclose(_direction(side), _direction(space_view("side")))
+    assert np.allclose(sent[-1].position, side.position), sent[-1]
+
+
+def _direction(view) -> np.ndarray:
+    d = np.subtract(view.look_at, view.position)
+    return d / np.linalg.norm(d)

@@ -142,7 +142,11 @@ def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_p
     page = open_page(poinsot_app.url, width=960, height=540, live_view=False)
     session = started_session(poinsot_app)
     lecture = lecture_of(session)
+    # A slide's size unless another is chosen, whatever the window.
+    assert page.dropdown_value("Picture size") == "1920×1080"
     # Current view: the 3D view's size, opaque on the dark theme's background.
+    page.choose("Picture size", "current view")
+    assert wait_until(lambda: lecture.size.value == "current view", 5)
     name, image = download_png(page)
     width, height = session.client.camera.image_width, session.client.camera.image_height
     view = page.canvas_box()  # the 3D view, between the docked columns

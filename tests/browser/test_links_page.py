@@ -67,11 +67,25 @@ def check_preset_link(page: BrowserPage, session) -> None:
     assert session.preset is preset and session.clock.paused
     # The server's copy of the camera is the browser's last report: a report of the first view,
     # sent before the browser took the link's, can come after it; the next one is the side view.
-    side = space_view("side").position
-    assert wait_until(lambda: np.allclose(session.client.camera.position, side), 20), (
+    # The side view's direction (framed for the browser's view: moved along it).
+    assert wait_until(lambda: looks_along(session.client.camera, space_view("side")), 20), (
         session.client.camera.position
     )
+    # Paused at t = 12, its plot is drawn all the same: the motion up to t, not one point.
+    plot = session.panel.motion.plot
+    assert plot is not None
+    assert wait_until(lambda: len(plot.data[0]) > 100 and abs(plot.data[0][-1] - 12.0) < 0.2, 20)
+    assert np.all(np.isfinite(np.asarray(plot.data[1:4])))
     assert page.page.get_by_role("button", name="Play", exact=True).count() == 1
+
+
+def looks_along(camera, view) -> bool:
+    """Does ``camera`` look in ``view``'s direction (wherever it stands along it)?"""
+    forward = np.subtract(camera.look_at, camera.position)
+    wanted = np.subtract(view.look_at, view.position)
+    return bool(
+        np.allclose(forward / np.linalg.norm(forward), wanted / np.linalg.norm(wanted), atol=1e-3)
+    )
 
 
 def check_scene_link(page: BrowserPage, session) -> None:

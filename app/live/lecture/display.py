@@ -4,8 +4,12 @@ view, and the labels' layout for the browser's camera.
 - Theme: dark or light (:func:`poinsot.app.construction.view.configure_theme`), and the scene's
 colours
   for it (:func:`poinsot.app.construction.palette.look`), which the legend follows.
-- Projector mode, one switch: large text, thick curves and lines, the high-contrast colours, and
-  both docked columns minimized to slim strips so that the 3D view takes the screen.
+- Large text: the page's root font size scaled (every panel size is in rem), both docked
+  columns widened in proportion (so that no line of the panels is cut and the sliders keep their
+  tracks), and the scene's labels scaled alike.
+- Projector mode, one switch: larger text still, thick curves and lines, the high-contrast
+  colours, the control panel minimized to a slim strip and the left column kept as a compact
+  legend and t (its caption, readouts and plot hidden) so that the 3D view takes the screen.
 - Two views: the body frame's picture beside the space frame's
   (:class:`~poinsot.app.construction.body_view.BodyView`), the camera stepped back to frame both and
   the left column folded (its strip opens it again) for a wide picture.
@@ -27,18 +31,27 @@ import numpy as np
 import viser
 
 from poinsot.app.construction import palette
-from poinsot.app.construction.body_view import OFFSET, BodyView
+from poinsot.app.construction.body_view import OFFSET, TITLE_HEIGHT, BodyView
+from poinsot.app.construction.cameras import body_and_traces, framed, sphere_points
 from poinsot.app.construction.construction import PoinsotScene
+from poinsot.app.construction.geometry import L_OVERSHOOT, Geometry
 from poinsot.app.construction.labels.layout import Camera, Steps, finish
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.sampled.frames import wxyz
 from poinsot.app.construction.view import DEFAULT_VIEW, View, configure_theme
-from poinsot.app.live.panel.motion_window import MotionWindow
+from poinsot.app.live.panel.motion_window import WINDOW_WIDTH, MotionWindow
 
 #: Root font size of the large-text mode: every panel size is in rem, so all text scales.
 LARGE_TEXT_PERCENT = 130
 #: ... and of the projector mode.
 PROJECTOR_TEXT_PERCENT = 150
+#: Width of viser's docked control panel at the normal text size [CSS px]: 20 em of 16 px
+#: (its theme's "medium" control width), which large text widens in proportion.
+MAIN_WIDTH = 320
+#: ... widened this much faster than the text grows.
+MAIN_GROWTH = 1.2
+#: Width of the projector's compact left column (legend and t) [CSS px at the normal size].
+PROJECTOR_LEGEND_WIDTH = 290
 #: Labels are laid out this often [Hz] while the browser's camera moves (the user turns the
 #: view: the boxes follow it), at most every LABEL_MIN_FRAMES frames; under a still camera,
 #: when only the time runs, LABEL_STILL_HZ and every LABEL_STILL_FRAMES frames at most (the boxes
@@ -67,25 +80,60 @@ class Style:
     two_views: bool = False
 
 
-def two_view_camera() -> View:
-    """From the front, stepped back to frame the space and the body pictures side by side."""
+def two_view_camera(geometry: Geometry | None = None, aspect: float | None = None) -> View:
+    """From the front, stepped back to frame the space and the body pictures side by side;
+    given the body's ``geometry`` and the picture's ``aspect``, moved along that direction to
+    frame both pictures of that body (each body and its traces, L, the titles) and no more."""
     target = np.array([0.5 * OFFSET[0], 0.0, 0.1])
     elevation = math.radians(TWO_VIEW_ELEVATION)
     step = TWO_VIEW_DISTANCE * np.array([0.0, -math.cos(elevation), math.sin(elevation)])
     x, y, z = (float(v) for v in target + step)
     tx, ty, tz = (float(v) for v in target)
-    return View(position=(x, y, z), look_at=(tx, ty, tz))
+    view = View(position=(x, y, z), look_at=(tx, ty, tz))
+    if geometry is None or aspect is None:
+        return view
+    top = geometry.plane_height + L_OVERSHOOT
+    space = body_and_traces(geometry.plane_height, geometry.herpolhode_radius, top)
+    body = sphere_points(OFFSET, max(1.0, top))  # L turns in the body frame
+    titles = np.array([[0.0, 0.0, TITLE_HEIGHT], np.add(OFFSET, (0.0, 0.0, TITLE_HEIGHT))])
+    return framed(view, aspect, np.concatenate([space, body, titles]))
+
+
+def text_percent(style: Style) -> int:
+    """The page's root font size [% of the browser's]."""
+    if style.projector:
+        return PROJECTOR_TEXT_PERCENT
+    return LARGE_TEXT_PERCENT if style.large_text else 100
 
 
 def text_css(style: Style) -> str:
     """A style element that scales the page's root font size (empty at the normal size)."""
-    if style.projector:
-        percent = PROJECTOR_TEXT_PERCENT
-    elif style.large_text:
-        percent = LARGE_TEXT_PERCENT
-    else:
+    percent = text_percent(style)
+    if percent == 100:
         return ""
     return f"<style>html {{ font-size: {percent}% !important; }}</style>"
+
+
+def column_widths(style: Style) -> tuple[int, int]:
+    """(left column, control panel) widths [CSS px] for ``style``'s text size: both in
+    proportion to the text, the projector's left column a compact legend."""
+    scale = text_percent(style) / 100.0
+    left = PROJECTOR_LEGEND_WIDTH if style.projector else WINDOW_WIDTH
+    # The control panel's rows hold more fixed padding per text (its buttons' 40 px): a
+    # little more than in proportion (at 130 %, a button's "Mesh: ... (GLB)" was 2 px short).
+    main = round(MAIN_WIDTH * (1.0 + MAIN_GROWTH * (scale - 1.0)))
+    if style.projector:  # opened from its strip beside the legend, at 1280 px the picture
+        # between them stays wider than half its height (else the page is laid out compact)
+        main = min(main, column_widths(Style(large_text=True))[1])
+    return round(left * scale), main
+
+
+def scene_look(style: Style) -> palette.Look:
+    """The scene's colours and label size for ``style``: the labels grow with large text."""
+    look = palette.look(style.dark, style.projector)
+    if style.large_text and not style.projector:
+        look = dataclasses.replace(look, label_scale=look.label_scale * LARGE_TEXT_PERCENT / 100)
+    return look
 
 
 def browser_camera(client: viser.ClientHandle) -> Camera | None:
@@ -161,6 +209,8 @@ class Display:
         wanted = self.wanted
         if wanted != self.style:
             self.apply(wanted)
+        elif wanted.projector:  # a plot added since (another preset) is hidden too
+            self._compact_legend(True)
         view = self.body_view
         scene = self.scene
         if view is not None and frame is not None and scene.geometry is not None:
@@ -236,14 +286,19 @@ class Display:
         )
         for html in (self.style_html, self.motion.style):  # whichever column is open
             html.content = text_css(style)
-        look = palette.look(style.dark, style.projector)
+        look = scene_look(style)
         self.scene.restyle(look)
         self.motion.legend.restyle(look)
         if self.body_view is not None:
             self.body_view.restyle(look)
-        # Projector: both columns folded; two views: the left one, for a wide picture.
+        if column_widths(style) != column_widths(old):
+            left, main = column_widths(style)
+            self.motion.window.set_width(left)
+            gui.main_panel.set_width(main)
+        self._compact_legend(style.projector)
+        # Projector: the control panel folded; two views: the left column, for a wide picture.
         if style.projector != old.projector or style.two_views != old.two_views:
-            folded = {"main": style.projector, "left": style.projector or style.two_views}
+            folded = {"main": style.projector, "left": style.two_views}
             for key, panel in (("main", gui.main_panel), ("left", self.motion.window)):
                 if folded[key]:
                     panel.minimize()
@@ -252,12 +307,27 @@ class Display:
         if style.two_views != old.two_views:
             self._two_views(style.two_views, look)
 
+    def _compact_legend(self, on: bool) -> None:
+        """The projector's left column: the legend and t only (the caption, the readouts and
+        the plot hidden), or all of it again."""
+        motion = self.motion
+        for handle in (motion.legend.caption, motion.readouts, motion.plot):
+            if handle is not None and handle.visible == on:
+                handle.visible = not on
+        motion.choice.show(not on and motion.plot is not None)
+
     def _two_views(self, on: bool, look: palette.Look) -> None:
         if on and self.body_view is None:
             self.body_view = BodyView(self.client.scene, look)
         elif not on and self.body_view is not None:
             self.body_view.remove()
             self.body_view = None
-        view = two_view_camera() if on else DEFAULT_VIEW
+        view = DEFAULT_VIEW
+        if on:  # the left column folds: the picture gains its width (less the strip)
+            camera = browser_camera(self.client)
+            aspect = None
+            if camera is not None:
+                aspect = (camera.width + column_widths(self.style)[0] - 40.0) / camera.height
+            view = two_view_camera(self.scene.geometry, aspect)
         with self.client.atomic():
             view.apply(self.client.camera)

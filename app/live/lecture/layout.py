@@ -41,12 +41,19 @@ from typing import Protocol
 import numpy as np
 import viser
 
-from poinsot.app.construction.cameras import construction_points, framed, sphere_points
+from poinsot.app.construction.cameras import (
+    body_and_traces,
+    framed,
+    framed_above,
+    sphere_points,
+)
 from poinsot.app.construction.construction import PoinsotScene
-from poinsot.app.construction.geometry import L_OVERSHOOT, PLANE_RADIUS
+from poinsot.app.construction.geometry import L_OVERSHOOT
 from poinsot.app.construction.view import DEFAULT_VIEW
 from poinsot.app.live.panel.motion_window import MotionWindow
+from poinsot.app.live.panel.readouts import REGIME_TEXT
 from poinsot.app.live.panel.showcase import LiveShowcase
+from poinsot.app.model.presets import Preset
 from poinsot.app.viser_private import fold_bottom_sheet
 
 #: A phone's or a tablet's browser says so in its User-Agent.
@@ -62,14 +69,40 @@ MIRROR_ORDER = -100.0
 #: at first and up to 60 % of the screen high: here it is held to :data:`SHEET_HEIGHT` (it
 #: scrolls), the mirrored legend at its top, in larger text than the docked column's.
 SHEET_HEIGHT = "34%"
+#: viser's sheet is 20 em wide, right-aligned (on a phone held upright, 266 of 390 px): here it
+#: takes the screen's width, its contents too. Its folded bar (3.5 em, :data:`SHEET_BAR_PX`)
+#: shows the panel's label, which a compact page makes t and the regime
+#: (:meth:`Layout.show_header`).
+SHEET = '.mantine-Paper-root[style*="bottom: 0px"]'
+#: A finger's target [CSS px]: buttons, menu rows, fields, sliders, check boxes and folder
+#: headers of a touch page are at least this tall (WCAG 2.5.5's 44 px).
+TOUCH_TARGET_PX = 44
 SHEET_CSS = f"""<style>
 .poinsot-mirror {{ display: none; }}
 @media (max-width: 36em) {{
   .poinsot-mirror {{ display: block; }}
   .poinsot-mirror .poinsot-legend {{ font-size: 0.95rem !important; }}
-  .mantine-Paper-root[style*="bottom: 0px"] {{ max-height: {SHEET_HEIGHT} !important; }}
+  {SHEET} {{ max-height: {SHEET_HEIGHT} !important; width: 100% !important; left: 0; }}
+  {SHEET} [style*="width: 20em"] {{ width: 100% !important; }}
 }}
 </style>"""
+#: Touch targets, on a compact page only (a desktop's mouse keeps viser's dense panel).
+TOUCH_CSS = f"""<style>
+.mantine-Button-root, [role="option"], .mantine-Input-input,
+.mantine-Slider-root, .mantine-Checkbox-root, .mantine-ActionIcon-root {{
+  min-height: {TOUCH_TARGET_PX}px !important;
+}}
+[role="option"] {{ display: flex; align-items: center; }}
+.mantine-Slider-root, .mantine-Checkbox-root {{ display: flex; align-items: center; }}
+.mantine-Checkbox-body {{ align-items: center; }}
+.mantine-ActionIcon-root {{ min-width: {TOUCH_TARGET_PX}px !important; }}
+</style>"""
+#: The bottom sheet's bar, folded [CSS px]: 3.5 em of 16 px.
+SHEET_BAR_PX = 56.0
+#: A page narrower than this [CSS px] shows the bottom sheet (viser's 36 em breakpoint).
+SHEET_BREAKPOINT_PX = 36 * 16
+#: The sheet's header is rewritten at most this often [Hz] (t in tenths).
+HEADER_HZ = 5.0
 
 
 def touch_agent(user_agent: str) -> bool:
@@ -85,8 +118,15 @@ def compact_aspect(width: float, height: float) -> bool:
 
 
 def mirrored(legend_html: str) -> str:
-    """The legend as the sheet shows it, with the sheet's style."""
-    return f'{SHEET_CSS}<div class="poinsot-mirror">{legend_html}</div>'
+    """The legend as the sheet shows it, with the sheet's style and the touch targets'."""
+    return f'{SHEET_CSS}{TOUCH_CSS}<div class="poinsot-mirror">{legend_html}</div>'
+
+
+def header_text(t: float, regime: str) -> str:
+    """The sheet's header (the panel's label on a compact page): t, and the regime if the
+    readouts show it (a challenge hides it until answered)."""
+    time = f"t = {t:.1f}"
+    return f"{time} · {regime}" if regime else time
 
 
 class LayoutSession(Protocol):
@@ -97,6 +137,8 @@ class LayoutSession(Protocol):
 
     @property
     def showcase(self) -> LiveShowcase | None: ...
+    @property
+    def preset(self) -> Preset: ...
 
     def post(self, action: Callable[[], None], key: Hashable | None = None) -> None: ...
 
@@ -113,6 +155,8 @@ class Layout:
         self.size: tuple[int, int] | None = None  # the canvas last reported [px]
         self.mirror: viser.GuiHtmlHandle | None = None
         self.framings = 0  # camera framings sent (tests)
+        self.header = ""  # the sheet's header last sent
+        self._header_at = -1.0  # monotonic time it was
         session.client.camera.on_update(self._on_camera)
         session.post(self._first)
 
@@ -171,15 +215,38 @@ class Layout:
             self.frame(self.size[0] / self.size[1])
 
     def frame(self, aspect: float) -> None:
-        """Frame the whole construction for a picture ``aspect`` wide, from the direction of the
-        scene's view, with the pictures a scene draws beside it."""
+        """Frame the body and its traces for a picture ``aspect`` wide, from the direction of
+        the scene's view, with the pictures a scene draws beside it; on a page with a bottom
+        sheet, in the part of the screen above its folded bar."""
         geometry = self.session.scene.geometry
         h = 1.0 if geometry is None else geometry.plane_height
-        top = h + L_OVERSHOOT  # L's tip
-        points = [construction_points(h, PLANE_RADIUS, top)]
+        ring = 0.0 if geometry is None else geometry.herpolhode_radius
+        points = [body_and_traces(h, ring, h + L_OVERSHOOT)]
         showcase = self.session.showcase
         view = DEFAULT_VIEW if showcase is None else showcase.spec.view
         if showcase is not None:
             points += [sphere_points(centre, radius) for centre, radius in showcase.spec.beside]
-        framed(view, aspect, np.concatenate(points)).apply(self.session.client.camera)
+        width, height = self.size if self.size is not None else (0, 0)
+        every = np.concatenate(points)
+        if 0 < width < SHEET_BREAKPOINT_PX and height > 4 * SHEET_BAR_PX:
+            chosen = framed_above(view, width, height, SHEET_BAR_PX, every)
+        else:
+            chosen = framed(view, aspect, every)
+        chosen.apply(self.session.client.camera)
         self.framings += 1
+
+    def show_header(self, now: float, t: float) -> None:
+        """(After a frame) a compact page's panel label, the sheet's header: t and the regime
+        (:func:`header_text`), at most :data:`HEADER_HZ` times a second, when it changed."""
+        if not self.compact or now - self._header_at < 1.0 / HEADER_HZ:
+            return
+        self._header_at = now
+        body = self.session.scene.body
+        readouts = self.motion.readouts
+        withheld = self.session.preset.withheld  # a challenge's: the regime tells the answer
+        shown = body is not None and readouts.visible and bool(readouts.content) and not withheld
+        regime = REGIME_TEXT.get(body.regime, "") if shown and body is not None else ""
+        text = header_text(t, regime)
+        if text != self.header:
+            self.header = text
+            self.session.client.gui.set_panel_label(text)

@@ -32,10 +32,13 @@ from poinsot.app.construction.cameras import (
     BODY_VIEW,
     CAMERA_NAMES,
     RIDE_ALONG,
+    body_and_traces,
+    framed,
     ride_along,
     space_view,
 )
 from poinsot.app.construction.construction import PoinsotScene
+from poinsot.app.construction.geometry import L_OVERSHOOT
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.view import View
 from poinsot.app.exports.glb import scene_glb
@@ -43,7 +46,7 @@ from poinsot.app.exports.run_csv import run_csv, run_span
 from poinsot.app.exports.screenshot import SIZE_CHOICES, THEME_BACKGROUND, filename, png_bytes
 from poinsot.app.live.classroom.links import link_of
 from poinsot.app.live.lecture.challenges import ChallengeControls, ChallengeSession, add_challenges
-from poinsot.app.live.lecture.display import LARGE_TEXT_PERCENT, Display
+from poinsot.app.live.lecture.display import LARGE_TEXT_PERCENT, Display, browser_camera
 from poinsot.app.live.lecture.neighbour import Neighbour, add_neighbour
 from poinsot.app.live.lecture.strobe_shot import strobe_render
 from poinsot.app.live.lecture.video_export import VideoExport, browser_view
@@ -60,8 +63,12 @@ from poinsot.physics import FreeRigidBody
 RENDER_TIMEOUT = 60.0
 __all__ = ["LARGE_TEXT_PERCENT", "LectureControls", "add_lecture_controls"]
 
+#: The picture size a screenshot has unless another is chosen: a slide's, whatever the window.
+DEFAULT_PICTURE_SIZE = "1920×1080"
 #: Order of the lecture folder in the panel (after the session's own groups).
 FOLDER_ORDER = 70.0
+#: The views framed for the browser's 3D view and the body shown (:meth:`LectureControls.view`).
+FRAMED_VIEWS = ("along-L", "side")
 #: Hotkeys of the camera views, in CAMERA_NAMES order.
 CAMERA_HOTKEYS: tuple[Literal["1", "2", "3", "4"], ...] = ("1", "2", "3", "4")
 
@@ -149,8 +156,8 @@ class LectureControls:
         self.size = gui.add_dropdown(
             "Picture size",
             tuple(SIZE_CHOICES),
-            initial_value=next(iter(SIZE_CHOICES)),
-            hint="Pixels of the PNG; 'current view' is the size of the 3D view.",
+            initial_value=DEFAULT_PICTURE_SIZE,
+            hint="Pixels of the PNG (a slide's unless chosen); 'current view': the 3D view's.",
         )
         self.transparent = gui.add_checkbox(
             "Transparent PNG", False, hint="Leave the background transparent (for slides)."
@@ -269,7 +276,20 @@ class LectureControls:
                 if frame is not None:
                     self._apply(ride_along(BODY_VIEW, frame.wxyz))
                 return
-            self._apply(space_view(name))
+            self._apply(self.view(name))
+
+    def view(self, name: str) -> View:
+        """The space-frame view ``name`` as this browser gets it: the side and along-L views
+        moved along their direction to frame the body and its traces in the browser's 3D view
+        (the default view is already framed so on a desktop's)."""
+        view = space_view(name)
+        geometry = self.session.scene.geometry
+        camera = browser_camera(self.client)
+        if name not in FRAMED_VIEWS or geometry is None or camera is None:
+            return view
+        h = geometry.plane_height
+        points = body_and_traces(h, geometry.herpolhode_radius, h + L_OVERSHOOT)
+        return framed(view, camera.width / camera.height, points)
 
     def _apply(self, view: View) -> None:
         with self.client.atomic():

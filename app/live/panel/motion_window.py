@@ -17,6 +17,7 @@ import viser
 import viser.uplot
 
 from poinsot.app.construction import palette
+from poinsot.app.construction.sampled.frames import wxyz
 from poinsot.app.live.panel import plots, readouts
 from poinsot.app.live.panel.legend import Legend
 from poinsot.app.live.panel.overlay import LEGEND, Measured, measured_series, merge
@@ -121,6 +122,22 @@ class MotionWindow:
 
     def clear_plot(self) -> None:
         self._t, self._omega, self._wxyz = [], [], []
+
+    def fill_history(self, t: float, omega: np.ndarray, step: float) -> bool:
+        """A page that opens paused at ``t`` (a link) would plot one sample: the window up to
+        ``t`` is evaluated from the body instead, one sample every ``step`` seconds, when the
+        plot holds fewer than two samples and the body is the one drawn (its ω at ``t`` is the
+        frame's ``omega``). True if the plot was filled."""
+        body = self.body
+        if self.plot is None or body is None or len(self._t) >= 2 or t < 2 * step:
+            return False
+        if not np.allclose(body.omega(t), omega, rtol=1e-6, atol=1e-9):
+            return False
+        times = t - step * np.arange(min(PLOT_SAMPLES, int(t / step)))[::-1]
+        self._t = [float(v) for v in times]
+        self._omega = list(np.asarray(body.omega(times), dtype=np.float64))
+        self._wxyz = list(wxyz(body.attitude(times)))
+        return True
 
     def record_plot(self, t: float, omega: np.ndarray, wxyz: np.ndarray | None = None) -> None:
         """Add a sample (the session does, at the plot's refresh rate, then sends)."""

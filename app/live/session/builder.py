@@ -181,6 +181,7 @@ def _frame_thread(
         tools=(lecture, tools.ghost),
         publish=tools.follow,
         laid_out=lambda: lecture.display.laid_out_now,
+        header=tools.layout.show_header,
     )
     loop = FrameLoop(
         f"poinsot-session-{client.client_id}",

@@ -41,7 +41,7 @@ class AfterFrame(Protocol):
 class FrameWork:
     """The session's frame-thread work (see the module's docstring). ``tools``: told of each
     frame drawn, in order; ``laid_out``: whether this frame carries a step of the labels'
-    layout (the plot then waits)."""
+    layout (the plot then waits); ``header(now, t)``: the page's header after a frame."""
 
     def __init__(
         self,
@@ -57,6 +57,7 @@ class FrameWork:
         tools: tuple[OnFrame, ...],
         publish: AfterFrame,
         laid_out: Callable[[], bool],
+        header: Callable[[float, float], None],
     ) -> None:
         self.client, self.pacer, self.queue, self.status = client, pacer, queue, status
         self.choice, self.build, self.source, self.clock = choice, choice.build, source, clock
@@ -64,6 +65,7 @@ class FrameWork:
         self.stats: SessionStats = choice.build.stats
         self.refresh, self.tools, self.publish = refresh, tools, publish
         self._laid_out = laid_out
+        self._header = header  # (now, t): the page's header (a phone's sheet: t, the regime)
 
     def work(self) -> None:
         """Before each frame: the queued actions, then a rebuild if they asked for one (none
@@ -95,6 +97,8 @@ class FrameWork:
         busy = self.scene.sent_traces or self._laid_out()  # a layout step
         frame, showcase = self.build.frame, self.choice.showcase
         self.refresh.after_frame(now, frame, self.clock.paused, busy)
+        if frame is not None:  # a phone's sheet: t and the regime in its header
+            self._header(now, frame.t)
         if showcase is not None and frame is not None:
             showcase.refresh(now, frame.t)  # its readouts and plots, at their rates
 

@@ -35,6 +35,8 @@ class Refresh:
         self._frames_since_plot += 1
         if now - self._last_plot >= 1.0 / PLOT_HZ and frame is not None:
             self._last_plot = now
+            if paused and motion.fill_history(frame.t, frame.omega, 1.0 / PLOT_HZ):
+                self._plot_unsent = True  # a paused link's plot: its history up to t
             motion.record_plot(frame.t, frame.omega, frame.wxyz)
             self._plot_unsent = True
         if self._plot_unsent and self._frames_since_plot >= PLOT_MIN_FRAMES and not busy:
