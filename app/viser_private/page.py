@@ -37,10 +37,16 @@ Private names:
       chevron ``svg.tabler-icon-chevron-up`` when open) takes no focus: it is given
       ``role=button``, ``tabindex=0``, ``aria-expanded`` (from its chevron) and Enter/Space.
     - The panel's header icons (``ActionIcon``: a Tabler ``svg`` inside a ``Tooltip``) and a
-      notification's close button have no text: named from their icon.
+      notification's close button have no text: named from their icon; the server's address
+      in the configuration view (``ServerControls.tsx``: a ``TextInput`` whose left section
+      is viser's logo, named by a tooltip only) is named "Server URL", the logo an empty
+      ``alt``; a scene node's "edit" popover target in its scene tree (a ``div`` with
+      ``aria-haspopup``, ``SceneTreeTable.tsx``) is made a named button.
     - Text marked "dimmed" (``--mantine-color-dimmed``: the controls' labels, the slider
       ticks) is at 4.0:1 on dark and 3.3:1 on light: a style sheet sets colours at 4.5:1 or
       more and the ticks a size a little larger.
+    - A panel that scrolls (Mantine's ``ScrollArea`` viewport) with nothing focusable in it
+      cannot be scrolled from the keyboard: it is given ``tabindex=0`` while it scrolls.
     - A button group (``components/ButtonGroup.tsx``) shows no choice: the server says which
       option is on (:func:`show_pressed`, through the group's GUI: ``handle._impl`` with its
       ``uuid`` and ``gui_api._websock_interface``), the script sets ``aria-pressed`` and a
@@ -190,7 +196,7 @@ _A11Y_CSS = """
 :root[data-mantine-color-scheme="dark"] { --mantine-color-dimmed: %(dark)s; }
 :root[data-mantine-color-scheme="light"] { --mantine-color-dimmed: %(light)s; }
 .mantine-Slider-markLabel { font-size: 0.7rem !important; color: var(--mantine-color-dimmed); }
-[data-poinsot-folder]:focus-visible {
+[data-poinsot-folder]:focus-visible, [data-poinsot-scroll]:focus-visible {
   outline: 2px solid var(--mantine-primary-color-filled); outline-offset: -2px;
 }
 button[aria-pressed="true"] {
@@ -262,17 +268,32 @@ _A11Y_JS = """
       set(header, "tabindex", live ? "0" : null);
       set(header, "aria-expanded", live ?
         String(icon.classList.contains("tabler-icon-chevron-up")) : null);
-      if (!header.poinsotKeys) {
-        header.poinsotKeys = true;
-        header.addEventListener("keydown", (event) => {
-          if (event.target !== header || !header.hasAttribute("role")) return;
-          if (event.key !== "Enter" && event.key !== " ") return;
-          event.preventDefault();
-          event.stopPropagation();
-          header.click();
-        });
-      }
+      pressable(header);
     }
+  };
+
+  // Enter and Space press a div made a button, as they press a <button>.
+  const pressable = (e) => {
+    if (e.poinsotKeys) return;
+    e.poinsotKeys = true;
+    e.addEventListener("keydown", (event) => {
+      if (event.target !== e || e.getAttribute("role") !== "button") return;
+      if (event.key !== "Enter" && event.key !== " ") return;
+      event.preventDefault();
+      event.stopPropagation();
+      e.click();
+    });
+  };
+
+  // viser's configuration view: a scene node's "edit" popover target (a div), its logo.
+  const configuration = () => {
+    for (const e of document.querySelectorAll("div[aria-haspopup]:not([role])")) {
+      set(e, "role", "button");
+      set(e, "tabindex", "0");
+      name(e, "Edit " + (e.parentElement.getAttribute("data-scene-node") || "properties"));
+      pressable(e);
+    }
+    for (const img of document.querySelectorAll("img:not([alt])")) set(img, "alt", "");
   };
 
   const iconButtons = () => {
@@ -286,7 +307,29 @@ _A11Y_JS = """
     }
   };
 
-  const apply = () => { nameRows(); folders(); iconButtons(); };
+  // The server's address in viser's configuration view (its tooltip says "Server URL").
+  const serverBox = () => {
+    for (const input of document.querySelectorAll(".mantine-TextInput-input")) {
+      const wrapper = input.closest(".mantine-Input-wrapper");
+      if (wrapper && wrapper.querySelector(".mantine-Input-section img")) name(input, "Server URL");
+    }
+  };
+
+  // A scrolled panel with nothing focusable in it: the keyboard scrolls it once it has focus.
+  const scrollers = () => {
+    const focusable = "a[href], button, input, select, textarea, [tabindex]:not([tabindex='-1'])";
+    for (const view of document.querySelectorAll(".mantine-ScrollArea-viewport")) {
+      const scrolls = view.scrollHeight > view.clientHeight || view.scrollWidth > view.clientWidth;
+      const needs = scrolls && !view.querySelector(focusable);
+      if (needs === view.hasAttribute("data-poinsot-scroll")) continue;
+      set(view, "tabindex", needs ? "0" : null);
+      set(view, "data-poinsot-scroll", needs ? "" : null);
+    }
+  };
+
+  const apply = () => {
+    nameRows(); folders(); iconButtons(); serverBox(); configuration(); scrollers();
+  };
   let queued = false;
   const later = () => {
     if (queued) return;

@@ -12,7 +12,7 @@ import pytest
 from conftest import BrowserPage, lecture_of, wait_until
 from test_touch_page import IPHONE, screen_point
 
-from poinsot.app.lessons import scene_by_name, scene_names
+from poinsot.app.lessons import scene_names
 
 pytestmark = pytest.mark.browser
 
@@ -66,15 +66,14 @@ def open_at(open_page, app, scene: str | None, size: str) -> tuple[BrowserPage, 
     assert wait_until(lambda: bool(set(app.sessions()) - known), 30), "no session"
     session = app.sessions()[max(set(app.sessions()) - known)]
     if scene is not None:
-        spec = scene_by_name(scene)
         assert wait_until(
             lambda: (
                 session.showcase is not None
-                and session.showcase.spec is spec
+                and session.showcase.spec.name == scene
                 and session.showcase.loaded
             ),
             30,
-        )
+        ), scene
     assert wait_until(lambda: page.page.evaluate("() => !!window.poinsotA11y"), 30)
     return page, session
 
@@ -146,10 +145,18 @@ def test_every_slider_and_number_box_has_a_name(app, open_page) -> None:
         assert wait_until(lambda: named.count() == 1 and box.count() == 1, 10), name  # noqa: B023
     for field in page.page.get_by_role("textbox", include_hidden=True).all():
         assert field.evaluate("e => !!(e.labels.length || e.getAttribute('aria-label'))")
-    # The two icon buttons of the panel's header are named.
+    # The two icon buttons of the panel's header are named; one opens viser's configuration
+    # view (the server's address, the scene tree), which axe finds clean too.
     header = page.page.locator(".mantine-ActionIcon-root")
     names = [b.get_attribute("aria-label") for b in header.all()]
     assert len(names) == 2 and all(names), names
+    page.click_button("Configuration & diagnostics")
+    server = page.page.get_by_role("textbox", name="Server URL", exact=True)
+    assert wait_until(server.is_visible, 10)
+    assert axe_failures(page) == {}
+    page.click_button("Return to the controls")
+    assert wait_until(page.page.get_by_role("slider", name="I₁").is_visible, 10)
+    assert page.errors == []
 
 
 def test_every_folder_opens_with_tab_and_enter(app, open_page) -> None:
@@ -175,18 +182,27 @@ def test_every_folder_opens_with_tab_and_enter(app, open_page) -> None:
     assert page.errors == []
 
 
+def pressed(page: BrowserPage, pair: tuple[str, str]) -> str | None:
+    """The one button of ``pair`` shown pressed (aria-pressed), or None if not exactly one."""
+    states = {name: page.page.evaluate(_PRESSED_JS, name) for name in pair}
+    on = [name for name, state in states.items() if state == ["true"]]
+    off = [name for name, state in states.items() if state == ["false"]]
+    return on[0] if len(on) == 1 and len(off) == 1 else None
+
+
 def test_the_paired_buttons_show_which_one_is_on(app, open_page) -> None:
+    """The default preset's: the default view, the major axis, + pole; a click on the other
+    button of each pair presses it (and the server's state follows)."""
     page, session = open_at(open_page, app, None, "laptop")
     open_every_folder(page)
-    for on, off in (("default", "side"), ("minor axis", "major axis"), ("+ pole", "− pole")):
-        assert wait_until(lambda: page.page.evaluate(_PRESSED_JS, on) == ["true"], 20), on  # noqa: B023
-        assert page.page.evaluate(_PRESSED_JS, off) == ["false"], off
+    pairs = (("default", "side"), ("major axis", "minor axis"), ("+ pole", "− pole"))
+    for on, off in pairs:
+        assert wait_until(lambda: pressed(page, (on, off)) == on, 20), on  # noqa: B023
         assert page.page.evaluate(_BACKGROUND_JS, on) != page.page.evaluate(_BACKGROUND_JS, off)
         page.click_button(off)
-        assert wait_until(lambda: page.page.evaluate(_PRESSED_JS, off) == ["true"], 20), off  # noqa: B023
-        assert page.page.evaluate(_PRESSED_JS, on) == ["false"], on
+        assert wait_until(lambda: pressed(page, (on, off)) == off, 20), off  # noqa: B023
     assert lecture_of(session).camera == "side"
-    assert session.params.side() == "major" and session.params.pole_sign == -1
+    assert session.params.side() == "minor" and session.params.pole_sign == -1
     assert page.errors == []
 
 
