@@ -44,7 +44,8 @@ Private names:
       ``aria-haspopup``, ``SceneTreeTable.tsx``) is made a named button.
     - Text marked "dimmed" (``--mantine-color-dimmed``: the controls' labels, the slider
       ticks) is at 4.0:1 on dark and 3.3:1 on light: a style sheet sets colours at 4.5:1 or
-      more and the ticks a size a little larger.
+      more and the ticks a size a little larger. A link in a text (a markdown's) is told
+      from the text by its colour alone, under 3:1 from it on dark: it is underlined.
     - A panel that scrolls (Mantine's ``ScrollArea`` viewport) with nothing focusable in it
       cannot be scrolled from the keyboard: it is given ``tabindex=0`` while it scrolls.
     - A button group (``components/ButtonGroup.tsx``) shows no choice: the server says which
@@ -196,6 +197,7 @@ _A11Y_CSS = """
 :root[data-mantine-color-scheme="dark"] { --mantine-color-dimmed: %(dark)s; }
 :root[data-mantine-color-scheme="light"] { --mantine-color-dimmed: %(light)s; }
 .mantine-Slider-markLabel { font-size: 0.7rem !important; color: var(--mantine-color-dimmed); }
+:where(p, li, td, th) a[href] { text-decoration: underline !important; }
 [data-poinsot-folder]:focus-visible, [data-poinsot-scroll]:focus-visible {
   outline: 2px solid var(--mantine-primary-color-filled); outline-offset: -2px;
 }

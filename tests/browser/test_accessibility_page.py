@@ -55,6 +55,48 @@ _PRESSED_JS = f"(name) => {_BUTTONS}.map((b) => b.getAttribute('aria-pressed'))"
 _BACKGROUND_JS = f"(name) => getComputedStyle({_BUTTONS}[0]).backgroundColor"
 
 
+#: Every visible text on the page whose contrast with the background under it (its ancestors'
+#: backgrounds composited) is below WCAG's 4.5:1 (3:1 for large text): "text: ratio". axe-core
+#: leaves the phone's bottom sheet undecided ("overlapped by another element"); this decides it.
+_LOW_CONTRAST_JS = r"""() => {
+  const rgba = (s) => {
+    const v = s.match(/[\d.]+/g).map(Number);
+    return v.length === 3 ? [...v, 1] : v;
+  };
+  const over = (top, under) =>
+    [0, 1, 2].map((i) => top[i] * top[3] + under[i] * (1 - top[3])).concat([1]);
+  const lin = (c) => (c /= 255) <= 0.03928 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4;
+  const lum = (c) => 0.2126 * lin(c[0]) + 0.7152 * lin(c[1]) + 0.0722 * lin(c[2]);
+  const background = (e) => {
+    const layers = [];
+    for (let a = e; a; a = a.parentElement) {
+      const c = rgba(getComputedStyle(a).backgroundColor);
+      if (c[3] > 0) layers.push(c);
+      if (c[3] >= 1) break;
+    }
+    return layers.reverse().reduce((under, top) => over(top, under), [255, 255, 255, 1]);
+  };
+  const low = [], seen = new Set();
+  const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+  for (let n = walker.nextNode(); n; n = walker.nextNode()) {
+    const e = n.parentElement;
+    if (!n.textContent.trim() || seen.has(e) || e.closest("svg, canvas, script, style")) continue;
+    seen.add(e);
+    const box = e.getBoundingClientRect();
+    const shown = e.checkVisibility({ opacityProperty: true, visibilityProperty: true });
+    if (!box.width || !box.height || !shown) continue;
+    const style = getComputedStyle(e);
+    const bg = background(e), fg = over(rgba(style.color), bg);
+    const ratio = (Math.max(lum(fg), lum(bg)) + 0.05) / (Math.min(lum(fg), lum(bg)) + 0.05);
+    const size = parseFloat(style.fontSize), bold = parseInt(style.fontWeight) >= 700;
+    const large = size >= 24 || (bold && size >= 18.66);
+    const text = n.textContent.trim().slice(0, 30);
+    if (ratio < (large ? 3 : 4.5)) low.push(`${text}: ${ratio.toFixed(2)}`);
+  }
+  return low;
+}"""
+
+
 def open_at(open_page, app, scene: str | None, size: str) -> tuple[BrowserPage, object]:
     """A page on ``app`` (``?scene=``), its session once its scene is loaded and the page's
     accessibility script runs."""
@@ -121,15 +163,18 @@ def test_axe_finds_no_serious_violation(app, open_page, scene, size) -> None:
     open_sheet(page, session)
     open_every_folder(page)
     found = {"dark": axe_failures(page)}
+    low = {"dark": page.page.evaluate(_LOW_CONTRAST_JS)}
     lecture_of(session).set_theme(dark=False)
     light = "() => document.documentElement.dataset.mantineColorScheme === 'light'"
     assert wait_until(lambda: page.page.evaluate(light), 30), "the light theme never came"
     found["light"] = axe_failures(page)
+    low["light"] = page.page.evaluate(_LOW_CONTRAST_JS)
     counts = {
         theme: {rule: len(nodes) for rule, nodes in rules.items()} for theme, rules in found.items()
     }
-    print(f"axe {scene or 'default'} {size}: {counts}")
+    print(f"axe {scene or 'default'} {size}: {counts}; below 4.5:1: {low}")
     assert found == {"dark": {}, "light": {}}, found
+    assert low == {"dark": [], "light": []}, low
     assert page.errors == []
 
 
