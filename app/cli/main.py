@@ -69,7 +69,7 @@ def serve(
     a landing port (:mod:`poinsot.app.live.workers`); with ``redis`` the lead is followed on
     every host linked to it (:mod:`poinsot.app.live.broker`). A port that cannot be served is
     one line and exit status 2."""
-    from poinsot.app.live.hardening.network import PortError, board, check_port, port_problem
+    from poinsot.app.live.hardening.network import PortError, check_port
     from poinsot.app.model.presets import preset_by_key
 
     code, url = _classroom_link(redis, lecturer_code)
