@@ -41,13 +41,15 @@ install-test: $(VENV)/.installed-test
 
 # Debian's Chromium drives the real-browser tests (playwright uses it via executable_path).
 # strace lets a test prove that the browser reaches nothing past loopback; nginx runs the
-# README's load-balancer set-up on loopback (tests/app/test_nginx.py).
+# README's load-balancer set-up on loopback (tests/app/test_nginx.py); redis-server links the
+# hosts of a classroom (tests/app/test_redis.py).
 chromium:
-	@if [ -x "$(CHROMIUM)" ] && command -v strace >/dev/null && [ -x /usr/sbin/nginx ]; then \
+	@if [ -x "$(CHROMIUM)" ] && command -v strace >/dev/null && [ -x /usr/sbin/nginx ] \
+		&& command -v redis-server >/dev/null; then \
 		echo "chromium: $(CHROMIUM)"; else \
-		echo "installing Debian's chromium, strace and nginx-light"; \
+		echo "installing Debian's chromium, strace, nginx-light and redis-server"; \
 		$(SUDO) apt-get update && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y \
-			chromium strace nginx-light; fi
+			chromium strace nginx-light redis-server; fi
 
 run: install
 	$(VENV)/bin/poinsot serve --host $(HOST) --port $(PORT)

@@ -104,6 +104,7 @@ BROWSER_GROUPS: dict[str, str] = {
         "test_strobe_picture",
         "test_uploads_page",
         "test_challenges_page",
+        "test_accessibility_page",
     )
 }
 BROWSER_LAST_GROUP = "browser-1"

@@ -22,7 +22,7 @@ import os
 import sys
 import time
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from poinsot.app.cli.arguments import (
     OneLineParser,
@@ -61,32 +61,59 @@ def serve(
     workers: int,
     allow_origin: list[str],
     link: str | None = None,
+    redis: str | None = None,
+    lecturer_code: str | None = None,
 ) -> int:
     """Serve until interrupted (Ctrl-C); each browser starts with ``start_scene`` if given,
     else with ``preset``. With ``workers`` > 1 the sessions run in that many processes behind
-    a landing port (:mod:`poinsot.app.live.workers`). A port that cannot be served is one
-    line and exit status 2."""
-    from poinsot.app.live.hardening.network import PortError, board, check_port, port_problem
+    a landing port (:mod:`poinsot.app.live.workers`); with ``redis`` the lead is followed on
+    every host linked to it (:mod:`poinsot.app.live.broker`). A port that cannot be served is
+    one line and exit status 2."""
+    from poinsot.app.live.hardening.network import PortError, check_port
     from poinsot.app.model.presets import preset_by_key
 
+    code, url = _classroom_link(redis, lecturer_code)
     try:
         check_port(host, port)
         if workers > 1:
             from poinsot.app.live.workers import serve_classroom
 
             scene = start_scene.name if start_scene else None
-            origins = tuple(allow_origin)
             return serve_classroom(
-                host, port, workers, preset, scene, origins=origins, link=link or ""
+                host,
+                port,
+                workers,
+                preset,
+                scene,
+                origins=tuple(allow_origin),
+                link=link or "",
+                code=code,
+                redis=url,
             )
     except PortError as exc:
         print(f"poinsot serve: {exc}", file=sys.stderr)
         return 2
+    return _serve_one(
+        host, port, preset_by_key(preset), start_scene, allow_origin, link, _hub(code, url)
+    )
+
+
+def _serve_one(
+    host: str,
+    port: int,
+    preset: Any,
+    start_scene: SceneSpec | None,
+    allow_origin: list[str],
+    link: str | None,
+    hub: Any,
+) -> int:
+    """``poinsot serve --workers 1``: one process, until Ctrl-C."""
+    from poinsot.app.live.hardening.network import board, port_problem
     from poinsot.app.live.server import PoinsotApp
     from poinsot.app.live.workers import lecturer_line
 
     app = PoinsotApp(
-        host, port, preset=preset_by_key(preset), scene=start_scene, allow_origins=allow_origin
+        host, port, preset=preset, scene=start_scene, allow_origins=allow_origin, follow=hub
     )
     if port and app.port != port:  # viser took the next free port: the board would be wrong
         app.stop()
@@ -102,6 +129,32 @@ def serve(
     finally:
         app.stop()
     return 0
+
+
+def _classroom_link(redis: str | None, lecturer_code: str | None) -> tuple[str, str]:
+    """The lecturer code ("": a new one) and the Redis URL to link to ("": none), with
+    ``--redis`` the code shared there and one line said (:mod:`poinsot.app.live.broker`)."""
+    lecturer_code = lecturer_code.strip().lower() if lecturer_code else None  # as it is typed
+    if not redis:
+        return lecturer_code or "", ""
+    from poinsot.app.live.broker import shared_code
+    from poinsot.app.live.classroom.follow import new_code
+
+    code, line, reachable = shared_code(redis, lecturer_code, new_code())
+    print(line, file=sys.stdout if reachable else sys.stderr, flush=True)
+    return code, redis if reachable else ""
+
+
+def _hub(code: str, url: str) -> Any:
+    """One process's follow hub, linked to the Redis at ``url`` if given."""
+    from poinsot.app.live.classroom.follow import FollowHub
+
+    hub = FollowHub(code or None)
+    if url:
+        from poinsot.app.live.broker import link_hub
+
+        link_hub(hub, url)
+    return hub
 
 
 def report(args: argparse.Namespace) -> int:
@@ -155,6 +208,7 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         help="also print the link to this state and its QR code, as 'preset=t_handle&t=12"
         "&view=side' (the guide's page Link parameters lists them)",
     )
+    _add_redis_arguments(parser)
     which = parser.add_mutually_exclusive_group()
     which.add_argument(
         "--preset",
@@ -171,6 +225,24 @@ def _add_serve_arguments(parser: argparse.ArgumentParser) -> None:
         help="or the scene each new browser starts with",
     )
     parser.set_defaults(func=serve)
+
+
+def _add_redis_arguments(parser: argparse.ArgumentParser) -> None:
+    """Following across hosts (:mod:`poinsot.app.live.broker`)."""
+    parser.add_argument(
+        "--redis",
+        default=None,
+        metavar="URL",
+        help="follow the lecturer across hosts through this Redis, as redis://HOST:6379/0 "
+        "(redis://:PASSWORD@HOST:6379/0 with requirepass; needs pip install 'poinsot[redis]')",
+    )
+    parser.add_argument(
+        "--lecturer-code",
+        default=None,
+        metavar="CODE",
+        help="the lecturer code (default: a new one, or with --redis the one the classroom's "
+        "first host set there)",
+    )
 
 
 def _add_report_arguments(parser: argparse.ArgumentParser) -> None:

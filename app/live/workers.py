@@ -68,6 +68,7 @@ def _worker_main(
     landing: int = 0,
     feed: Connection | None = None,
     code: str = "",
+    redis: str = "",
 ) -> None:
     """The worker: serve, report ``("ready", port)``, stop when told or when the parent's end
     of the pipe closes (then, whatever happens, the process ends within ``STOP_GRACE``).
@@ -80,7 +81,7 @@ def _worker_main(
     app = None
     status = 0
     try:
-        app = _serve(host, port, preset, scene, origins, landing, feed, code)
+        app = _serve(host, port, preset, scene, origins, landing, feed, code, redis)
         if port and app.port != port:  # viser moved on to the next free port: refuse
             conn.send(("error", port_problem(host, port)))
             return
@@ -110,6 +111,7 @@ def _serve(
     landing: int = 0,
     feed: Connection | None = None,
     code: str = "",
+    redis: str = "",
 ) -> PoinsotApp:
     from poinsot.app.lessons import scene_by_name
     from poinsot.app.live.relay import worker_hub
@@ -117,6 +119,11 @@ def _serve(
     from poinsot.app.model.presets import preset_by_key
 
     start_scene = scene_by_name(scene) if scene else None
+    hub = worker_hub(feed, code) if feed is not None else None
+    if hub is not None and redis:  # other hosts' workers too (:mod:`.broker`)
+        from poinsot.app.live.broker import link_hub
+
+        link_hub(hub, redis)
     return PoinsotApp(
         host,
         port,
@@ -124,7 +131,7 @@ def _serve(
         scene=start_scene,
         allow_origins=origins,
         landing_port=landing,
-        follow=worker_hub(feed, code) if feed is not None else None,
+        follow=hub,
     )
 
 
@@ -141,6 +148,7 @@ class Worker:
         origins: tuple[str, ...] = (),
         landing: int = 0,
         code: str = "",
+        redis: str = "",
     ):
         ctx = mp.get_context("spawn")
         self.index = index
@@ -160,6 +168,7 @@ class Worker:
                 landing,
                 child_feed,
                 code,
+                redis,
             ),
             name=f"poinsot-worker-{index}",
             daemon=True,
@@ -231,6 +240,7 @@ def start_workers(
     scene: str | None,
     origins: tuple[str, ...] = (),
     code: str = "",
+    redis: str = "",
 ) -> list[Worker]:
     """Start ``count`` workers (all at once) and wait until every one serves. With a fixed
     ``port`` they take the next ports, ``port + 1`` to ``port + count`` (one range to open in
@@ -241,7 +251,9 @@ def start_workers(
         check_port(host, p)
     # Links copied from a worker's page name the landing (a fixed port: known now).
     code = code or new_code()
-    workers = [Worker(i, host, p, preset, scene, origins, port, code) for i, p in enumerate(ports)]
+    workers = [
+        Worker(i, host, p, preset, scene, origins, port, code, redis) for i, p in enumerate(ports)
+    ]
     try:
         for worker in workers:
             worker.wait_ready(START_TIMEOUT)
@@ -289,6 +301,8 @@ def serve_classroom(
     announce: bool = True,
     origins: tuple[str, ...] = (),
     link: str = "",
+    code: str = "",
+    redis: str = "",
 ) -> int:
     """Run ``count`` workers behind a landing on ``host:port`` until Ctrl-C (exit status 0),
     or until every worker has ended (1). A port that cannot be served raises
@@ -299,8 +313,8 @@ def serve_classroom(
     from poinsot.app.live.relay import Relay
 
     check_port(host, port)
-    code = new_code()
-    workers = start_workers(count, host, port, preset, scene, origins, code)
+    code = code or new_code()
+    workers = start_workers(count, host, port, preset, scene, origins, code, redis)
     relay = Relay([w.feed for w in workers]).start()
     try:
         landing = LandingServer(host, port, Balancer(workers))

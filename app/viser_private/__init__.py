@@ -80,7 +80,8 @@ Inventory (section, private name, what it is used for):
 
 *Page* (:mod:`poinsot.app.viser_private.page`)
   - A client's websocket handshake (its ``Origin``), JavaScript run in its page, and its
-    localStorage: a page's own address, the clipboard, a narrow page's bottom sheet.
+    localStorage: a page's own address, the clipboard, a narrow page's bottom sheet; the
+    page's accessibility (names, keyboard, contrast, pressed buttons) inside viser's client.
 """
 
 from __future__ import annotations
@@ -110,8 +111,10 @@ from poinsot.app.viser_private.page import (
     copy_to_clipboard,
     fold_bottom_sheet,
     handshake_origin,
+    make_accessible,
     page_address,
     scroll_to_button,
+    show_pressed,
 )
 from poinsot.app.viser_private.scene import (
     CACHED_HINTS,
@@ -178,6 +181,8 @@ __all__ = [
     "copy_to_clipboard",
     "fold_bottom_sheet",
     "scroll_to_button",
+    "make_accessible",
+    "show_pressed",
     "handshake_origin",
     "hooked_server",
     "message_type",

@@ -152,7 +152,7 @@ def test_answer_then_play_in_a_session(poinsot_app, probe) -> None:
     # the next three, all answered "it stays, about e₁": the score counts the right ones
     for n in range(2, 5):
         probe.set_value(probe.widget(challenges.NEXT)[0], True)
-        assert wait_until(lambda: not folder.revealed, 10)
+        assert wait_until(lambda: not folder.revealed and folder.axis.value == CHOOSE, 10)
         probe.set_value(probe.widget("Flip or stay?")[0], OUTCOMES[1])
         probe.set_value(probe.widget("About which axis?")[0], AXES[0])
         assert wait_until(lambda: folder.axis.value == AXES[0], 10)

@@ -236,6 +236,24 @@ def test_a_widget_s_id_loop_and_uploads_are_where_viser_put_them(poinsot_app, pr
         assert callable(getattr(connection, name, None)), f"{name}: {WRITTEN_FOR}"
 
 
+def test_a_button_group_reaches_its_page_through_its_gui(poinsot_app, probe):
+    """:func:`show_pressed` sends a line of JavaScript through the group's own GUI
+    (``handle._impl.gui_api._websock_interface``): a client's group, to that client's page."""
+    session = session_of(poinsot_app)
+    group = session.panel.widgets.side
+    connection = session.client._websock_connection
+    assert group._impl.gui_api._websock_interface is connection, WRITTEN_FOR
+    sent: list = []
+    original = connection.queue_message
+    connection.queue_message = lambda message: (sent.append(message), original(message))
+    try:
+        viser_private.show_pressed(group, "major axis")
+    finally:
+        del connection.queue_message
+    assert [type(m) for m in sent] == [_messages.RunJavascriptMessage], WRITTEN_FOR
+    assert viser_private.handle_id(group) in sent[0].source and "major axis" in sent[0].source
+
+
 def test_slider_marks_are_a_sent_property_of_the_handle(make_app):
     """viser 1.1 sends a slider's ``_marks`` prop (``GuiSliderProps._marks``) when it is set."""
     server = make_app().server

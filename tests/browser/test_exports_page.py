@@ -20,7 +20,6 @@ from conftest import FRAME_CAP_JS, NO_MSAA_JS, lecture_of, session_of, wait_unti
 from PIL import Image
 
 from poinsot.app.construction.cameras import BODY_VIEW, ride_along
-from poinsot.app.construction.view import VIEWS
 from poinsot.app.exports import html as html_export
 from poinsot.app.exports.screenshot import THEME_BACKGROUND
 from poinsot.app.live.lecture.lecture import LARGE_TEXT_PERCENT
@@ -178,7 +177,7 @@ def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_p
 def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     page = open_page(poinsot_app.url, width=960, height=540)
     session = started_session(poinsot_app)
-    lecture_of(session)
+    lecture = lecture_of(session)
     camera = session.client.camera
     box = page.canvas_box()
     # Focus the 3D view (not a widget): its bottom centre, between the floating panels.
@@ -194,7 +193,7 @@ def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     assert wait_until(lambda: not session.clock.paused, 5), "space did not resume"
     # 2: view along L. The browser reports its camera back to the server.
     page.page.keyboard.press("2")
-    top = VIEWS["along-L"]
+    top = lecture.view("along-L")  # framed for this browser's view and the body shown
     # The browser reports its camera while the view animates: wait for the settled state
     # (position and look-at both at the view's), not the first report that passes one.
     assert wait_until(
@@ -229,7 +228,8 @@ def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     assert wait_until(riding, 10), ("the camera did not ride", camera.position, distance)
     # 3: side view ends the ride.
     page.page.keyboard.press("3")
-    assert wait_until(near(VIEWS["side"].position), 10), ("side view", camera.position)
+    side = lecture.view("side")  # framed likewise
+    assert wait_until(near(side.position), 10), ("side view", camera.position, side.position)
     # Theme: the page's background turns light.
     page.page.keyboard.press("Space")
     corner = (-3, int(box["x"] + box["width"] / 2))  # below the floating panels

@@ -36,6 +36,8 @@ def test_the_video_button_downloads_an_mp4_of_the_current_view(poinsot_app, open
     lecture = lecture_of(session)
     page.press_slider("Video length [s]", "Home")  # 1 s
     assert wait_until(lambda: lecture.video.seconds.value == 1, 5)
+    page.choose("Picture size", "current view")  # the slide's 1920x1080 unless chosen
+    assert wait_until(lambda: lecture.size.value == "current view", 10)
     t_before = session.clock.now()
     with page.page.expect_download(timeout=300_000) as info:
         page.click_button("Video")

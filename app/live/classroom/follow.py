@@ -81,7 +81,7 @@ class FollowHub:
 
     def __init__(self, code: str | None = None, uplink: Callable[[Message], None] | None = None):
         self.code = code or new_code()
-        self._uplink = uplink
+        self._uplinks = [] if uplink is None else [uplink]
         self._lock = threading.Lock()
         self._lead: Any = None  # this process's lead (a session's controls), if it has it
         self._lead_token = ""
@@ -141,10 +141,19 @@ class FollowHub:
         with self._lock:
             return self._lead_token if lead is self._lead else ""
 
+    def add_uplink(self, uplink: Callable[[Message], None]) -> None:
+        """Send this process's messages there too (another host's link, :mod:`..broker`)."""
+        self._uplinks.append(uplink)
+
+    def leads_here(self) -> bool:
+        """Whether the lead is a session of this process."""
+        with self._lock:
+            return self._lead is not None
+
     def _send(self, message: Message) -> None:
         self.deliver(message)
-        if self._uplink is not None:
-            self._uplink(message)
+        for uplink in self._uplinks:
+            uplink(message)
 
     # -- every message -------------------------------------------------------------------
     def deliver(self, message: Message) -> None:

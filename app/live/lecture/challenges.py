@@ -217,12 +217,15 @@ class ChallengeControls:
         """The challenge's body at t = 0 (every choice of a preset rebuilds it from t = 0):
         paused while the student predicts, playing once the answer is in (all posted)."""
         session = self.session
+        if not revealed:  # paused first: the body comes at t = 0 and stays there
+            session.post(lambda: self._run(paused=True))
         if revealed and challenge.kind == "lag" and challenge.twin_ratio == 10.0:
             session.choose_scene(scene_by_name("dzhanibekov"))  # its defaults: ε, ε/10
         else:
             number = self.index + 1
             session.choose_preset(body_preset(challenge, number, revealed))
-        session.post(lambda: self._run(not revealed))
+        if revealed:  # played from t = 0 once it is there
+            session.post(lambda: self._run(paused=False))
 
     def _scroll_to(self, button: str) -> None:
         """The page scrolls ``button`` into view, after the widgets the body's choice adds

@@ -52,7 +52,7 @@ from poinsot.app.live.lecture.strobe_shot import strobe_render
 from poinsot.app.live.lecture.video_export import VideoExport, browser_view
 from poinsot.app.live.panel.clock import SimClock
 from poinsot.app.live.panel.motion_window import MotionWindow
-from poinsot.app.live.panel.widgets import Sent, on_user, set_value
+from poinsot.app.live.panel.widgets import Pressed, Sent, on_user, set_value
 from poinsot.app.model.parameters import Parameters
 from poinsot.app.model.presets import Preset
 from poinsot.app.viser_private import copy_to_clipboard
@@ -125,6 +125,8 @@ class LectureControls:
         self.page = self.last_link = ""
         with self.client.gui.add_folder("Lecture: views and export", order=order):
             self._add_widgets(self.client.gui)
+        self._pressed = Pressed()  # the camera's button shown pressed
+        self._pressed.show(self.views, self.camera)
         self.display = Display(session.client, session.scene, motion, self.style)
         # Browser changes only, each value checked against its widget first (:func:`on_user`).
         for handle, callback in (
@@ -271,6 +273,7 @@ class LectureControls:
             raise ValueError(f"no camera view {name!r}")
         with self._camera_lock:
             self.camera = name
+            self._pressed.show(self.views, name)
             if name == RIDE_ALONG:
                 frame = self.session.frame
                 if frame is not None:

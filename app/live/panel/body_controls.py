@@ -17,7 +17,14 @@ from typing import Any
 
 import viser
 
-from poinsot.app.live.panel.widgets import Removable, Sent, Widgets, set_marks, set_value
+from poinsot.app.live.panel.widgets import (
+    Pressed,
+    Removable,
+    Sent,
+    Widgets,
+    set_marks,
+    set_value,
+)
 from poinsot.app.model.elements import Control
 from poinsot.app.model.parameters import INERTIA_RANGE, OMEGA_NORM_RANGE, Parameters
 
@@ -65,6 +72,9 @@ class BodyControls:
         #: the last one applied to the parameters asked for (:meth:`_edit`, :meth:`_mirror`).
         self._sent: dict[str, Sent] = {}
         self._applied: dict[str, tuple[Sent, int]] = {}
+        #: The pole's group (built with the side's), and the options shown pressed in both.
+        self._pole: viser.GuiButtonGroupHandle | None = None
+        self._pressed = Pressed()
 
     def build_inertia(self, params: Parameters) -> list[Removable]:
         sliders = []
@@ -125,7 +135,7 @@ class BodyControls:
             sign = 1 if handle.value == POLE_OPTIONS[0] else -1
             self.edit(lambda p: p.with_pole(sign))
 
-        self.widgets.side = side
+        self.widgets.side, self._pole = side, pole
         return [self.on_user(side, choose_side), self.on_user(pole, choose_pole)]
 
     def build_omega_norm(self, params: Parameters) -> list[Removable]:
@@ -160,6 +170,9 @@ class BodyControls:
             self._mirror("D", w.energy, float(params.D))
         if w.side is not None and w.side.visible != params.has_separatrix:
             w.side.visible = params.has_separatrix  # a symmetric body has no separatrix
+        if w.side is not None and self._pole is not None:
+            self._pressed.show(w.side, SIDE_OPTIONS[params.side() == "major"])
+            self._pressed.show(self._pole, POLE_OPTIONS[params.pole_sign < 0])
         if w.omega_norm is not None:
             lo, hi = slider_range(OMEGA_NORM_RANGE, (params.omega_norm,))
             if (w.omega_norm.min, w.omega_norm.max) != (lo, hi):

@@ -377,20 +377,26 @@ class ControlPanel:
         return lambda handle: self.actions.set_visible(element, bool(handle.value))
 
     # -- mirroring the session's state ---------------------------------------------------
-    def show_preset(self, preset: Preset, menu_count: int | None = None) -> None:
+    def show_preset(
+        self, preset: Preset, menu_count: int | None = None, edited: Preset | None = None
+    ) -> None:
         """Show ``preset`` as the scene's source; in the menu too, unless the browser has chosen
-        again since ``menu_count`` (``menu.count`` read when the change was asked for)."""
+        again since ``menu_count`` (``menu.count`` read when the change was asked for).
+        ``edited``: the preset a hand edit started from, whose source stays (the Scene folder
+        keeps its height: the sliders under it do not move)."""
         write_unless_newer(self.preset, preset.label, self.menu, menu_count, self._loop)
-        self.source.content = self._source_text(preset)
+        self.source.content = self._source_text(preset, edited)
         self.help.content = help_markdown(preset.key)
         self.show_hint(preset)
         self.motion.legend.show_caption(caption(preset))
 
     @staticmethod
-    def _source_text(preset: Preset) -> str:
-        """The choice's whole name (the menu's field may cut a long one), and its source."""
+    def _source_text(preset: Preset, edited: Preset | None = None) -> str:
+        """The choice's whole name (the menu's field may cut a long one), and its source (that
+        of the preset ``edited`` from, if any)."""
         name = shown_label(preset.label)
-        return f"**{name}**<br><small>_Source:_ {readouts.readable(preset.source)}</small>"
+        source = (edited or preset).source
+        return f"**{name}**<br><small>_Source:_ {readouts.readable(source)}</small>"
 
     def show_hint(self, preset: Preset) -> None:
         """Say that the ellipsoid can be clicked, where a click starts the motion there (not on

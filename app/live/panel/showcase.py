@@ -36,7 +36,14 @@ from poinsot.app.lessons.support.spec import (
     screen_table,
 )
 from poinsot.app.live.panel.motion_window import MotionWindow
-from poinsot.app.live.panel.widgets import Removable, Retirement, Sent, on_user, set_value
+from poinsot.app.live.panel.widgets import (
+    Pressed,
+    Removable,
+    Retirement,
+    Sent,
+    on_user,
+    set_value,
+)
 from poinsot.physics import FreeRigidBody
 
 #: Order of the scene's folder in the panel (after "Scene", before "Playback").
@@ -78,6 +85,9 @@ class LiveShowcase:
         self.plots: dict[str, viser.GuiUplotHandle] = {}
         self.sliders: dict[str, viser.GuiSliderHandle[float]] = {}
         self.part_boxes: dict[str, viser.GuiCheckboxHandle] = {}
+        #: The choices shown as buttons, and the option shown pressed in each.
+        self.groups: dict[str, tuple[Choice, viser.GuiButtonGroupHandle]] = {}
+        self._pressed = Pressed()
         self._shown: dict[str, int] = {}  # plot key -> samples last sent
         self._last_readout = self._last_plot = -1e9
         self._readout_text = ""
@@ -118,6 +128,7 @@ class LiveShowcase:
             return self._on_user(slider, self._slider_callback(control))
         if control.buttons:
             group = gui.add_button_group(control.label, control.options, order=order)
+            self.groups[control.key] = (control, group)
             return self._on_user(group, self._choice_callback(control))
         dropdown = gui.add_dropdown(
             control.label,
@@ -174,8 +185,16 @@ class LiveShowcase:
             self._show_model_values()
         self._shown.clear()
         self._last_readout = self._last_plot = -1e9
+        self._show_pressed()
         self.refresh(0.0, frame.t)
         return frame
+
+    def _show_pressed(self) -> None:
+        """Each choice shown as buttons shows the option of the settings just loaded."""
+        for key, (control, group) in self.groups.items():
+            on = [o for o in control.options if control.value(o) == self.desired.get(key)]
+            if on:
+                self._pressed.show(group, on[0])
 
     def _show_model_values(self) -> None:
         """After a start pointed at, a slider whose key the model has (the D the point gave)

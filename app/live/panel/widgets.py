@@ -312,6 +312,20 @@ def on_user(
     return handle
 
 
+class Pressed:
+    """The option shown pressed in each button group (``aria-pressed`` and the pressed style in
+    the page: :func:`~poinsot.app.viser_private.show_pressed`), sent only when it changes."""
+
+    def __init__(self) -> None:
+        self._shown: dict[str, str] = {}
+
+    def show(self, group: viser.GuiButtonGroupHandle, option: str) -> None:
+        key = viser_private.handle_id(group)
+        if self._shown.get(key) != option:
+            self._shown[key] = option
+            viser_private.show_pressed(group, option)
+
+
 # -- the widgets a session's state is mirrored into ---------------------------------------------
 @dataclasses.dataclass
 class Widgets:

@@ -40,6 +40,7 @@ from poinsot.app.live.session.rebuild import BodyBuild
 from poinsot.app.live.session.refresh import Refresh
 from poinsot.app.live.session.source import MotionSource
 from poinsot.app.model.presets import Preset
+from poinsot.app.viser_private import make_accessible
 
 #: The animation rate cap per client [frames per second].
 MAX_FPS = 60.0
@@ -104,6 +105,7 @@ def compose(
     body built; its frame thread made, not started."""
     spec = options.scene
     apply_theme(client)
+    make_accessible(client)  # names, keyboard, contrast: what viser's page leaves out
     options.view.apply(client.camera)
     stats = SessionStats()
     status = Status(stats, str(client.client_id))

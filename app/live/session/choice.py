@@ -100,11 +100,11 @@ class Choice:
             # Edited by hand: the scene becomes "Custom", which declares everything, and keeps
             # the controls the preset had (a toss's upload folder). Only additions happen here,
             # so the slider being dragged, or the ellipsoid clicked, stays in place.
-            controls = CUSTOM.controls | self.preset.controls
+            edited = self.preset
             self.preset = CUSTOM
             self.scene.declare(ALL_ELEMENTS)
-            self._declare(controls, CUSTOM.plots, CUSTOM.elements, new)
-            self.panel.show_preset(CUSTOM, menu_count)
+            self._declare(CUSTOM.controls | edited.controls, CUSTOM.plots, CUSTOM.elements, new)
+            self.panel.show_preset(CUSTOM, menu_count, edited)
 
     def _declare(
         self,
