@@ -36,7 +36,10 @@ def _markdown(probe: Probe, prefix: str) -> str:
     _, widgets = probe.snapshot()
     for widget in widgets.values():
         text = str(widget.props.get("_markdown", ""))
-        if widget.type == "GuiMarkdownMessage" and text.startswith(prefix):
+        # (a table may stand under a headline: its header row starts a line of the text)
+        if widget.type == "GuiMarkdownMessage" and (
+            text.startswith(prefix) or f"\n{prefix}" in text
+        ):
             return text
     return ""
 

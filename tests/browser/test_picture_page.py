@@ -618,7 +618,9 @@ def test_projector_mode_folds_the_control_panel_and_thickens_the_picture(pages):
     pause(page, session)
     page.drawn_after(session.client)
     before_box = page.canvas_box()
-    before = line_thickness(hue_mask(scene_only(session, 1280, 800), session.scene.look.herpolhode))
+    # Bright pixels only: the plane's grid has the trace's hue, darker, and is drawn thin.
+    herpolhode = session.scene.look.herpolhode
+    before = line_thickness(hue_mask(scene_only(session, 1280, 800), herpolhode, brightness=0.8))
     root = "parseFloat(getComputedStyle(document.documentElement).fontSize)"
     base_font = page.page.evaluate(root)
     page.set_checkbox("Projector mode", True)
@@ -639,7 +641,9 @@ def test_projector_mode_folds_the_control_panel_and_thickens_the_picture(pages):
 
     def thickened() -> bool:
         thicknesses.append(
-            line_thickness(hue_mask(scene_only(session, 1280, 800), look.herpolhode))
+            line_thickness(
+                hue_mask(scene_only(session, 1280, 800), look.herpolhode, brightness=0.8)
+            )
         )
         return thicknesses[-1] > 1.4 * before
 
