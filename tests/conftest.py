@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import io
+import math
 import os
 import re
 import shutil
@@ -294,6 +295,23 @@ def lecture_of(session: Session) -> LectureControls:
     lecture = getattr(session, "lecture", None)
     assert isinstance(lecture, LectureControls), "the session did not mount the lecture panel"
     return lecture
+
+
+def css_pixel(camera, box: dict, point: np.ndarray) -> tuple[float, float]:
+    """Where the browser's ``camera`` draws the world ``point``, in the page's CSS pixels,
+    for the 3D view's ``box`` (``x``, ``y``, ``width``, ``height``: a perspective camera whose
+    vertical field of view spans the box's height)."""
+    position = np.asarray(camera.position, float)
+    forward = np.asarray(camera.look_at, float) - position
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, np.asarray(camera.up_direction, float))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    q = np.asarray(point, float) - position
+    scale = box["height"] / 2.0 / math.tan(camera.fov / 2.0) / (q @ forward)
+    x = box["x"] + box["width"] / 2.0 + scale * (q @ right)
+    y = box["y"] + box["height"] / 2.0 - scale * (q @ up)
+    return float(x), float(y)
 
 
 def wait_until(predicate: Callable[[], bool], timeout: float = 10.0, poll: float = 0.02) -> bool:

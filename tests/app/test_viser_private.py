@@ -250,7 +250,9 @@ def test_a_button_group_reaches_its_page_through_its_gui(poinsot_app, probe):
         viser_private.show_pressed(group, "major axis")
     finally:
         del connection.queue_message
-    assert [type(m) for m in sent] == [_messages.RunJavascriptMessage], WRITTEN_FOR
+    # (the session's frame thread may queue its frames on the same connection meanwhile)
+    scripts = [m for m in sent if isinstance(m, _messages.RunJavascriptMessage)]
+    assert len(scripts) == 1, WRITTEN_FOR
     assert viser_private.handle_id(group) in sent[0].source and "major axis" in sent[0].source
 
 

@@ -7,6 +7,8 @@ from the page (app/viser_private/page.py, :func:`make_accessible`)."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from conftest import BrowserPage, lecture_of, wait_until
@@ -127,7 +129,8 @@ def open_sheet(page: BrowserPage, session) -> None:
     assert wait_until(lambda: page.page.evaluate("() => window.poinsotSheetFolded === true"), 30)
     slider = page.page.get_by_role("slider").first
     if not slider.is_visible():
-        page.page.get_by_text("Poinsot: free rigid body", exact=True).first.tap()
+        # its header: t and the regime (the page's layout writes them there)
+        page.page.get_by_text(re.compile(r"^t = \d+\.\d")).first.tap()
     assert wait_until(slider.is_visible, 15), "the sheet did not open"
 
 

@@ -10,11 +10,9 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
-from conftest import session_of, wait_until
+from conftest import css_pixel, session_of, wait_until
 
 from poinsot.app.lessons import scene_by_name
 from poinsot.app.live.lecture import challenges
@@ -26,20 +24,6 @@ pytestmark = pytest.mark.browser
 
 #: viser's drag binding on the ellipsoid answers a mouse press so.
 DRAG_BINDING = "Unable to preventDefault inside passive event listener invocation."
-
-
-def _pixel(camera, box, point: np.ndarray) -> tuple[float, float]:
-    """Where the browser's camera draws the world ``point``, in CSS pixels."""
-    position = np.asarray(camera.position, float)
-    forward = np.asarray(camera.look_at, float) - position
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, np.asarray(camera.up_direction, float))
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    q = point - position
-    scale = box["height"] / 2.0 / math.tan(camera.fov / 2.0) / (q @ forward)
-    x = box["x"] + box["width"] / 2.0 + scale * (q @ right)
-    return x, box["y"] + box["height"] / 2.0 - scale * (q @ up)
 
 
 def test_the_menu_shows_its_groups_and_a_scene_whole(make_app, open_page) -> None:
@@ -84,7 +68,7 @@ def test_a_click_beside_the_body_says_so_and_one_on_it_moves_no_slider(make_app,
     box = page.settled_canvas(session.client)
     camera = session.client.camera
     # beside the body: a corner of the view, far from the ellipsoid
-    corner = _pixel(camera, box, np.asarray(camera.look_at, float))
+    corner = css_pixel(camera, box, np.asarray(camera.look_at, float))
     page.page.mouse.click(corner[0] - 0.45 * box["width"] / 2, box["y"] + 0.1 * box["height"])
     missed = MISSED.format(verb="click").replace("**", "")
     page.page.get_by_text(missed).wait_for(timeout=20000)
@@ -93,7 +77,7 @@ def test_a_click_beside_the_body_says_so_and_one_on_it_moves_no_slider(make_app,
     before = slider.bounding_box()
     body = session.body
     assert body is not None and before is not None
-    x, y = _pixel(camera, page.settled_canvas(session.client), np.zeros(3))
+    x, y = css_pixel(camera, page.settled_canvas(session.client), np.zeros(3))
     page.page.mouse.click(x, y)
     assert wait_until(lambda: pointer.starts == 1 and session.body is not body, 20)
     assert wait_until(lambda: session.preset.key == "custom" and not session.build.dirty, 20)

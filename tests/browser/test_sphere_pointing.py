@@ -3,31 +3,14 @@ sets the start there, at |L| kept (app/live/pointing/sphere_pointer.py)."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
-from conftest import session_of, wait_until
+from conftest import css_pixel, session_of, wait_until
 
 from poinsot.app.lessons import scene_by_name
 
 #: viser's drag binding on a node answers a mouse press so (the same on the energy ellipsoid).
 DRAG_BINDING = "Unable to preventDefault inside passive event listener invocation."
-
-
-def _pixel(camera, box, point: np.ndarray) -> tuple[float, float]:
-    """Where the browser's camera draws the world ``point``, in CSS pixels."""
-    position = np.asarray(camera.position, float)
-    forward = np.asarray(camera.look_at, float) - position
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, np.asarray(camera.up_direction, float))
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    q = point - position
-    scale = box["height"] / 2.0 / math.tan(camera.fov / 2.0) / (q @ forward)
-    return box["x"] + box["width"] / 2.0 + scale * (q @ right), box["y"] + box[
-        "height"
-    ] / 2.0 - scale * (q @ up)
 
 
 def test_a_click_on_landaus_sphere_sets_the_start(make_app, open_page) -> None:
@@ -46,7 +29,7 @@ def test_a_click_on_landaus_sphere_sets_the_start(make_app, open_page) -> None:
     toward = np.asarray(camera.position, float) - centre
     toward /= np.linalg.norm(toward)
     aim = toward + np.array([0.5, 0.0, 0.35])
-    x, y = _pixel(camera, box, centre + picture.radius * aim / np.linalg.norm(aim))
+    x, y = css_pixel(camera, box, centre + picture.radius * aim / np.linalg.norm(aim))
     page.page.mouse.click(x, y)
     assert wait_until(lambda: session.body is not body, 15), "the click set no start"
     assert pointer.starts == 1

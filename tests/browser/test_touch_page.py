@@ -4,12 +4,11 @@ show, and no console error (app/live/lecture/layout.py, app/live/pointing/pointe
 
 from __future__ import annotations
 
-import math
 import re
 
 import numpy as np
 import pytest
-from conftest import BrowserPage, session_of, wait_until
+from conftest import BrowserPage, css_pixel, session_of, wait_until
 
 from poinsot.app.live.session.session import Session
 
@@ -62,21 +61,7 @@ def open_device(open_page, url: str, device: str) -> BrowserPage:
 def screen_point(session: Session, page: BrowserPage, point: np.ndarray) -> tuple[float, float]:
     """Where the browser's camera draws the world ``point``, in the page's CSS pixels (once the
     page's view has settled: see :meth:`BrowserPage.settled_canvas`)."""
-    box = page.settled_canvas(session.client)
-    camera = session.client.camera
-    position = np.asarray(camera.position, float)
-    forward = np.asarray(camera.look_at, float) - position
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, np.asarray(camera.up_direction, float))
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    q = point - position
-    depth = q @ forward
-    half = math.tan(camera.fov / 2.0)
-    scale = box["height"] / 2.0 / half
-    x = box["x"] + box["width"] / 2.0 + scale * (q @ right) / depth
-    y = box["y"] + box["height"] / 2.0 - scale * (q @ up) / depth
-    return float(x), float(y)
+    return css_pixel(session.client.camera, page.settled_canvas(session.client), point)
 
 
 def folded_share(device: str) -> float:
