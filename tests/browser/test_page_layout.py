@@ -150,6 +150,13 @@ def test_a_phone_s_sheet_is_full_width_with_t_and_the_regime_and_44_px_targets(
     page.page.locator(f"[id='{page.widget_id('Preset')}']").click()
     options = page.page.get_by_role("option")
     options.first.wait_for()
-    rows = [box["height"] for box in (o.bounding_box() for o in options.all()) if box]
-    assert len(rows) >= 5 and min(rows) >= TOUCH_TARGET_PX - 0.5, rows
+    rows: list[float] = []
+
+    def listed() -> bool:  # the menu's rows, once it has laid them out (it opens animated)
+        nonlocal rows
+        rows = [box["height"] for box in (o.bounding_box() for o in options.all()) if box]
+        return len(rows) >= 5
+
+    assert wait_until(listed, 10), rows
+    assert min(rows) >= TOUCH_TARGET_PX - 0.5, rows
     assert page.errors == []

@@ -92,7 +92,7 @@ class Pages:
         target, camera = VIEWS["default"], session.client.camera
         if not at_view(camera, target):
             page.set_live_view(True)  # the camera's move to the view is animated frame by frame
-            page.click_button("default")
+            session.lecture.set_camera("default")  # (the Views folder may be folded by now)
             assert wait_until(lambda: at_view(camera, target), 20)
         page.set_live_view(False)
 
@@ -659,7 +659,7 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     page.set_live_view(True)
     started(session, frames=40)
     pause(page, session)
-    page.click_button(view)
+    session.lecture.set_camera(view)  # (the views are pressed from the keyboard in another test)
     # The layout is for the camera the browser reports: wait until the view has settled there
     # (under load the animation to it outlasts any fixed wait).
     # (the side and along-L views framed for this page's view: the view the lecture sent)
