@@ -26,8 +26,8 @@ NOTABLE_FLOOR = 1e-6
 
 
 def orders_section(results: list[CaseResult]) -> list[str]:
-    """The observed orders; blank where the error does not converge, flagged where the fit
-    reaches below the case's conditioning floor."""
+    """The observed orders, fitted above each case's conditioning floor; blank where the
+    error does not converge."""
     low, high = ORDER_FIT_RANGE
     lines = [
         "## Observed orders",
@@ -37,9 +37,9 @@ def orders_section(results: list[CaseResult]) -> list[str]:
         + ", ".join(f"{i.name} {i.order}" for i in INTEGRATORS.values())
         + ". Blank: fewer than two runs in that range (the case is too hard or too easy), or "
         "errors that do not decrease as the cost grows (listed below the table: they sit at a "
-        "floor, and a fit through them would give an order near zero or negative). †: the fit "
-        "includes errors below the case's conditioning floor κ u (see Conditioning), where "
-        "amplified rounding competes with the method's truncation error.",
+        "floor, and a fit through them would give an order near zero or negative). Errors below "
+        "the case's conditioning floor κ u (see Conditioning) are left out of the fit: there "
+        "amplified rounding, not the method's truncation, sets the error.",
         "",
         "| case | κ u | " + " | ".join(INTEGRATORS) + " |",
         "|---|---|" + "---|" * len(INTEGRATORS),
@@ -48,10 +48,10 @@ def orders_section(results: list[CaseResult]) -> list[str]:
     for r in results:
         cells = []
         for name in INTEGRATORS:
-            fitted = order_fit_runs([run for run in r.runs if run.method == name])
+            mine = [run for run in r.runs if run.method == name]
+            fitted = order_fit_runs(mine, r.conditioning.floor)
             p = observed_order(fitted)
-            below = any(run.omega_error < r.conditioning.floor for run in fitted)
-            cells.append(f"{p:.2f}{'†' if below else ''}" if math.isfinite(p) else "")
+            cells.append(f"{p:.2f}" if math.isfinite(p) else "")
             if not math.isfinite(p) and len({run.cost for run in fitted}) >= 2:
                 errors = ", ".join(exp(run.omega_error) for run in fitted)
                 stalled.append(

@@ -109,10 +109,12 @@ def _exact_against_integrators(
     )
 
 
-def order_fit_runs(runs: list[IntegratorRun]) -> list[IntegratorRun]:
-    """The runs an order is fitted over: omega error inside ORDER_FIT_RANGE, by cost."""
+def order_fit_runs(runs: list[IntegratorRun], floor: float = 0.0) -> list[IntegratorRun]:
+    """The runs an order is fitted over, by cost: omega error inside ORDER_FIT_RANGE and above
+    ``floor`` (the case's conditioning floor κ u: below it amplified rounding, not the method's
+    truncation, sets the error, and differs from one machine's rounding to another's)."""
     low, high = ORDER_FIT_RANGE
-    inside = [r for r in runs if low < r.omega_error < high and r.cost > 0]
+    inside = [r for r in runs if max(low, floor) < r.omega_error < high and r.cost > 0]
     return sorted(inside, key=lambda r: r.cost)
 
 

@@ -58,14 +58,28 @@ def _set(probe: Probe, label: str, value: object = True) -> None:
 
 
 def _ready(probe: Probe) -> Probe:
+    """The probe, once the class folder answers: its widgets are sent before their callbacks
+    are bound (a click in between was lost, once in 23 runs beside four busy loops); the
+    lecture's keys line is made after, by the tools the session mounts last."""
     assert probe.wait_for(lambda p: p.has_widget("Explore from here"), 60), "no panel"
+    assert probe.wait_for(lambda p: _says(p, "Keys: **space**"), 60), "no lecture tools"
     return probe
 
 
 def _lead(probe: Probe, code: str) -> None:
     _set(probe, "Lecturer code", code)
     _set(probe, "Lead this class")
-    assert probe.wait_for(lambda p: _says(p, "You lead this class"), 30)
+    assert probe.wait_for(lambda p: _says(p, "You lead this class"), 30), _texts(probe)
+
+
+def _texts(probe: Probe) -> list[str]:
+    """Every markdown text the probe shows (what a failed wait saw)."""
+    _, widgets = probe.snapshot()
+    return [
+        str(w.props.get("_markdown", ""))[:120]
+        for w in widgets.values()
+        if w.props.get("_markdown")
+    ]
 
 
 def _follow(probe: Probe) -> None:
