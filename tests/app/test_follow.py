@@ -312,11 +312,18 @@ def test_followers_share_one_build_of_the_lead_s_scene(poinsot_app, make_probe):
     _set(lead, "Preset", POLHODES)
     shared_once(1.6, builds)
     builds = scenes.builds
-    _, widgets = lead.snapshot()  # the scene's D slider (the preset's, hidden, came before it)
-    lead.set_value([u for u, w in widgets.items() if w.props.get("label") == D][-1], 2.2)
+    # The scene's D slider (the preset's, hidden, came before it), once the lead's page has it.
+    assert lead.wait_for(lambda p: len(_uuids(p, D)) == 2, 30), _uuids(lead, D)
+    lead.set_value(_uuids(lead, D)[-1], 2.2)
     shared_once(2.2, builds)
     assert all(f.stats.errors == 0 for f in followers), [f.stats.last_error for f in followers]
     assert not any(_says(p, "could not be shown") for p in probes)
+
+
+def _uuids(probe: Probe, label: str) -> list[str]:
+    """The probe's widgets labelled ``label``, oldest first."""
+    _, widgets = probe.snapshot()
+    return [u for u, w in widgets.items() if w.props.get("label") == label]
 
 
 def _run(coroutine) -> None:
