@@ -108,6 +108,7 @@ from poinsot.app.viser_private.messages import (
 )
 from poinsot.app.viser_private.page import (
     LOCAL_STORAGE_PREFIX,
+    RAIL_TITLE,
     copy_to_clipboard,
     fold_bottom_sheet,
     handshake_origin,
@@ -182,6 +183,7 @@ __all__ = [
     "fold_bottom_sheet",
     "scroll_to_button",
     "make_accessible",
+    "RAIL_TITLE",
     "show_pressed",
     "handshake_origin",
     "hooked_server",

@@ -193,6 +193,10 @@ ICON_NAMES = {
     "x": "Close",
 }
 
+#: A folded column's title, written down its rail (a tablet's page, the projector's control
+#: panel): the client's ``FloatingPanel`` cuts it at ``max-height: 14em``, which on a tablet held
+#: upright cut the label "t = 5.8 · polhode around the major axis" after "around the".
+RAIL_TITLE = '[style*="writing-mode: vertical-rl"]'
 _A11Y_CSS = """
 :root[data-mantine-color-scheme="dark"] { --mantine-color-dimmed: %(dark)s; }
 :root[data-mantine-color-scheme="light"] { --mantine-color-dimmed: %(light)s; }
@@ -207,6 +211,7 @@ button[aria-pressed="true"] {
   font-weight: 700;
 }
 button[aria-pressed="true"]::before { content: "\\2713\\00a0"; }
+%(rail)s { max-height: none !important; }
 """
 
 _A11Y_JS = """
@@ -361,7 +366,7 @@ def make_accessible(client: viser.ClientHandle) -> None:
     text at 4.5:1 contrast, the pressed option of a button group shown (:func:`show_pressed`),
     no console error on a press on a draggable node. Once per page; it follows the panel as
     it changes."""
-    css = _A11Y_CSS % {"dark": DIMMED_DARK, "light": DIMMED_LIGHT}
+    css = _A11Y_CSS % {"dark": DIMMED_DARK, "light": DIMMED_LIGHT, "rail": RAIL_TITLE}
     source = _A11Y_JS % {"icons": json.dumps(ICON_NAMES), "css": json.dumps(css)}
     _run_javascript(client, source)
     client.flush()

@@ -41,6 +41,7 @@ from conftest import (  # noqa: E402
     BrowserPage,
     wait_until,
 )
+from test_picture_page import lay_out_on_the_frame_thread  # noqa: E402
 from test_touch_page import ANDROID_TABLET, IPHONE, screen_point  # noqa: E402
 
 from poinsot.app.exports.chromium import CHROMIUM_ARGS  # noqa: E402
@@ -52,6 +53,9 @@ ASSETS = Path(__file__).resolve().parents[2] / "assets"
 PAGES = ASSETS / "page"
 #: Seconds of motion before a picture: the traces grow a little.
 TRACE_SECONDS = 4.0
+#: Seconds for the labels laid out for the paused picture to reach the page and be drawn (a
+#: paused page draws a frame a second).
+LABEL_SECONDS = 2.0
 
 
 #: name: (width, height, touch User-Agent or "" for a desktop, what to switch on)
@@ -121,6 +125,8 @@ def shot(browser, name: str, dark: bool) -> None:
         time.sleep(TRACE_SECONDS)
         session.toggle_pause()  # a paused page draws a frame a second: a busy machine's
         assert wait_until(lambda: session.clock.paused, 60)  # screenshot comes sooner
+        lay_out_on_the_frame_thread(session)  # the labels, for the style and the paused time
+        time.sleep(LABEL_SECONDS)  # (a light projector picture was once taken without them)
         theme = "dark" if dark else "light"
         save(page.page.screenshot(), PAGES / f"{theme}_{name}.png")
     finally:

@@ -11,6 +11,7 @@ import pytest
 from conftest import BrowserPage, css_pixel, session_of, wait_until
 
 from poinsot.app.live.session.session import Session
+from poinsot.app.viser_private import RAIL_TITLE
 
 IPHONE = (
     "Mozilla/5.0 (iPhone; CPU iPhone OS 17_0 like Mac OS X) AppleWebKit/605.1.15 "
@@ -49,6 +50,11 @@ _LEGEND_SHOWN_JS = """(name) => {
   const top = document.elementFromPoint(r.left + r.width / 2, r.top + r.height / 2);
   return top !== null && (e.contains(top) || top.contains(e));
 }"""
+
+
+#: Every title written down a folded column's rail: [its text, whether it is cut].
+_RAIL_TITLES_JS = f"""() => [...document.querySelectorAll('{RAIL_TITLE}')]
+  .map((e) => [e.textContent, e.scrollHeight > e.clientHeight + 1])"""
 
 
 def open_device(open_page, url: str, device: str) -> BrowserPage:
@@ -91,6 +97,11 @@ def test_the_page_on_a_phone_and_a_tablet(poinsot_app, open_page, device) -> Non
     )
     # The page opens folded (on a phone held upright, viser's bottom sheet down to its bar).
     assert wait_until(lambda: not page.page.evaluate(_LEGEND_SHOWN_JS, LEGEND_ENTRY), 10)
+    if device == "tablet-portrait":  # its column folded to a rail: the label whole down it
+        titles = lambda: page.page.evaluate(_RAIL_TITLES_JS)  # noqa: E731
+        assert wait_until(lambda: any("·" in text for text, _ in titles()), 20), titles()
+        for text, cut in titles():
+            assert not cut, text
     assert wait_until(lambda: page.page.evaluate(_SCENE_SHARE_JS) >= folded_share(device), 10)
     # One tap opens the sheet, and the legend is on screen; one tap closes it.
     sheet_toggle(page, device, opening=True).tap()
