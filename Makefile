@@ -116,8 +116,8 @@ docs: $(VENV)/.installed-docs
 
 # The pictures of the README and the guide, made again by Poinsot's own commands (headless
 # Chromium: `make chromium`), the page's at every size and theme among them (assets/page/).
-# Minutes of software rendering; not part of CI.
-pictures: install-test chromium
+# Minutes of software rendering; not part of CI. The guide is built first: the pages link to it.
+pictures: install-test chromium docs
 	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" sh docs/pictures.sh
 
 clean:
