@@ -619,6 +619,13 @@ def test_projector_mode_folds_the_control_panel_and_thickens_the_picture(pages):
     page.drawn_after(session.client)
     before_box = page.canvas_box()
     thin = session.scene.look.trace_width
+    # The herpolhode alone is measured: the plane's grid and the compact legend's swatch share
+    # its hue (darker, thinner), which made a measure of the whole page read 2 px either way.
+    others = [e for e in Element if e is not Element.HERPOLHODE]
+    for element in others:
+        session.set_visible(element, False)
+    assert wait_until(lambda: not any(session.scene.is_visible(e) for e in others), 10)
+    thin_px = trace_thickness(page, session)
     root = "parseFloat(getComputedStyle(document.documentElement).fontSize)"
     base_font = page.page.evaluate(root)
     page.set_checkbox("Projector mode", True)
@@ -630,10 +637,13 @@ def test_projector_mode_folds_the_control_panel_and_thickens_the_picture(pages):
     # The control panel folds to its strip; the left column stays, a compact legend and t.
     wider = before_box["width"] + 100
     assert wait_until(lambda: page.canvas_box()["width"] > wider, 10), page.canvas_box()
-    # The lines are drawn twice as thick (3.5 to 7 px): the look the scene was restyled with.
-    # (Their pixels are no longer compared: with the Okabe-Ito palette the plane's grid and the
-    # compact legend's swatch share the trace's hue, and the measure read 2 px either way.)
+    # The lines are drawn twice as thick (3.5 to 7 px), and the picture shows it: the trace's
+    # pixels of its own colour (its anti-aliased edge left out) are thicker by more than 1.4.
     assert look.trace_width >= 1.9 * thin, (thin, look.trace_width)
+    thick_px = trace_thickness(page, session)
+    assert thick_px >= 1.4 * thin_px, (thin_px, thick_px)
+    for element in others:
+        session.set_visible(element, True)
     assert before_box["width"] < 0.6 * 1280
     # A column opened from its strip shows its text large.
     session.client.gui.main_panel.expand()
@@ -708,6 +718,17 @@ def test_labels_stand_apart_and_off_the_contact_point(pages, view):
     labels = np.isin(patches, 1 + np.flatnonzero(sizes > 40))
     assert not labels[cy - 4 : cy + 5, cx - 4 : cx + 5].any(), "a label covers the contact point"
     assert page.errors == []
+
+
+def trace_thickness(page, session) -> float:
+    """The herpolhode's mean thickness in the 3D view, once the page has drawn what was sent
+    [pixels]: the pixels of its colour, in patches of a trace's size."""
+    rgb, box = drawn_screenshot(page, session.client), page.canvas_box()
+    x, y = int(box["x"]), int(box["y"])
+    view = rgb[y : y + int(box["height"]), x : x + int(box["width"])]
+    mask = in_patches(near(view, session.scene.look.herpolhode), 200)
+    assert mask.sum() > 500, f"only {mask.sum()} pixels of the herpolhode"
+    return line_thickness(mask)
 
 
 def drawn_screenshot(page, client) -> np.ndarray:
