@@ -1,9 +1,9 @@
 """The traced curves as scene elements: the polhode (on the body) and the herpolhode (on the
 invariable plane), each a :class:`~poinsot.app.construction.trail.Trail` and its label.
 
-:class:`~poinsot.app.construction.construction.PoinsotScene` sends their increments each frame
-through
-:attr:`Trace.trail`; this module fits their labels to the body and lays them out.
+:class:`~poinsot.app.construction.construction.PoinsotScene` sends their increments each
+frame through :attr:`Trace.trail`; this module fits their labels to the body and lays them
+out.
 """
 
 from __future__ import annotations

@@ -3,14 +3,13 @@
 Two ways in, both from the bytes of an upload (never from a path a browser names):
 
 - a recording (phyphox export ``.zip`` or a ``.csv`` of ``t, ωx, ωy, ωz``):
-  :func:`fit_recording` reads it (:mod:`poinsot.app.model.recordings`), finds the free flights, fits
-  each (:func:`poinsot.app.model.fitting.fit_segments`) and keeps the best; :func:`toss_preset`
-  makes the fitted body a preset under the label of :data:`~poinsot.app.model.presets.FITTED_TOSS`,
-  and
-  :func:`toss_markdown` is its readout;
-- a mesh (STL, OBJ, PLY, GLB, or one of the bundled bodies): :mod:`poinsot.app.model.bodies`
-measures
-  it, :func:`mesh_preset` makes it a preset whose solid is the mesh itself.
+  :func:`fit_recording` reads it (:mod:`poinsot.app.model.recordings`), finds the free
+  flights, fits each (:func:`poinsot.app.model.fitting.fit_segments`) and keeps the best;
+  :func:`toss_preset` makes the fitted body a preset under the label of
+  :data:`~poinsot.app.model.presets.FITTED_TOSS`, and :func:`toss_markdown` is its readout;
+- a mesh (STL, OBJ, PLY, GLB, or one of the bundled bodies):
+  :mod:`poinsot.app.model.bodies` measures it, :func:`mesh_preset` makes it a preset whose
+  solid is the mesh itself.
 
 Sizes are checked before anything is parsed. Every failure is a ValueError whose message is
 for the student. Formatting and bookkeeping only: the fit and the moments come from

@@ -1,9 +1,9 @@
 """How one session's picture looks: the theme, the projector mode, the second (body-frame)
 view, and the labels' layout for the browser's camera.
 
-- Theme: dark or light (:func:`poinsot.app.construction.view.configure_theme`), and the scene's
-colours
-  for it (:func:`poinsot.app.construction.palette.look`), which the legend follows.
+- Theme: dark or light (:func:`poinsot.app.construction.view.configure_theme`), and the
+  scene's colours for it (:func:`poinsot.app.construction.palette.look`), which the legend
+  follows.
 - Large text: the page's root font size scaled (every panel size is in rem), both docked
   columns widened in proportion (so that no line of the panels is cut and the sliders keep their
   tracks), and the scene's labels scaled alike.
