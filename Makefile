@@ -12,7 +12,7 @@ SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # again (about 12 core-seconds of the suite on a 2-core machine).
 unexport PYTHONDONTWRITEBYTECODE
 
-.PHONY: run test test-busy test-fast install install-test chromium bench bench-compare load lint docs pictures clean
+.PHONY: run test test-busy test-fast test-times install install-test chromium bench bench-compare load lint docs pictures clean
 
 $(VENV)/bin/activate:
 	$(PYTHON) -m venv $(VENV)
@@ -77,6 +77,12 @@ test: install-test chromium
 BUSY_LOOPS ?= 2
 test-busy: install-test chromium
 	$(PY) tests/busy.py --loops $(BUSY_LOOPS) -- $(MAKE) --no-print-directory test
+
+# Where the suite's time goes: the parallel stage with a JUnit report (its own status is not
+# this target's), then each group's seconds and the slowest tests (tests/durations.py).
+test-times: install-test chromium
+	-$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not serial" -q --junitxml=build/junit.xml
+	$(PY) tests/durations.py build/junit.xml
 
 # The inner loop: no browser, no live server, nothing slow (physics, report, the app's logic).
 # These tests compute rather than wait: a worker more than the cores, no more (each worker
