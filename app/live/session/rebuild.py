@@ -153,16 +153,16 @@ class BodyBuild:
         motion.set_body(body)
         motion.restart_plot(0.0, frame.omega, frame.wxyz)  # the old curve goes with its motion
         self._say("")
+        if self.base.withheld:  # a challenge's body: hidden at once, with the body itself
+            motion.show_readouts(WITHHELD)  # (the last body's readouts would tell the answer)
+            return
         # The readouts' table just after the new body has gone out (Montgomery's phase is
         # measured over a period: half a millisecond that the redraw need not wait for).
         self._post(lambda: self._show_readouts(body, shared), "readouts")
 
     def _show_readouts(self, body: FreeRigidBody, shared: Motion | None) -> None:
-        if body is not self.body:  # a newer body came meanwhile: its own readouts follow
-            return
-        if self.base.withheld:  # a challenge's body: the readouts would tell the answer
-            self.panel.motion.show_readouts(WITHHELD)
-            return
+        if body is not self.body or self.base.withheld:  # a newer body came meanwhile
+            return  # (its own readouts follow, or it is a challenge's: hidden already)
         if shared is None:
             text = readouts.markdown(body)
         else:  # a follower's: made once for the followers of the process
