@@ -278,7 +278,7 @@ def test_cli_serves_the_page_and_prints_the_url(argv):
     "command", [[sys.prefix + "/bin/poinsot"], [sys.executable, "-m", "poinsot.app"]]
 )
 def test_console_script_and_module_forms_answer(command):
-    out = subprocess.run([*command, "serve", "--help"], capture_output=True, text=True, timeout=30)
+    out = subprocess.run([*command, "serve", "--help"], capture_output=True, text=True, timeout=180)
     assert out.returncode == 0 and "--host" in out.stdout and "--port" in out.stdout
 
 

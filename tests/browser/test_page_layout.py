@@ -96,10 +96,17 @@ def test_the_projector_keeps_a_compact_legend_and_t(poinsot_app, open_page):
     page = open_page(poinsot_app.url, 1920, 1080, live_view=False)
     session = session_of(poinsot_app, timeout=60)
     assert wait_until(lambda: session.running and session.lecture is not None, 30)
-    before = page.canvas_box()["width"]
+
+    # The picture ends where the control panel begins (the page has laid the panel out: the
+    # canvas is first as wide as the page), then at the folded panel's strip.
+    def right() -> float:
+        box = page.canvas_box()
+        return box["x"] + box["width"]
+
+    assert wait_until(lambda: right() < 1920 - 200, 20), page.canvas_box()
     page.set_checkbox("Projector mode", True)
     assert wait_until(lambda: session.lecture.display.style.projector, 20)
-    assert wait_until(lambda: page.canvas_box()["width"] > before + 100, 20), page.canvas_box()
+    assert wait_until(lambda: right() > 1920 - 60, 20), page.canvas_box()
     legend = page.page.locator('[data-legend="herpolhode (plane)"]').first
     assert wait_until(legend.is_visible, 20)
     time = page.page.locator("p").filter(has_text=re.compile(r"t = +\d")).first
