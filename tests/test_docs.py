@@ -101,6 +101,7 @@ def run_command(words: list[str], where: Path) -> None:
             assert (where / name).exists(), name
 
 
+@pytest.mark.server  # it starts a process of its own
 def test_every_command_of_the_readme_runs_from_a_fresh_clone(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     found = commands(README)
@@ -153,6 +154,7 @@ def test_every_figure_the_guide_reads_from_the_code_exists():
 
 
 # -- the tutorials -----------------------------------------------------------------------------
+@pytest.mark.server  # it starts a process of its own
 @pytest.mark.parametrize("page", TUTORIALS, ids=lambda p: p.stem)
 def test_every_code_block_of_a_tutorial_runs(page: Path, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)

@@ -1,10 +1,19 @@
 """The package boundary: physics/ imports numpy and scipy only."""
 
 import ast
+import functools
 import pathlib
 import re
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+@functools.cache
+def _nodes(path: pathlib.Path) -> tuple[ast.AST, ...]:
+    """Every node of the module at ``path``: parsed and walked once for all this file's tests."""
+    return tuple(ast.walk(ast.parse(path.read_text())))
+
+
 ALLOWED = {
     "numpy",
     "scipy",
@@ -25,9 +34,8 @@ ALLOWED = {
 
 
 def _top_level_imports(path: pathlib.Path) -> set[str]:
-    tree = ast.parse(path.read_text())
     names: set[str] = set()
-    for node in ast.walk(tree):
+    for node in _nodes(path):
         if isinstance(node, ast.Import):
             names.update(a.name.split(".")[0] for a in node.names)
         elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
@@ -44,9 +52,8 @@ def test_physics_imports_only_numpy_and_scipy():
 
 
 def _imported_modules(path: pathlib.Path) -> set[str]:
-    tree = ast.parse(path.read_text())
     names: set[str] = set()
-    for node in ast.walk(tree):
+    for node in _nodes(path):
         if isinstance(node, ast.Import):
             names.update(a.name for a in node.names)
         elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
@@ -169,7 +176,7 @@ def _import_graph() -> dict[str, set[str]]:
     graph = {}
     for name, f in files.items():
         found = set()
-        for node in ast.walk(ast.parse(f.read_text())):
+        for node in _nodes(f):
             if isinstance(node, ast.Import):
                 found.update(a.name for a in node.names)
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
@@ -269,7 +276,7 @@ def test_functions_do_one_step():
     long = {}
     for f in _code_files():
         lines = f.read_text().splitlines()
-        for node in ast.walk(ast.parse("\n".join(lines))):
+        for node in _nodes(f):
             if not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
                 continue
             assert node.end_lineno is not None
@@ -386,9 +393,8 @@ def _touches_clock(node: ast.AST, names: set[str]) -> bool:
 def _test_functions() -> list[tuple[str, ast.FunctionDef]]:
     found = []
     for path in sorted((ROOT / "tests").rglob("*.py")):
-        tree = ast.parse(path.read_text())
         rel = str(path.relative_to(ROOT))
-        found += [(rel, f) for f in ast.walk(tree) if isinstance(f, ast.FunctionDef)]
+        found += [(rel, f) for f in _nodes(path) if isinstance(f, ast.FunctionDef)]
     return found
 
 
@@ -478,12 +484,13 @@ PRIVATE_VISER_ATTRIBUTES = frozenset(
 VISER_ADAPTER = ROOT / "app" / "viser_private"
 
 
-def _private_viser_uses(source: str) -> list[str]:
-    """Where ``source`` names a private part of viser: an import of a private viser module or
-    name, ``viser._x``, ``x.<private attribute>`` (``self``/``cls`` excepted), or a
-    ``getattr``/``setattr``/``hasattr`` of one."""
+def _private_viser_uses(source: str | pathlib.Path) -> list[str]:
+    """Where ``source`` (a module's text, or its path) names a private part of viser: an import
+    of a private viser module or name, ``viser._x``, ``x.<private attribute>`` (``self``/``cls``
+    excepted), or a ``getattr``/``setattr``/``hasattr`` of one."""
     found = []
-    for node in ast.walk(ast.parse(source)):
+    nodes = _nodes(source) if isinstance(source, pathlib.Path) else ast.walk(ast.parse(source))
+    for node in nodes:
         line = getattr(node, "lineno", 0)
         if isinstance(node, ast.Import):
             modules = [a.name for a in node.names]
@@ -526,7 +533,7 @@ def test_viser_s_private_names_are_used_only_in_the_adapter():
     for f in sorted(files):
         if VISER_ADAPTER in f.parents or f in ADAPTER_TESTS:
             continue
-        found = _private_viser_uses(f.read_text())
+        found = _private_viser_uses(f)
         if found:
             used[str(f.relative_to(ROOT))] = found
     assert not used, f"private viser names outside app/viser_private/: {used}"
@@ -541,7 +548,7 @@ def test_the_adapter_is_entered_by_its_front_door():
     for f in sorted(files):
         if VISER_ADAPTER in f.parents or f in ADAPTER_TESTS:
             continue
-        for node in ast.walk(ast.parse(f.read_text())):
+        for node in _nodes(f):
             if isinstance(node, ast.Import):
                 names = [a.name for a in node.names]
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:

@@ -187,6 +187,7 @@ def test_the_load_tool_reports_a_failure_in_one_line(monkeypatch, capsys):
     _assert_one_line(code, err, 1, LOAD)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "argv",
     [

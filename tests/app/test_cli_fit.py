@@ -57,6 +57,7 @@ def recording(tmp_path):
     return path
 
 
+@pytest.mark.server  # it starts a process of its own
 def test_the_table_and_the_json(recording, tmp_path):
     out = tmp_path / "fits.json"
     done = poinsot(str(recording), "--json", str(out))
@@ -94,6 +95,7 @@ def test_rotation_and_bias_are_fitted_on_request(recording, tmp_path, in_process
     assert len(segment["rotation"]) == 3 and len(segment["bias"]) == 3
 
 
+@pytest.mark.server  # it starts a process of its own
 def test_a_missing_file_is_one_line(tmp_path):
     line = one_line_error(poinsot(str(tmp_path / "nowhere.csv")))
     assert line.startswith("poinsot fit:") and "no such file" in line

@@ -232,6 +232,7 @@ def _write_layout(repo: Path, namespaced: bool, physics: str, app: str) -> None:
         )
 
 
+@pytest.mark.server  # it starts a process of its own
 def test_the_working_tree_runs_against_an_older_layout_from_a_temporary_worktree(tmp_path):
     repo = tmp_path / "repo"
     repo.mkdir()
@@ -254,6 +255,7 @@ def test_the_working_tree_runs_against_an_older_layout_from_a_temporary_worktree
     assert _worktree_paths(repo) == {str(repo)}  # the temporary one is gone
 
 
+@pytest.mark.server  # it starts a process of its own
 def test_a_namespaced_tree_imports_its_own_folders_not_the_installed_package(tmp_path):
     _write_layout(tmp_path, True, "physics", "app")
     tree = compare.prepare(tmp_path, tmp_path / "scratch")

@@ -306,6 +306,7 @@ def run_cli(*args: str, env: dict[str, str] | None = None) -> subprocess.Complet
     )
 
 
+@pytest.mark.server  # it starts a process of its own
 def test_cli_screenshot_without_chromium_says_how_to_install_it(tmp_path):
     out = tmp_path / "x.png"
     done = run_cli(
@@ -332,6 +333,7 @@ def test_cli_screenshot_rejects_bad_arguments(tmp_path, capsys):
     assert screenshot.resolve_scene("T_HANDLE").key == "t_handle"
 
 
+@pytest.mark.slow
 def test_cli_export_html_writes_the_page(tmp_path):
     out = tmp_path / "clip.html"
     done = run_cli("export-html", "--preset", "oblate", "--seconds", "1.5", "--out", str(out))

@@ -313,6 +313,7 @@ def window(errors: list[GhostErrors], lo: float, hi: float, field: str) -> np.nd
     return np.array([abs(getattr(e, field)) for e in errors if lo <= e.t <= hi])
 
 
+@pytest.mark.slow
 def test_rk45_drifts_and_the_splitting_energy_error_stays_bounded(server):
     times = np.arange(0.0, 240.0, 1.0 / 15.0)  # 15 frames per time unit: speed 4 at 60 Hz
     config = GhostConfig(enabled=True, method="RK45", tolerance=1e-3)

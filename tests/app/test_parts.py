@@ -274,6 +274,7 @@ def test_cli_serves_the_page_and_prints_the_url(argv):
     assert wait_until(lambda: proc.poll() is not None, 5)
 
 
+@pytest.mark.server  # it starts a process of its own
 @pytest.mark.parametrize(
     "command", [[sys.prefix + "/bin/poinsot"], [sys.executable, "-m", "poinsot.app"]]
 )

@@ -166,6 +166,7 @@ def test_long_cylinder_looks_stable_for_a_long_time():
     assert math.degrees(model.cone_angle()) < 7.0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kappa", [float(k) for k in explorer_1.KAPPAS])
 def test_explorer_crosses_the_separatrix_within_a_window(kappa):
     model = explorer_1.build({"kappa": kappa})

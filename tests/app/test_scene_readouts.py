@@ -21,6 +21,7 @@ def tables() -> list[readouts.Tabulated]:
     return [tab for spec in SCENES for tab in readouts.tabulate(spec)]
 
 
+@pytest.mark.slow
 def test_the_command_prints_one_markdown_table_of_every_scene(capsys) -> None:
     assert readouts.main([]) == 0
     lines = capsys.readouterr().out.splitlines()

@@ -242,6 +242,7 @@ def test_a_busy_port_is_one_line_and_exit_2(busy_port: int, workers: str, capsys
     assert "running at" not in out
 
 
+@pytest.mark.server  # it starts a process of its own
 def test_a_busy_worker_port_is_one_line_and_exit_2(busy_port: int):
     """The workers take the ports after the landing's: one of them taken is refused too (a
     real ``poinsot serve`` process: one line, no traceback)."""

@@ -81,6 +81,7 @@ def _check_against_reference(body: FreeRigidBody, ref: ReferenceBody, times) -> 
 # ---- the two first failures found -------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_subnormal_complementary_parameter_attitude_is_finite_and_exact() -> None:
     """1 - m = 4.27e-317 (subnormal): K = 365.6, and at t = 7 the periodic part of the
     precession Π fell in its complementary branch with v = K - |r| = 178.8, where cn²v, dn²v
@@ -99,6 +100,7 @@ def test_subnormal_complementary_parameter_attitude_is_finite_and_exact() -> Non
     _check_against_reference(body, ref, [0.0, 7.0, -3.0, 100.0])
 
 
+@pytest.mark.slow
 def test_start_closer_to_the_separatrix_than_a_double_is_exact() -> None:
     """1 - m ~ 1e-647: even sqrt(1 - m) underflows. The AGM's first steps are taken in decimal
     arithmetic until b_k is a normal double, and u0 = F(φ0|m) from the exact ratio

@@ -311,6 +311,7 @@ def test_splitting_energy_error_is_bounded_and_shrinks_with_the_step():
     assert first / first_half_step > 3.5
 
 
+@pytest.mark.slow
 def test_the_drift_check_detects_a_drifting_method():
     first, last = _first_and_last_tenth("RK45", 1e-8)
     assert last > 5 * NO_DRIFT_FACTOR * first

@@ -16,6 +16,7 @@ For each example, at random times:
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from reference import (
@@ -52,6 +53,9 @@ def fd_tolerance(rate_ratio: float) -> float:
 
 
 SETTINGS = settings(max_examples=400, deadline=None, derandomize=True)
+
+#: 400 examples a test: seconds each, so not in ``make test-fast``'s inner loop.
+pytestmark = pytest.mark.slow
 
 
 @st.composite

@@ -291,6 +291,7 @@ def test_report_quick_into_a_file_writes_a_few_lines_of_progress(quick_report):
     assert progress[-1].startswith("report: 100%")
 
 
+@pytest.mark.server  # it starts a process of its own
 def test_python_dash_m_runs_the_report_command():
     done = subprocess.run(
         [sys.executable, "-m", "poinsot.app.report", "--help"],
