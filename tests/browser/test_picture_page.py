@@ -617,6 +617,8 @@ def test_projector_mode_folds_the_control_panel_and_thickens_the_picture(pages):
     assert wait_until(lambda: session.frame is not None and session.frame.t > 6.0, 30)
     pause(page, session)
     page.drawn_after(session.client)
+    # The page has laid its control panel out (the canvas is first as wide as the page).
+    assert wait_until(lambda: page.canvas_box()["width"] < 0.6 * 1280, 20), page.canvas_box()
     before_box = page.canvas_box()
     thin = session.scene.look.trace_width
     # The herpolhode alone is measured: the plane's grid and the compact legend's swatch share
@@ -644,7 +646,6 @@ def test_projector_mode_folds_the_control_panel_and_thickens_the_picture(pages):
     assert thick_px >= 1.4 * thin_px, (thin_px, thick_px)
     for element in others:
         session.set_visible(element, True)
-    assert before_box["width"] < 0.6 * 1280
     # A column opened from its strip shows its text large.
     session.client.gui.main_panel.expand()
     assert wait_until(lambda: page.page.evaluate(root) >= base_font * 1.45, 10)
