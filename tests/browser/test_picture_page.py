@@ -440,18 +440,38 @@ def test_the_sphere_shows_omega_and_L_apart(pages):
     started(session)
     page.choose("Preset", preset_by_key("sphere").label)
     assert wait_until(lambda: session.preset.key == "sphere" and session.body is not None, 10)
-    page.drawn_after(session.client)
+    pause(page, session)
     box = page.canvas_box()
-    view = scene_only(session, box["width"], box["height"])
-    look = session.scene.look
-    omega, momentum = hue_mask(view, look.omega), hue_mask(view, look.angular_momentum)
+    drawn = [e for e in Element if session.scene.is_visible(e)]
+    # Each arrow's pixels: a picture with it alone against one with nothing (the lit arrow's
+    # shades stray from its colour's hue; the sphere's amber and an axis are near L's).
+    pictures = {
+        shown: alone_in_the_view(session, shown, box["width"], box["height"])
+        for shown in (None, Element.OMEGA, Element.L)
+    }
+    for element in drawn:
+        session.set_visible(element, True)
+    nothing = pictures[None].astype(int)
+    omega, momentum = (
+        in_patches(np.abs(pictures[e].astype(int) - nothing).max(axis=2) > 40, 50)
+        for e in (Element.OMEGA, Element.L)
+    )
     assert omega.sum() > 150 and momentum.sum() > 150, (omega.sum(), momentum.sum())
-    # L's colour reaches higher on screen than ω's (L goes on above the plane).
+    # L reaches higher on screen than ω (L goes on above the plane).
     assert bounding_box(momentum)[1] < bounding_box(omega)[1] - 20
+    assert wait_until(lambda: all(session.scene.is_visible(e) for e in drawn), 10)
     placed = lay_out_on_the_frame_thread(session)
     assert {"omega", "L"} <= placed.keys()
     assert not boxes_overlap(placed["omega"].box, placed["L"].box)
     assert page.errors == []
+
+
+def alone_in_the_view(session, shown: Element | None, width: float, height: float):
+    """The 3D view rendered with ``shown`` its only element (None: no element at all)."""
+    for element in Element:
+        session.set_visible(element, element is shown)
+    assert wait_until(lambda: all(session.scene.is_visible(e) == (e is shown) for e in Element), 10)
+    return scene_only(session, width, height)
 
 
 def boxes_overlap(a, b) -> bool:
