@@ -75,8 +75,8 @@ def show(page, session, spec: SceneSpec, before: SceneSpec | None) -> None:
             and session.showcase.spec is spec
             and session.showcase.loaded
         ),
-        20,
-    )
+        60,  # the first is loaded as the page's session starts: late on a loaded machine
+    ), (spec.name, session.showcase and session.showcase.spec.name)
     labels = {c.label for c in spec.controls} | {p.label for p in spec.parts}
     old = set() if before is None else {c.label for c in before.controls}
     old |= set() if before is None else {p.label for p in before.parts}
