@@ -64,10 +64,11 @@ run: install
 # `serial` tests, alone (they measure what the machine gives them), collected from the files that
 # hold one only (collecting the whole suite costs seconds). Both stages always run.
 JOBS ?= 4
+PARALLEL = -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not serial"
 SERIAL_FILES = $(shell grep -rl --include='test_*.py' 'mark.serial' tests)
 test: install-test chromium
 	status=0; \
-	$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not serial" || status=1; \
+	$(PY) -m pytest $(PARALLEL) || status=1; \
 	$(PY) -m pytest -m serial $(SERIAL_FILES) || status=1; \
 	exit $$status
 
@@ -81,7 +82,7 @@ test-busy: install-test chromium
 # Where the suite's time goes: the parallel stage with a JUnit report (its own status is not
 # this target's), then each group's seconds and the slowest tests (tests/durations.py).
 test-times: install-test chromium
-	-$(PY) -m pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder -m "not serial" -q --junitxml=build/junit.xml
+	-$(PY) -m pytest $(PARALLEL) -q --junitxml=build/junit.xml
 	$(PY) tests/durations.py build/junit.xml
 
 # The inner loop: no browser, no live server, nothing slow (physics, report, the app's logic).
