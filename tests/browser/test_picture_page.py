@@ -446,7 +446,7 @@ def test_the_sphere_shows_omega_and_L_apart(pages):
     # Each arrow's pixels: a picture with it alone against one with nothing (the lit arrow's
     # shades stray from its colour's hue; the sphere's amber and an axis are near L's).
     pictures = {
-        shown: alone_in_the_view(session, shown, box["width"], box["height"])
+        shown: alone_in_the_view(session, drawn, shown, box["width"], box["height"])
         for shown in (None, Element.OMEGA, Element.L)
     }
     for element in drawn:
@@ -466,11 +466,13 @@ def test_the_sphere_shows_omega_and_L_apart(pages):
     assert page.errors == []
 
 
-def alone_in_the_view(session, shown: Element | None, width: float, height: float):
-    """The 3D view rendered with ``shown`` its only element (None: no element at all)."""
-    for element in Element:
+def alone_in_the_view(session, drawn, shown: Element | None, width: float, height: float):
+    """The 3D view rendered with ``shown`` the only one of the ``drawn`` elements (None: none
+    of them). Only these are touched: hiding an element the preset does not draw would keep it
+    hidden in the presets after, and in the module's later tests on this page."""
+    for element in drawn:
         session.set_visible(element, element is shown)
-    assert wait_until(lambda: all(session.scene.is_visible(e) == (e is shown) for e in Element), 10)
+    assert wait_until(lambda: all(session.scene.is_visible(e) == (e is shown) for e in drawn), 10)
     return scene_only(session, width, height)
 
 
@@ -585,6 +587,8 @@ def test_two_views_show_the_body_frame_beside_the_space_frame(pages):
     assert wait_until(lambda: session.lecture.display.body_view is not None, 10)
     pause(page, session)
     look = session.scene.look
+    traces = (Element.POLHODE, Element.HERPOLHODE)
+    assert all(session.scene.is_visible(e) for e in traces), "an earlier test left one hidden"
 
     def halves() -> tuple[int, int, int, int, int]:
         """Herpolhode left and right, polhode left and right, ellipsoid right [pixels]."""
