@@ -101,3 +101,25 @@ def test_following_is_the_motion_sources_one_switch(poinsot_app, probe):
     session.toggle_pause()
     assert wait_until(lambda: session.clock.paused, 15)
     assert source.now() == session.clock.now()
+
+
+def test_a_deferred_action_waits_for_the_next_frame_and_a_posted_one_wakes_the_thread():
+    """The readouts of a new body are deferred (:meth:`Front.defer`): they run before the
+    frame thread's next frame, not at once, so that they do not compete with the sending of
+    the new body's window; a request is posted and wakes the thread."""
+    from poinsot.app.live.hardening.pacing import SessionStats
+    from poinsot.app.live.session.actions import ActionQueue
+    from poinsot.app.live.session.front import Status
+
+    queue = ActionQueue()
+    front = Front(None, None, None, queue, Status(SessionStats(), "parts"))  # type: ignore[arg-type]
+    wakes: list[int] = []
+    front.wake = lambda: wakes.append(1)
+    ran: list[str] = []
+    front.defer(lambda: ran.append("readouts"), "readouts")
+    front.defer(lambda: ran.append("newer readouts"), "readouts")  # replaces the queued one
+    assert wakes == [] and len(queue) == 1 and ran == []
+    front.post(lambda: ran.append("slider"))
+    assert wakes == [1] and len(queue) == 2
+    queue.run(lambda exc: None)
+    assert ran == ["newer readouts", "slider"]

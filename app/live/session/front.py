@@ -134,6 +134,12 @@ class Front:
         self.queue.put(action, key)
         self.wake()
 
+    def defer(self, action: Action, key: Hashable | None = None) -> None:
+        """Run ``action`` on the frame thread before its next frame, without waking it now
+        (what may follow the window just sent: it would compete with that window's sending
+        for the interpreter). Otherwise as :meth:`post`."""
+        self.queue.put(action, key)
+
     def report(self, error: BaseException) -> None:
         """Show an error raised outside the frame thread (a GUI callback)."""
         self.post(lambda: self.status.report(error))

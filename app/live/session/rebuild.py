@@ -39,9 +39,9 @@ WITHHELD = "_The readouts are hidden until you answer the challenge._"
 
 class BodyBuild:
     """The body a session shows, rebuilt by :meth:`rebuild` when :attr:`dirty`. ``say`` sets the
-    session's status line; ``post`` queues an action on its frame thread (the readouts);
-    ``source`` says where the motion comes from (:mod:`.source`: the session's own or the
-    lead's)."""
+    session's status line; ``post`` queues an action for its frame thread's next frame (the
+    readouts); ``source`` says where the motion comes from (:mod:`.source`: the session's own
+    or the lead's)."""
 
     def __init__(
         self,
@@ -156,8 +156,9 @@ class BodyBuild:
         if self.base.withheld:  # a challenge's body: hidden at once, with the body itself
             motion.show_readouts(WITHHELD)  # (the last body's readouts would tell the answer)
             return
-        # The readouts' table just after the new body has gone out (Montgomery's phase is
-        # measured over a period: half a millisecond that the redraw need not wait for).
+        # The readouts' table before the next frame, once the new body has gone out: made now,
+        # its 2 ms (Montgomery's phase is measured over a period) would hold that window's
+        # sending, which needs the interpreter (``post`` defers it: :meth:`.front.Front.defer`).
         self._post(lambda: self._show_readouts(body, shared), "readouts")
 
     def _show_readouts(self, body: FreeRigidBody, shared: Motion | None) -> None:
