@@ -297,6 +297,31 @@ def test_a_label_goes_beyond_its_tip():
     assert x0 >= px - 1e-6 and x1 > x0
 
 
+def test_a_label_keeps_its_box_inside_the_picture():
+    """An axis pointing right whose tip is near the picture's right edge: its box goes left
+    of its point, wholly inside (beyond the tip it would be cut by the edge); and a movable
+    label whose point is just above the top edge is pushed down into the picture."""
+    from poinsot.app.construction.labels.layout import Slot, lay_out
+
+    camera = _camera((0.0, -5.0, 0.0))
+    edge = camera.width
+    # the world x whose projection lies 3 px inside the right edge (at depth 5)
+    x = (edge / 2 - 3.0) * float(camera.world_per_px(5.0))
+    tip = np.array([x, 0.0, 0.0])
+    placed = lay_out([Slot("axis1", "1", 1.3, tip * 1.001, tip, np.zeros(3))], camera)
+    x0, y0, x1, y1 = placed["axis1"].box
+    assert 0.0 <= x0 < x1 <= edge and 0.0 <= y0 < y1 <= camera.height, placed["axis1"]
+    assert placed["axis1"].overlap == 0.0
+    # L's tip 2 px above the top edge, the arrow pointing up: pushed, not drawn off the top.
+    z = (camera.height / 2 + 2.0) * float(camera.world_per_px(5.0))
+    top = np.array([0.0, 0.0, z])
+    slot = Slot("L", "L", 1.4, top * 1.001, top, np.zeros(3), movable=True, clearance=6.0)
+    placed = lay_out([slot], camera)
+    x0, y0, x1, y1 = placed["L"].box
+    assert 0.0 <= x0 < x1 <= edge and 0.0 <= y0 < y1 <= camera.height, placed["L"]
+    assert np.linalg.norm(placed["L"].offset) > 0.0
+
+
 def test_a_label_box_is_as_wide_as_the_browser_draws_it():
     """ω is wider than a Latin letter: Chromium draws ω's box at font scale 1.4 18-19 CSS px
     wide (the mean advance of a letter gave 13.3 px, and ω's box then touched the herpolhode's

@@ -14,6 +14,9 @@ reports (:class:`Camera`):
 - labels are placed in order of importance, each taking the first of its anchors (ordered by
   that outward direction) whose box overlaps no box placed before and no marker (the contact
   point); if none is free, the one that overlaps least;
+- a box keeps inside the picture: a label whose point is near an edge takes an anchor on the
+  inner side (a box cut by the edge cannot be read); a label whose point is outside the
+  picture keeps as much of its box inside as it can;
 - a label whose point may move (:attr:`Slot.movable`: L's, ω's, the herpolhode's, which hang
   from frames that only translate) may also be pushed, in the screen plane, in one of eight
   directions (the outward one first), far enough beyond its tip to clear a marker drawn there,
@@ -160,6 +163,16 @@ def _overlap_costs(boxes: np.ndarray, placed: np.ndarray) -> np.ndarray:
     return LABEL_WEIGHT * np.sum(np.maximum(w, 0.0) * np.maximum(h, 0.0), axis=1)
 
 
+def _outside_costs(boxes: np.ndarray, width: float, height: float) -> np.ndarray:
+    """The area of each candidate box (K, 4) outside the view [0, width] x [0, height] (CSS
+    px), times OUTSIDE_WEIGHT: zero for a box wholly inside (a box may touch the edge)."""
+    x0, y0, x1, y1 = boxes.T
+    inside_w = np.maximum(np.minimum(x1, width) - np.maximum(x0, 0.0), 0.0)
+    inside_h = np.maximum(np.minimum(y1, height) - np.maximum(y0, 0.0), 0.0)
+    outside = (x1 - x0) * (y1 - y0) - inside_w * inside_h
+    return OUTSIDE_WEIGHT * np.maximum(outside, 0.0)
+
+
 def _disc_costs(
     boxes: np.ndarray, centres: np.ndarray, radii: np.ndarray, weights: np.ndarray
 ) -> np.ndarray:
@@ -215,9 +228,11 @@ def _outward(first: np.ndarray, second: np.ndarray) -> np.ndarray:
 
 #: Points along an arrow that the boxes keep clear of.
 ARROW_SAMPLES = 12
-#: Where no place is free, what is worst to cover: another label, then a marker, then an
-#: arrow's shaft (weights of the overlaps).
+#: Where no place is free, what is worst: to cover another label or to lie outside the
+#: picture (unread either way), then to cover a marker, then an arrow's shaft (weights of the
+#: overlaps).
 LABEL_WEIGHT = 10.0
+OUTSIDE_WEIGHT = 10.0
 MARKER_WEIGHT = 5.0
 #: A movable label is pushed up to this many times its clearance before it settles for the
 #: least overlap.
@@ -265,7 +280,8 @@ def lay_out(
     the boxes avoid crossing. Labels behind the camera keep their anchor.
 
     A candidate's cost is its overlap with the labels placed before it (LABEL_WEIGHT) plus its
-    reach into the markers and arrows; the first candidate of cost 0 wins, else the cheapest.
+    area outside the camera's view (OUTSIDE_WEIGHT) and its reach into the markers and arrows;
+    the first candidate of cost 0 wins, else the cheapest.
     Every label's candidates are made, and their reach costed, in one pass of array
     operations (:class:`_Candidates`); only the overlap with the labels placed before is a
     step per label (:func:`_choose`)."""
@@ -282,8 +298,8 @@ def lay_out_in_steps(
     arrows: Sequence[tuple[np.ndarray, np.ndarray, float]] = (),
 ) -> Steps[dict[str, Placement]]:
     """:func:`lay_out` in three steps, a ``yield`` between two: the candidates, their reach
-    into the markers and arrows, the choice. A caller that resumes it once per frame spreads
-    a layout over frames (:func:`finish` runs it at once)."""
+    into the markers and arrows and out of the picture, the choice. A caller that resumes it
+    once per frame spreads a layout over frames (:func:`finish` runs it at once)."""
     if not slots:
         return {}
     points = np.array([[slot.point, slot.tip, slot.root] for slot in slots], float)
@@ -294,7 +310,9 @@ def lay_out_in_steps(
     shown = [slots[i] for i in front.tolist()]
     c = _Candidates.of(shown, screen.reshape(-1, 3, 2)[front])
     yield
-    cost = _disc_costs(c.boxes.reshape(-1, 4), *_discs(camera, markers, arrows))
+    boxes = c.boxes.reshape(-1, 4)
+    cost = _disc_costs(boxes, *_discs(camera, markers, arrows))
+    cost += _outside_costs(boxes, camera.width, camera.height)
     cost = cost.reshape(c.boxes.shape[:2]) + c.barred
     yield
     chosen, costs = _choose(c.boxes, cost)
