@@ -472,6 +472,39 @@ def test_a_body_built_for_an_older_value_leaves_the_slider_where_the_browser_mov
     assert not any(v == pytest.approx(first) for v in sent_back), sent_back
 
 
+def test_a_slider_is_written_on_viser_s_loop_never_between_a_browser_s_value_and_its_callbacks(
+    poinsot_app, probe
+):
+    """viser stores a browser's value in the handle on its event loop, then runs the callbacks
+    that count it. The panel mirrors a built body into its sliders from the frame thread; were
+    the write made there, it could land between the two and replace the user's value before it
+    is counted. So the write waits for the loop: with the loop held, the slider keeps its
+    value; released, the mirrored value is written (and sent)."""
+    import threading
+
+    session = session_of(poinsot_app)
+    uuid, _ = probe.widget("|ω₀|")
+    slider = session.panel.widgets.omega_norm
+    assert slider is not None
+    before = float(slider.value)
+    mirrored = round(before + 0.3, 2)
+    held, release = threading.Event(), threading.Event()
+
+    def hold() -> None:
+        held.set()
+        release.wait(30)
+
+    poinsot_app.server.get_event_loop().call_soon_threadsafe(hold)
+    assert held.wait(10), "viser's loop never ran the hold"
+    try:
+        session.panel.show_parameters(session.params.with_omega_norm(mirrored))
+        assert float(slider.value) == before  # not written from this thread
+    finally:
+        release.set()
+    assert wait_until(lambda: float(slider.value) == pytest.approx(mirrored), 10)
+    assert probe.wait_for(lambda p: p.widgets[uuid].value == pytest.approx(mirrored))
+
+
 def test_a_session_still_being_built_when_the_server_stops_logs_no_error(
     make_app, make_probe, caplog, monkeypatch
 ):

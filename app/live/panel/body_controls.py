@@ -10,6 +10,7 @@ browser is still on its way to the parameters (:meth:`~.widgets.Sent.newer_than`
 
 from __future__ import annotations
 
+import asyncio
 import math
 from collections.abc import Callable, Iterable
 from contextlib import AbstractContextManager
@@ -63,11 +64,13 @@ class BodyControls:
         widgets: Widgets,
         folder: Callable[[str | Control, str], AbstractContextManager[Any]],
         on_user: Callable[[Any, Callable[[Sent], None]], Any],
+        loop: asyncio.AbstractEventLoop,
     ) -> None:
         """``folder(name, label)``: the panel's folder to build in; ``on_user(handle,
-        callback)``: listen to the browser's changes only (:func:`~.widgets.on_user`)."""
+        callback)``: listen to the browser's changes only (:func:`~.widgets.on_user`);
+        ``loop``: viser's event loop, where the sliders' values are written (:meth:`_mirror`)."""
         self.gui, self.edit, self.widgets = gui, edit, widgets
-        self.folder, self.on_user = folder, on_user
+        self.folder, self.on_user, self._loop = folder, on_user, loop
         #: Per slider: the browser's values (their count as they arrived), and the count of
         #: the last one applied to the parameters asked for (:meth:`_edit`, :meth:`_mirror`).
         self._sent: dict[str, Sent] = {}
@@ -195,13 +198,27 @@ class BodyControls:
         self.edit(apply)
 
     def _mirror(self, key: str, slider: Any, value: float) -> None:
-        """Show ``value`` in slider ``key``, unless the browser has sent it a newer value that
-        the parameters do not hold yet: a body built for an older value (keys pressed faster
-        than the body is rebuilt) would put the thumb back under the user's hand, and the next
-        key would step from there. The newer value is shown once applied (snapped if need be)."""
+        """Show ``value`` in slider ``key``, unless the browser has sent it a newer value than
+        the parameters shown hold: a body built for an older value (keys pressed faster than
+        the body is rebuilt) would put the thumb back under the user's hand, and the next key
+        would step from there. The newer value is shown once applied (snapped if need be).
+
+        The check and the write run on viser's event loop (called from the frame thread).
+        viser stores a browser's value in the handle there, then runs the callbacks that count
+        it (:func:`~.widgets.on_user`); a write from the frame thread landing between the two
+        would replace the user's value before it is counted, and the edit would ask for the
+        mirrored one. The count the shown parameters hold is read here, when they are shown:
+        by the time the loop writes, the frame thread may have applied a newer value."""
         sent = self._sent.get(key)
+        applied = 0
         if sent is not None:
-            applied_sent, applied = self._applied.get(key, (sent, 0))
-            if sent.newer_than(applied if applied_sent is sent else 0):
-                return
-        set_value(slider, value)
+            applied_sent, count = self._applied.get(key, (sent, 0))
+            applied = count if applied_sent is sent else 0
+
+        def write() -> None:
+            now = self._sent.get(key)
+            if now is not None and (now is not sent or now.newer_than(applied)):
+                return  # the browser's newer value is on its way to the parameters
+            set_value(slider, value)
+
+        self._loop.call_soon_threadsafe(write)

@@ -168,11 +168,13 @@ class ControlPanel:
         self.pointing_verb = "Click"
         self.motion = MotionWindow(gui, order=_ORDER["readouts"])
         #: The body's groups (moments, D, side and pole, |ω₀|).
-        self.body = BodyControls(gui, actions.edit, self.widgets, self._folder, self._on_user)
+        self._loop = gui_event_loop(gui)  # viser's; runs the menu's and the sliders' writes
+        self.body = BodyControls(
+            gui, actions.edit, self.widgets, self._folder, self._on_user, self._loop
+        )
         #: The browser's choices in the menu (a preset shown for an older one is not written
         #: over a newer one: :meth:`show_preset`).
         self.menu = Sent(preset.label)
-        self._loop = gui_event_loop(gui)  # viser's; runs the menu's writes
         on_user(self.preset, self._choose_preset, self.actions.report, self.menu, inline=True)
 
     def _on_user(self, handle: H, callback: Callable[[Sent], None]) -> H:

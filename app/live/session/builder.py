@@ -136,7 +136,7 @@ def compose(
         budget=budget,
         stats=stats,
         say=status.say,
-        post=front.defer,
+        defer=front.defer,
     )
     choice = Choice(
         preset,

@@ -39,7 +39,7 @@ WITHHELD = "_The readouts are hidden until you answer the challenge._"
 
 class BodyBuild:
     """The body a session shows, rebuilt by :meth:`rebuild` when :attr:`dirty`. ``say`` sets the
-    session's status line; ``post`` queues an action for its frame thread's next frame (the
+    session's status line; ``defer`` queues an action for its frame thread's next frame (the
     readouts); ``source`` says where the motion comes from (:mod:`.source`: the session's own
     or the lead's)."""
 
@@ -56,11 +56,11 @@ class BodyBuild:
         budget: RebuildGate,
         stats: SessionStats,
         say: Callable[[str], None],
-        post: Callable[[Callable[[], None], object], None],
+        defer: Callable[[Callable[[], None], object], None],
     ) -> None:
         self.client, self.scene, self.playback, self.panel = client, scene, playback, panel
         self.ghost, self.source, self.budget, self.stats = ghost, source, budget, stats
-        self._say, self._post = say, post
+        self._say, self._defer = say, defer
         self.base = preset  # the last named preset: it supplies the solid
         self.params = self.desired = Parameters.from_preset(preset)
         self.base_inertia = self.params.inertia
@@ -158,8 +158,8 @@ class BodyBuild:
             return
         # The readouts' table before the next frame, once the new body has gone out: made now,
         # its 2 ms (Montgomery's phase is measured over a period) would hold that window's
-        # sending, which needs the interpreter (``post`` defers it: :meth:`.front.Front.defer`).
-        self._post(lambda: self._show_readouts(body, shared), "readouts")
+        # sending, which needs the interpreter (``defer`` holds it: :meth:`.front.Front.defer`).
+        self._defer(lambda: self._show_readouts(body, shared), "readouts")
 
     def _show_readouts(self, body: FreeRigidBody, shared: Motion | None) -> None:
         if body is not self.body or self.base.withheld:  # a newer body came meanwhile
