@@ -128,3 +128,32 @@ def test_a_browser_view_is_brought_within_1920x1080_with_even_sides():
     width, height = fit_within((2560, 1600), (1920, 1080), even=True)
     assert width <= 1920 and height <= 1080 and width % 2 == 0 and height % 2 == 0
     assert abs(width / height - 1.6) < 0.01
+
+
+def test_the_browser_s_progress_shows_the_first_frame_then_every_twentieth():
+    """A 30 s clip at 25 fps (750 frames): the bar and the message move after the first frame
+    (software WebGL takes seconds per frame of a slide's size), then every 37 frames, and at
+    the last; and a browser that has left cancels the clip."""
+    import threading
+    from types import SimpleNamespace
+
+    from poinsot.app.live.lecture.video_export import VideoExport
+
+    said: list[str] = []
+    bars: list[float] = []
+    session = SimpleNamespace(running=True)
+    export = SimpleNamespace(
+        lecture=SimpleNamespace(session=session),
+        cancel=threading.Event(),
+        _set_progress=bars.append,
+    )
+    progress = VideoExport._progress(export, said.append, 750)  # type: ignore[arg-type]
+    for done in range(1, 751):
+        progress(done, 750)
+    shown = [int(text.split()[4]) for text in said]
+    assert shown == [1, *range(37, 741, 37), 750]
+    assert bars[0] == pytest.approx(100 / 750) and bars[-1] == 100.0
+    assert not export.cancel.is_set()
+    session.running = False  # the browser has left
+    progress(2, 750)
+    assert export.cancel.is_set()

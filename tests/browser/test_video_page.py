@@ -77,6 +77,9 @@ def test_a_video_can_be_cancelled_and_the_next_one_starts(poinsot_app, open_page
     page.page.on("download", lambda download: downloads.append(download))
     page.press_slider("Video length [s]", "End")  # 30 s: it will not end by itself soon
     assert wait_until(lambda: video.seconds.value == 30, 5)
+    # The 3D view's size, not a slide's: software WebGL draws its frames several times faster.
+    page.choose("Picture size", "current view")
+    assert wait_until(lambda: lecture.size.value == "current view", 5)
     page.click_button("Video")
     assert wait_until(lambda: video.progress.visible and video.progress.value > 0, 240), (
         lecture.message.content

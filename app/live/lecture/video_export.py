@@ -256,12 +256,15 @@ class VideoExport:
             self.lecture.show(text, error=error)
 
     def _progress(self, show: Callable[[str], None], total: int) -> Callable[[int, int], None]:
+        """The bar and the message after the first frame (software WebGL takes seconds for
+        one frame of a slide's size: the user sees at once that it has begun), then every
+        twentieth of the clip, and at its end."""
         step = max(1, total // 20)
 
         def progress(done: int, _total: int) -> None:
             if not getattr(self.lecture.session, "running", True):
                 self.cancel.set()  # the browser has left: nobody to hand the clip to
-            if done % step == 0 or done == total:
+            if done == 1 or done % step == 0 or done == total:
                 with contextlib.suppress(Exception):
                     self._set_progress(100.0 * done / total)
                 show(f"Rendering the video: frame {done} of {total} …")
