@@ -118,6 +118,15 @@ def test_the_projector_keeps_a_compact_legend_and_t(poinsot_app, open_page):
     assert page.errors == []
 
 
+#: The phone's bottom sheet, and its box [CSS px] (null before the page has laid it out).
+SHEET = '.mantine-Paper-root[style*="bottom: 0px"]'
+SHEET_BOX_JS = f"""() => {{
+  const e = document.querySelector('{SHEET}');
+  if (!e) return null;
+  const r = e.getBoundingClientRect();
+  return {{x: r.x, width: r.width, height: r.height}};
+}}"""
+
 #: The touch targets of the page laid out (in the sheet, scrolled to or not) [CSS px high].
 TARGETS_JS = """() => {
   const kinds = {
@@ -140,28 +149,32 @@ def test_a_phone_s_sheet_is_full_width_with_t_and_the_regime_and_44_px_targets(
     page = open_device(open_page, poinsot_app.url, "phone-portrait")
     session = session_of(poinsot_app, timeout=60)
     assert wait_until(lambda: session.layout is not None and session.layout.compact, 30)
-    sheet = page.page.locator('.mantine-Paper-root[style*="bottom: 0px"]').first
-    box = sheet.bounding_box()
-    assert box is not None and box["x"] == 0 and box["width"] == 390, box
+    sheet = page.page.locator(SHEET).first
+    box: dict[str, float] | None = None
+
+    def full_width() -> bool:  # once the page has laid out the compact layout the server sent
+        nonlocal box
+        box = page.page.evaluate(SHEET_BOX_JS)
+        return box is not None and box["x"] == 0 and box["width"] == 390
+
+    assert wait_until(full_width, 20), box
     # The header: t and the regime, as the server last wrote them.
     header = re.compile(r"t = \d+\.\d · polhode around the major axis")
     assert wait_until(lambda: header.fullmatch(session.layout.header) is not None, 20)
     assert wait_until(lambda: header.search(sheet.inner_text()) is not None, 20)
     # Opened: every target a finger meets is 44 px tall, the Preset menu's rows too.
     page.page.get_by_text(header).first.click()
-    assert wait_until(lambda: sheet.bounding_box()["height"] > 200, 20)
+    assert wait_until(lambda: page.page.evaluate(SHEET_BOX_JS)["height"] > 200, 20)
     targets = page.page.evaluate(TARGETS_JS)
     assert targets["button"] and targets["slider"] and targets["field"], targets
     for kind, heights in targets.items():
         assert all(h >= TOUCH_TARGET_PX - 0.5 for h in heights), (kind, heights)
     page.page.locator(f"[id='{page.widget_id('Preset')}']").click()
-    options = page.page.get_by_role("option")
-    options.first.wait_for()
     rows: list[float] = []
 
     def listed() -> bool:  # the menu's rows, once it has laid them out (it opens animated)
         nonlocal rows
-        rows = [box["height"] for box in (o.bounding_box() for o in options.all()) if box]
+        rows = page.page.evaluate(TARGETS_JS)["option"]  # one read of them all, none waited for
         return len(rows) >= 5
 
     assert wait_until(listed, 10), rows
