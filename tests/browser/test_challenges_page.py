@@ -51,7 +51,7 @@ def _answer(page: BrowserPage, folder, c: Challenge) -> None:
 
 def test_each_challenge_keeps_its_secret_until_answered(make_app, open_page) -> None:
     app = make_app()
-    page = open_page(app.url, width=1280, height=800)
+    page = open_page(app.url, width=1280, height=800, live_view=False)  # reads no pixels
     session = session_of(app)
     assert wait_until(lambda: session.stats.frames > 20, 20)
     folder = session.lecture.challenges

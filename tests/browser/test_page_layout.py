@@ -146,7 +146,7 @@ TARGETS_JS = """() => {
 def test_a_phone_s_sheet_is_full_width_with_t_and_the_regime_and_44_px_targets(
     poinsot_app, open_page
 ):
-    page = open_device(open_page, poinsot_app.url, "phone-portrait")
+    page = open_device(open_page, poinsot_app.url, "phone-portrait", live_view=False)
     session = session_of(poinsot_app, timeout=60)
     assert wait_until(lambda: session.layout is not None and session.layout.compact, 30)
     sheet = page.page.locator(SHEET).first

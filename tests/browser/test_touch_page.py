@@ -57,11 +57,11 @@ _RAIL_TITLES_JS = f"""() => [...document.querySelectorAll('{RAIL_TITLE}')]
   .map((e) => [e.textContent, e.scrollHeight > e.clientHeight + 1])"""
 
 
-def open_device(open_page, url: str, device: str) -> BrowserPage:
+def open_device(open_page, url: str, device: str, live_view: bool = True) -> BrowserPage:
+    """A page as ``device`` shows it (``live_view``: as :func:`conftest.open_page`'s)."""
     width, height, agent = DEVICES[device]
-    return open_page(
-        url, width, height, has_touch=True, is_mobile=True, user_agent=agent, device_scale_factor=1
-    )
+    options = {"has_touch": True, "is_mobile": True, "user_agent": agent, "device_scale_factor": 1}
+    return open_page(url, width, height, live_view=live_view, **options)
 
 
 def screen_point(session: Session, page: BrowserPage, point: np.ndarray) -> tuple[float, float]:
