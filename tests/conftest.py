@@ -614,6 +614,13 @@ NO_MSAA_JS = """(() => {
 })();"""
 
 
+#: The longest a page may take to open, its 3D view shown [s]: a bound for a failure, not a
+#: wait. Opening a page costs Chromium 4 to 5 CPU-s (viser's client unpacks and compiles its
+#: script, software WebGL starts): about 3 s alone, but 20 s were not enough once beside two
+#: busy loops and three other workers on 2 cores.
+PAGE_OPEN_S = 90
+
+
 FRAMES_DRAWN_JS = """() => {
   const points = window.__viserTestpoints;
   return points ? points.rendererInfo.render.frame : 0;
@@ -649,10 +656,10 @@ def _page_opener(chromium) -> Iterator[Callable[..., BrowserPage]]:
         )
         page.on("pageerror", lambda e: errors.append(f"pageerror: {e}"))
         page.goto(url)
-        page.locator("canvas").first.wait_for(state="visible", timeout=20000)
+        page.locator("canvas").first.wait_for(state="visible", timeout=PAGE_OPEN_S * 1000)
         if not live_view:  # loudly, if viser's page is no longer laid out as assumed
             parked = "() => window.__poinsotPark()"
-            assert wait_until(lambda: page.evaluate(parked), 20), "the 3D view was not parked"
+            assert wait_until(lambda: page.evaluate(parked), PAGE_OPEN_S), "not parked"
         return BrowserPage(page, errors)
 
     try:
