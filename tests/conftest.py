@@ -199,11 +199,21 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 
 # -- servers and probes ------------------------------------------------------------------
+#: The most frames a second a test's server sends each browser or probe [frames/s] (``make``'s
+#: default; a test whose figures are shares of the server's own frames passes
+#: ``max_fps=MAX_FPS``). At the server's default, 60, a parked page of a playing session costs
+#: the machine 0.62 core (Chromium takes and applies every frame's messages; the server draws
+#: them); at 30, 0.34; at 15, 0.26 (10 s of one page, the whole machine's CPU). Tests wait for
+#: frames counted or for events, so fewer a second only spaces them out.
+TEST_MAX_FPS = 20.0
+
+
 @contextlib.contextmanager
 def _app_maker() -> Iterator[Callable[..., PoinsotApp]]:
     apps: list[PoinsotApp] = []
 
     def make(preset: Preset = DEFAULT_PRESET, **kwargs) -> PoinsotApp:
+        kwargs.setdefault("max_fps", TEST_MAX_FPS)
         app = PoinsotApp("127.0.0.1", 0, preset=preset, **kwargs)
         apps.append(app)
         return app

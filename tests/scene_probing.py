@@ -19,6 +19,7 @@ from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.construction.sampled.frames import xyzw_from_wxyz
 from poinsot.app.devtools.probe import Node, Probe
 from poinsot.app.live.server import PoinsotApp
+from poinsot.app.live.session.builder import MAX_FPS
 from poinsot.app.live.session.session import Session
 from poinsot.app.model.elements import Element
 
@@ -29,8 +30,9 @@ CONSTRUCTION_TRAILS = ("/space/body/polhode", "/space/herpolhode")
 
 
 def start(make_app, make_probe, spec) -> tuple[PoinsotApp, Session, Probe]:
-    """A server whose browsers start with scene ``spec``, a probe on it, once it has drawn."""
-    app = make_app(scene=spec)
+    """A server whose browsers start with scene ``spec``, a probe on it, once it has drawn; at
+    the server's own frame rate (a scene's time grid is a share of a frame's time)."""
+    app = make_app(scene=spec, max_fps=MAX_FPS)
     probe = make_probe(app)
     session = session_of(app)
     assert wait_until(lambda: session.running and session.stats.frames > 3, 30), "no frames"

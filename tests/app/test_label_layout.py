@@ -17,6 +17,7 @@ from poinsot.app.construction.construction import TRAIL_EVERY, PoinsotScene
 from poinsot.app.construction.labels import layout as labels
 from poinsot.app.construction.labels.layout import Camera, finish
 from poinsot.app.live.lecture import display
+from poinsot.app.live.session.builder import MAX_FPS
 from poinsot.app.live.session.session import PLOT_MIN_FRAMES
 from poinsot.app.model.parameters import Parameters
 from poinsot.app.model.presets import DEFAULT_PRESET
@@ -136,11 +137,14 @@ def test_a_layout_outdated_by_a_new_body_sends_nothing(scene_and_sent):
 
 
 @pytest.mark.serial  # the plot samples by the clock and sends by frames: it needs the frame rate
-def test_a_frame_carries_at_most_one_of_traces_plot_and_a_layout_step(poinsot_app, probe):
+def test_a_frame_carries_at_most_one_of_traces_plot_and_a_layout_step(make_app, make_probe):
     """In a live session, per frame drawn: at most one step of the labels' layout, and never
     with the traces or the plot on the same frame; layouts still complete, in five steps, and
-    the traces and the plot keep their rates."""
-    session = session_of(poinsot_app)
+    the traces and the plot keep their rates (at the server's own frame rate: the rates are
+    shares of its frames)."""
+    app = make_app(max_fps=MAX_FPS)
+    make_probe(app)
+    session = session_of(app)
     display, motion = session.lecture.display, session.panel.motion
     frames: list[set[str]] = []
     current: set[str] = set()
