@@ -16,7 +16,14 @@ import re
 
 import numpy as np
 import pytest
-from conftest import FRAME_CAP_JS, NO_MSAA_JS, lecture_of, session_of, wait_until
+from conftest import (
+    FRAME_CAP_JS,
+    NO_MSAA_JS,
+    PAGE_OPEN_S,
+    lecture_of,
+    session_of,
+    wait_until,
+)
 from PIL import Image
 
 from poinsot.app.construction.cameras import BODY_VIEW, ride_along
@@ -97,7 +104,7 @@ def test_html_export_plays_from_a_file_url_without_any_server(chromium, tmp_path
         page.on("pageerror", lambda e: errors.append(str(e)))
         page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
         page.goto(path.as_uri())
-        page.locator("canvas").first.wait_for(state="visible", timeout=30000)
+        page.locator("canvas").first.wait_for(state="visible", timeout=PAGE_OPEN_S * 1000)
         assert wait_until(
             lambda: amber_fraction(without_notice(page, screenshot_rgb(page))) > MIN_AMBER,
             30,

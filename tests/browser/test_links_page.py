@@ -16,7 +16,7 @@ from poinsot.app.live.landing import Balancer, LandingServer
 from poinsot.app.live.server import PoinsotApp
 from poinsot.app.model.presets import DEFAULT_PRESET, preset_by_key
 from tests.app.test_nginx import balancer  # noqa: F401 (the guide's nginx, a fixture)
-from tests.conftest import BrowserPage, session_of, wait_until
+from tests.conftest import PAGE_OPEN_S, BrowserPage, session_of, wait_until
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
@@ -146,7 +146,7 @@ def reopen(page: BrowserPage, url: str) -> BrowserPage:
     """Open ``url`` in the same page (its session leaves, a new one comes): the viser client
     comes from the page's cache, and one page renders at a time (software WebGL is slow)."""
     page.page.goto(url)
-    page.page.locator("canvas").first.wait_for(state="visible", timeout=20000)
+    page.page.locator("canvas").first.wait_for(state="visible", timeout=PAGE_OPEN_S * 1000)
     return page
 
 
