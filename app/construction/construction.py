@@ -111,6 +111,9 @@ class PoinsotScene:
         self._pending: list[tuple[FrameBatch, int, int, bool]] = []
         self._frames_since_flush = 0
         self._sent_traces = False  # by the last advance()
+        #: False: a frame leaves its three pose messages to another sender (a follower's poses,
+        #: encoded once for all the followers of a process: live/classroom/cast.py).
+        self.send_pose = True
         self._label_epoch = 0  # a layout begun before a change of it sends nothing
         self._look: Look = palette.DARK
         #: Called with each drawing made (a pointer binds its callbacks to the ellipsoid's).
@@ -309,6 +312,12 @@ class PoinsotScene:
         sampler = self.sampler
         return sampler.time(sampler.index(t)) if sampler else float(t)
 
+    def pose_nodes(self) -> tuple[str, str, str | None]:
+        """The names of the nodes a frame poses: the body frame, the tip, the ω arrow (if
+        drawn)."""
+        arrow = self._omega_arrow
+        return self.body_frame.name, self.tip.name, None if arrow is None else arrow.name
+
     @property
     def sampler(self) -> MotionSampler | None:
         return None if self._motion is None else self._motion.sampler
@@ -359,14 +368,16 @@ class PoinsotScene:
                 trail.clear()
             self._pending.clear()
         frame = batch.frame(i, j)
-        updates.set_wxyz(self.body_frame, frame.wxyz)
-        updates.set_position(self.tip, frame.contact)
-        if self._omega_arrow is not None:
-            updates.set_points(self._omega_arrow, batch.arrow[j])
+        if self.send_pose:
+            updates.set_wxyz(self.body_frame, frame.wxyz)
+            updates.set_position(self.tip, frame.contact)
+            if self._omega_arrow is not None:
+                updates.set_points(self._omega_arrow, batch.arrow[j])
         if self._trails:
             self._pending.append((batch, i, j + 1, restart))
         self._frames_since_flush += 1
-        if restart or self._frames_since_flush >= TRAIL_EVERY:
+        # A frame without the pose is one of a follower's few own frames: its traces go at once.
+        if restart or self._frames_since_flush >= TRAIL_EVERY or not self.send_pose:
             self.flush_trails()
         self._k_last = k
         self._frame = frame

@@ -55,7 +55,8 @@ class Batch:
     names: list[str]
 
 
-def _decode_frame(frame: bytes) -> list[dict[str, Any]]:
+def decode_frame(frame: bytes) -> list[dict[str, Any]]:
+    """The messages of one websocket frame, as viser's client decodes them."""
     inner_len = int.from_bytes(frame[0:8], "little")
     compressed_len = int.from_bytes(frame[8:16], "little")
     inner = zstandard.ZstdDecompressor().decompress(
@@ -106,6 +107,7 @@ class Probe:
         self.messages_received = 0
         self._cond = threading.Condition()
         self._listeners: list[Callable[[dict[str, Any], float], None]] = []
+        self._raw_listeners: list[Callable[[bytes], None]] = []
         self._ws = websockets.sync.client.connect(
             self.uri,
             subprotocols=[websockets.Subprotocol(f"viser-v{viser.__version__}")],
@@ -231,6 +233,11 @@ class Probe:
         """``listener(message, arrival_time)`` for every decoded message (receiver thread)."""
         self._listeners.append(listener)
 
+    def add_raw_listener(self, listener: Callable[[bytes], None]) -> None:
+        """``listener(frame)`` for every websocket frame as it came, before it is decoded
+        (receiver thread)."""
+        self._raw_listeners.append(listener)
+
     def _receive(self) -> None:
         try:
             while True:
@@ -238,7 +245,9 @@ class Probe:
                 frame = self._ws.recv()
                 now = time.perf_counter()
                 assert isinstance(frame, bytes)
-                messages = _decode_frame(frame)
+                for raw in self._raw_listeners:
+                    raw(frame)
+                messages = decode_frame(frame)
                 with self._cond:
                     self.bytes_received += len(frame)
                     self.messages_received += len(messages)

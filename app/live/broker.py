@@ -1,11 +1,12 @@
 """Following across hosts: the lead's messages through one Redis (``poinsot serve --redis URL``).
 
-Every server process (each worker of every host) links its hub (:class:`~.ui.follow.FollowHub`)
-to one Redis channel with :class:`RedisLink`: what its hub sends (its lead's "lead", "state" and
-"gone") is published there, and what the other processes publish is delivered to its hub, so
-that one lead is followed on every host. Pub/sub, not a stream: a follower needs only the newest
-state, the lead publishes its state again every quarter second (``lead.REPUBLISH``), so a
-message lost while a host reconnects is superseded at once, and nothing accumulates in Redis.
+Every server process (each worker of every host) links its hub
+(:class:`~.classroom.follow.FollowHub`) to one Redis channel with :class:`RedisLink`: what its hub
+sends (its lead's "lead", "state" and "gone") is published there, and what the other processes
+publish is delivered to its hub, so that one lead is followed on every host. Pub/sub, not a stream:
+a follower needs only the newest state, the lead publishes its state again every quarter second
+(``lead.REPUBLISH``), so a message lost while a host reconnects is superseded at once, and nothing
+accumulates in Redis.
 
 - The channel carries only the hub's messages, as JSON (:func:`encode`); a received one is
   parsed and validated field by field (:func:`decode`) and refused and counted

@@ -1,12 +1,11 @@
 """The lead's state between the workers of ``poinsot serve --workers N``.
 
 Each worker holds one end of a duplex :func:`multiprocessing.Pipe` (its "feed"), the parent the
-other. A worker's hub (:class:`~.ui.follow.FollowHub`) sends its lead's messages up its feed; the
-parent's :class:`Relay` passes each one to every other worker, in the order it came, and a
-reader thread in each worker delivers them to its hub. A worker whose feed closes (it ended,
-even by ``kill -9``) while it held the lead: the relay tells the others that the lead is gone.
-Within one host only (pipes between the processes of one machine).
-"""
+other. A worker's hub (:class:`~.classroom.follow.FollowHub`) sends its lead's messages up its feed;
+the parent's :class:`Relay` passes each one to every other worker, in the order it came, and a
+reader thread in each worker delivers them to its hub. A worker whose feed closes (it ended, even by
+``kill -9``) while it held the lead: the relay tells the others that the lead is gone. Within one
+host only (pipes between the processes of one machine)."""
 
 from __future__ import annotations
 

@@ -73,13 +73,13 @@ class PoinsotApp:
         that leaves more than ``backlog`` untaken for longer than its grace is disconnected
         (:mod:`.hardening.backlog`; its defaults if None). ``landing_port``: a landing in front of
         this server (:mod:`.landing`), named by the links copied from the pages served here.
-        ``follow``: the lead and its followers (:mod:`.ui.follow`; this server's alone, with a
-        new lecturer code, if None)."""
+        ``follow``: the lead and its followers (:mod:`.classroom.follow`; its own if None)."""
         self.preset = preset
         self.scene = scene
         self.landing_port = landing_port
-        #: The lecturer code, the lead and its followers (:mod:`.ui.follow`).
+        #: The lecturer code, the lead and its followers (:mod:`.classroom.follow`).
         self.follow = follow if follow is not None else FollowHub()
+        self.follow.cast.fps = min(self.follow.cast.fps, max_fps)  # the followers' poses too
         self.max_fps = max_fps
         self._lock, self._stopping = threading.Lock(), threading.Event()  # set by stop()
         self._sessions: dict[int, Session] = {}
@@ -224,6 +224,7 @@ class PoinsotApp:
 
     def stop(self) -> None:
         self._stopping.set()
+        self.follow.cast.close()
         self.backlog.stop()
         self.memory.stop()
         for session in self.sessions().values():

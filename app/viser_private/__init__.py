@@ -70,6 +70,13 @@ Inventory (section, private name, what it is used for):
     ``_background_event_loop``: a client's socket and its loop (the pacer's unacknowledged
     bytes, the backlog watch).
 
+*Window* (:mod:`poinsot.app.viser_private.window`)
+  - ``viser.infra._infra._message_producer``'s wire format (its ``_append_aligned_buffers``,
+    ``Message.as_serializable_dict``, zstd level 1): a window of messages encoded once and
+    written to many clients' connections (the followers' shared frames), each with websockets'
+    public ``ServerConnection.send`` as a task on its loop (:func:`encode_window`,
+    :class:`WindowSocket`, :func:`send_each`).
+
 *Messages*
   - ``viser._messages``: the client-to-server message classes whose fields
     :data:`ALLOWED` mirrors (names and order checked by :func:`check`), and ``ShareUrlRequest``
@@ -122,6 +129,9 @@ from poinsot.app.viser_private.scene import (
     NODE_FIELDS,
     cache_property_hints,
     node_state,
+    orientation_message,
+    position_message,
+    props_message,
     queue_orientation,
     queue_position,
     queue_props,
@@ -141,6 +151,7 @@ from poinsot.app.viser_private.transport import (
     set_on_its_loop_only,
 )
 from poinsot.app.viser_private.version import VISER_SERIES, ViserChanged
+from poinsot.app.viser_private.window import WindowSocket, encode_window, send_each
 
 __all__ = [
     "ALLOWED",
@@ -189,6 +200,12 @@ __all__ = [
     "hooked_server",
     "message_type",
     "page_address",
+    "WindowSocket",
+    "encode_window",
+    "send_each",
+    "orientation_message",
+    "position_message",
+    "props_message",
 ]
 
 

@@ -4,8 +4,9 @@
 - :func:`node_state`: a handle's server-side state (``handle._impl``: ``name``, ``wxyz``,
   ``position``, ``props``, ``removed``, ``api``);
 - :func:`queue_orientation`, :func:`queue_position`, :func:`queue_props`: the message a
-  setter queues, put on the scene API's queue (``SceneApi._queue_scene_message``) without the
-  setter's comparison;
+  setter queues (:func:`orientation_message`, :func:`position_message`,
+  :func:`props_message`), put on the scene API's queue (``SceneApi._queue_scene_message``)
+  without the setter's comparison;
 - :func:`cache_property_hints`: ``AssignablePropsBase._prop_hints`` (a per-instance
   ``functools.cached_property``) replaced by a property cached per properties class.
 """
@@ -28,19 +29,34 @@ def node_state(handle: viser.SceneNodeHandle) -> Any:
     return handle._impl
 
 
+def orientation_message(name: str, wxyz: tuple[float, float, float, float]) -> Any:
+    """The message ``handle.wxyz = wxyz`` queues for the node ``name``."""
+    return _messages.SetOrientationMessage(name, wxyz)
+
+
+def position_message(name: str, position: tuple[float, float, float]) -> Any:
+    """The message ``handle.position = position`` queues for the node ``name``."""
+    return _messages.SetPositionMessage(name, position)
+
+
+def props_message(name: str, updates: dict[str, Any]) -> Any:
+    """The message setting the properties ``updates`` on the node ``name`` queues."""
+    return _messages.SceneNodeUpdateMessage(name, updates)
+
+
 def queue_orientation(node: Any, wxyz: tuple[float, float, float, float]) -> None:
     """Queue the message that ``handle.wxyz = wxyz`` queues (``node``: :func:`node_state`)."""
-    node.api._queue_scene_message(_messages.SetOrientationMessage(node.name, wxyz))
+    node.api._queue_scene_message(orientation_message(node.name, wxyz))
 
 
 def queue_position(node: Any, position: tuple[float, float, float]) -> None:
     """Queue the message that ``handle.position = position`` queues."""
-    node.api._queue_scene_message(_messages.SetPositionMessage(node.name, position))
+    node.api._queue_scene_message(position_message(node.name, position))
 
 
 def queue_props(node: Any, updates: dict[str, Any]) -> None:
     """Queue the message that setting the properties ``updates`` on the handle queues."""
-    node.api._queue_scene_message(_messages.SceneNodeUpdateMessage(node.name, updates))
+    node.api._queue_scene_message(props_message(node.name, updates))
 
 
 @functools.cache

@@ -16,8 +16,8 @@ from poinsot.app.live.hardening.pacing import (
     MAX_UNACKED,
     MIN_FPS,
     Pacer,
+    next_due,
 )
-from poinsot.app.live.session.frame_loop import next_due
 from poinsot.app.model.parameters import Parameters
 from poinsot.app.model.presets import DEFAULT_PRESET
 

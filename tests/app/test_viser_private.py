@@ -288,3 +288,73 @@ _HAND_BUILT = (
     "FileTransferPartAck",
     "GuiSliderMark",
 )
+
+
+# -- window (poinsot.app.viser_private.window) -------------------------------------------------
+def _viser_s_own_window(messages: list) -> bytes:
+    """The bytes viser's send task writes for ``messages`` queued at once (its producer run on
+    a loop of its own, against a socket that records what it is sent)."""
+    from viser.infra import _infra
+    from viser.infra._async_message_buffer import AsyncMessageBuffer
+
+    sent: list[bytes] = []
+
+    async def produce() -> None:
+        buffer = AsyncMessageBuffer(asyncio.get_running_loop(), persistent_messages=False)
+        buffer.atomic_start()
+        for message in messages:
+            buffer.push(message)
+        buffer.atomic_end()
+
+        class Socket:
+            async def send(self, data: bytes) -> None:
+                sent.append(data)
+                buffer.set_done()
+
+        buffer.flush()
+        await _infra._message_producer(Socket(), buffer, client_id=0)  # type: ignore[arg-type]
+
+    asyncio.run(produce())
+    assert len(sent) == 1, WRITTEN_FOR
+    return sent[0]
+
+
+def test_a_window_encoded_once_is_the_window_viser_sends():
+    import msgspec
+    import numpy as np
+    import zstandard
+
+    from poinsot.app.devtools.probe import decode_frame
+
+    points = np.arange(18, dtype=np.float32).reshape(3, 2, 3)
+    messages = [
+        viser_private.orientation_message("/space/body", (1.0, 0.0, 0.0, 0.0)),
+        viser_private.position_message("/space/tip", (0.1, 0.2, 0.3)),
+        viser_private.props_message("/space/omega", {"points": points}),
+    ]
+    ours, theirs = viser_private.encode_window(messages), _viser_s_own_window(messages)
+
+    def header(frame: bytes) -> tuple[int, int]:
+        return int.from_bytes(frame[:8], "little"), int.from_bytes(frame[8:16], "little")
+
+    # The same msgpack size (the compressed size may differ by a byte: the timestamps differ).
+    assert header(ours)[0] == header(theirs)[0], WRITTEN_FOR
+
+    # The same messages, the same binary layout (only viser's timestamp differs).
+    def inner(frame: bytes) -> dict:
+        payload = zstandard.ZstdDecompressor().decompress(
+            frame[16 : 16 + header(frame)[1]], max_output_size=header(frame)[0]
+        )
+        decoded = msgspec.msgpack.decode(payload)
+        decoded.pop("timestampSec")
+        return decoded
+
+    assert inner(ours) == inner(theirs), WRITTEN_FOR
+    decoded = decode_frame(ours)
+    assert [m["type"] for m in decoded] == [
+        "SetOrientationMessage",
+        "SetPositionMessage",
+        "SceneNodeUpdateMessage",
+    ]
+    np.testing.assert_array_equal(decoded[2]["updates"]["points"], points.ravel())
+    assert ours[-points.nbytes :] == theirs[-points.nbytes :] == points.tobytes()

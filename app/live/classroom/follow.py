@@ -28,6 +28,7 @@ from collections.abc import Callable
 from typing import Any
 
 from poinsot.app.construction.sampled.motion import MotionCache
+from poinsot.app.live.classroom.cast import FollowCast
 
 #: Wrong codes from one client before its connection is closed.
 MAX_WRONG_CODES = 5
@@ -96,6 +97,8 @@ class FollowHub:
         self.motions = MotionCache()
         #: The lead's scenes (their models and motions), built once for this process's followers.
         self.scenes = MotionCache()
+        #: The followers' poses, encoded once for all of them (:mod:`.cast`).
+        self.cast = FollowCast(self.now)
 
     # -- the lead ------------------------------------------------------------------------
     def claim(self, lead: Any, code: str, client_key: int) -> Claim:

@@ -141,6 +141,17 @@ class PacerStats:
     max_in_flight: int = 0
 
 
+def next_due(due: float, now: float, step: float) -> float:
+    """When the frame after one due at ``due`` and drawn at ``now`` is due, ``step`` [s]
+    apart: on the cadence (a frame drawn a little late, after a rebuild or a wait for the
+    interpreter, is followed by one a little early, so the rate holds), but never sooner than
+    half a step after it, and from ``now`` if it was a whole step late (never a burst of
+    frames to catch up). Always at least ``step`` after ``due``."""
+    if now - due >= step:
+        return now + step
+    return max(due + step, now + 0.5 * step)
+
+
 class Pacer:
     """A client's frame rate (see the module's docstring). Frame thread only."""
 
@@ -158,13 +169,18 @@ class Pacer:
         self.max_in_flight = int(max_in_flight)
         self.max_unacked = int(max_unacked)
         self.fps = self.max_fps
+        #: A lower cap on the frame rate, whatever ``max_fps`` is (None: none): a follower
+        #: whose poses the process's cast sends draws its own frames at this rate
+        #: (:mod:`..classroom.cast`).
+        self.cap: float | None = None
         self.stats = PacerStats()
         self._marks: collections.deque[int] = collections.deque()
 
     @property
     def interval(self) -> float:
         """Seconds to the next frame at the client's current rate."""
-        return 1.0 / self.fps
+        cap = self.cap
+        return 1.0 / (self.fps if cap is None else min(self.fps, cap))
 
     def in_flight(self) -> int:
         """Frames drawn whose messages the client has not all taken yet."""

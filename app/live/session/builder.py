@@ -14,9 +14,11 @@ import dataclasses
 
 import viser
 
+from poinsot.app.construction.cameras import RIDE_ALONG
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.view import DEFAULT_VIEW, View, apply_theme
 from poinsot.app.lessons.support.spec import SceneSpec
+from poinsot.app.live.classroom.cast import SharedFrames
 from poinsot.app.live.classroom.follow import FollowHub
 from poinsot.app.live.classroom.lead import LeadControls
 from poinsot.app.live.hardening.budget import RebuildGate
@@ -82,6 +84,7 @@ class Core:
     retirement: Retirement
     frames: FrameWork
     loop: FrameLoop
+    shared: SharedFrames
 
 
 @dataclasses.dataclass(frozen=True)
@@ -168,23 +171,9 @@ def _frame_thread(
     options: SessionOptions,
 ) -> Core:
     """The frame thread's work and loop (made last: the front wakes it from then on)."""
-    client, build, lecture = front.client, choice.build, tools.lecture
+    client, build = front.client, choice.build
     pacer = Pacer(Outbox(client), max_fps=options.max_fps)
-    refresh = Refresh(panel.motion, retirement)
-    frames = FrameWork(
-        client,
-        pacer=pacer,
-        queue=front.queue,
-        status=front.status,
-        choice=choice,
-        source=source,
-        clock=front.clock,
-        refresh=refresh,
-        tools=(lecture, tools.ghost),
-        publish=tools.follow,
-        laid_out=lambda: lecture.display.laid_out_now,
-        header=tools.layout.show_header,
-    )
+    frames = _frame_work(front, panel, choice, source, retirement, tools, pacer)
     loop = FrameLoop(
         f"poinsot-session-{client.client_id}",
         pacer=pacer,
@@ -195,7 +184,7 @@ def _frame_thread(
         draw=lambda now: frames.draw(now),  # looked up late: tests wrap it
         report=front.status.report,
     )
-    front.wake = loop.wake
+    front.wake, frames.shared.draw_now = loop.wake, loop.draw_now
     return Core(
         client=client,
         front=front,
@@ -207,10 +196,41 @@ def _frame_thread(
         playback=build.playback,
         build=build,
         choice=choice,
-        refresh=refresh,
+        refresh=frames.refresh,
         retirement=retirement,
         frames=frames,
         loop=loop,
+        shared=frames.shared,
+    )
+
+
+def _frame_work(
+    front: Front,
+    panel: ControlPanel,
+    choice: Choice,
+    source: MotionSource,
+    retirement: Retirement,
+    tools: Tools,
+    pacer: Pacer,
+) -> FrameWork:
+    """What the frame thread does, and the parts it drives that no one else holds (the
+    refreshes at their rates; a follower's side of the process's cast)."""
+    lecture = tools.lecture
+    return FrameWork(
+        front.client,
+        pacer=pacer,
+        queue=front.queue,
+        status=front.status,
+        choice=choice,
+        source=source,
+        clock=front.clock,
+        refresh=Refresh(panel.motion, retirement),
+        tools=(lecture, tools.ghost),
+        publish=tools.follow,
+        laid_out=lambda: lecture.display.laid_out_now,
+        header=tools.layout.show_header,
+        shared=SharedFrames(tools.follow.hub.cast, front.client, pacer, front.scene),
+        own_view=lambda: lecture.camera == RIDE_ALONG or tools.ghost.wanted.enabled,
     )
 
 

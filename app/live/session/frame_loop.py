@@ -1,6 +1,7 @@
 """One session's frame thread: it wakes at its client's frame time (or when an action is
 posted), runs the session's queued work, and draws a frame if the browser has taken the one
-before (:class:`~..hardening.pacing.Pacer`). Frames are due on a cadence (:func:`next_due`): a
+before (:class:`~..hardening.pacing.Pacer`). Frames are due on a cadence
+(:func:`~..hardening.pacing.next_due`): a
 frame drawn late shortens the wait for the next, so that the rate is the pacer's, not the
 pacer's less the frames' own delays.
 
@@ -16,22 +17,11 @@ import time
 from collections.abc import Callable
 
 from poinsot.app.live.hardening.budget import RebuildGate
-from poinsot.app.live.hardening.pacing import Pacer, SessionStats
+from poinsot.app.live.hardening.pacing import Pacer, SessionStats, next_due
 
 #: While another session rebuilds, a due frame is held until the rebuild ends, for at most
 #: HOLD_SECONDS [s].
 HOLD_SECONDS = 0.05
-
-
-def next_due(due: float, now: float, step: float) -> float:
-    """When the frame after one due at ``due`` and drawn at ``now`` is due, ``step`` [s]
-    apart: on the cadence (a frame drawn a little late, after a rebuild or a wait for the
-    interpreter, is followed by one a little early, so the rate holds), but never sooner than
-    half a step after it, and from ``now`` if it was a whole step late (never a burst of
-    frames to catch up). Always at least ``step`` after ``due``."""
-    if now - due >= step:
-        return now + step
-    return max(due + step, now + 0.5 * step)
 
 
 class FrameLoop:
@@ -57,6 +47,7 @@ class FrameLoop:
         self.max_fps = float(max_fps)
         self._work, self._draw, self._report = work, draw, report
         self._wake, self._stop = threading.Event(), threading.Event()
+        self._due_now = False
         self.thread: threading.Thread | None = None
 
     def start(self) -> None:
@@ -67,6 +58,11 @@ class FrameLoop:
     def wake(self) -> None:
         """Run the work now rather than at the next frame time (any thread; never blocks)."""
         self._wake.set()
+
+    def draw_now(self) -> None:
+        """From the work (frame thread): the next frame is due at once, not at the rate's next
+        time (a follower whose frames the process's cast sent, drawing its own again)."""
+        self._due_now = True
 
     def close(self, timeout: float | None = None) -> None:
         """Stop the thread (never called from it). Safe to call twice."""
@@ -95,6 +91,8 @@ class FrameLoop:
             try:
                 self._work()
                 now = time.monotonic()
+                if self._due_now:  # the work asked for a frame now (:meth:`draw_now`)
+                    self._due_now, next_frame = False, min(next_frame, now)
                 if held and not self.budget.rebuilding:
                     next_frame = now  # the rebuild that held this frame is over
                 if now >= next_frame and now - due < HOLD_SECONDS and self.budget.hold(self._wake):

@@ -3,7 +3,9 @@ frame the queued actions and, if they asked for one, a rebuild; a frame, if the 
 taken the one before; after it the refreshes at their rates.
 
 The frame's time is the motion source's (:mod:`.source`: the session's own, or the lead's
-while following); each frame goes out in one atomic window, flushed at once.
+while following); each frame goes out in one atomic window, flushed at once. A follower whose
+frame is the lead's has its poses sent by the process's cast (:mod:`..classroom.cast`) and
+draws the rest of its frames (traces, labels, plot) at a low rate.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import viser
 
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.sampled.batch import Frame
+from poinsot.app.live.classroom.cast import SharedFrames, Source
 from poinsot.app.live.hardening.pacing import Pacer, SessionStats
 from poinsot.app.live.panel.clock import SimClock
 from poinsot.app.live.session.actions import ActionQueue
@@ -58,6 +61,8 @@ class FrameWork:
         publish: AfterFrame,
         laid_out: Callable[[], bool],
         header: Callable[[float, float], None],
+        shared: SharedFrames,
+        own_view: Callable[[], bool],
     ) -> None:
         self.client, self.pacer, self.queue, self.status = client, pacer, queue, status
         self.choice, self.build, self.source, self.clock = choice, choice.build, source, clock
@@ -66,6 +71,9 @@ class FrameWork:
         self.refresh, self.tools, self.publish = refresh, tools, publish
         self._laid_out = laid_out
         self._header = header  # (now, t): the page's header (a phone's sheet: t, the regime)
+        #: A follower's poses sent by the process's cast while its frame is the lead's;
+        #: ``own_view()``: the follower's view is its own (its ghost, a ride-along camera).
+        self.shared, self._own_view = shared, own_view
 
     def work(self) -> None:
         """Before each frame: the queued actions, then a rebuild if they asked for one (none
@@ -77,6 +85,17 @@ class FrameWork:
             self._drain()
             if self.build.dirty:
                 self.build.rebuild(self.choice.showcase)
+        self.shared.update(self._shared_source())
+
+    def _shared_source(self) -> Source | None:
+        """What the cast poses this follower from, if its frame is the lead's (a body, not a
+        lecture scene; the lead's state received; no rebuild pending; its view not its own);
+        None: its own frames."""
+        if not self.source.lead_known or self.choice.showcase is not None:
+            return None
+        if self.build.dirty or self._own_view():
+            return None
+        return Source.of(self.scene)
 
     def draw(self, now: float) -> bool:
         """Draw a frame, unless the browser has not yet taken the one before (:class:`Pacer`:

@@ -73,6 +73,8 @@ class Session:
             core.choice,
         )
         self.refresh, self.retirement = core.refresh, core.retirement
+        #: A follower's poses, sent by the process's cast (:mod:`..classroom.cast`).
+        self.shared = core.shared
         self.ghost, self.uploads, self.follow = tools.ghost, tools.uploads, tools.follow
         self.lecture, self.layout = tools.lecture, tools.layout
         self.pointer, self.sphere_pointer = tools.pointer, tools.sphere_pointer
@@ -85,6 +87,7 @@ class Session:
     def close(self, timeout: float | None = None) -> None:
         """Stop the frame thread (never called from it). Safe to call twice."""
         self.follow.close()
+        self.shared.leave()
         self.loop.close(timeout)
 
     @property

@@ -43,6 +43,11 @@ class MotionSource:
         """The lead's motion, not the session's own."""
         return self._following.mode == "follow"
 
+    @property
+    def lead_known(self) -> bool:
+        """Following, and the lead's state received (its time is the hub's)."""
+        return self.follows and self._following.hub.state is not None
+
     def now(self) -> float:
         """The frame's simulation time."""
         if self.follows:

@@ -1,0 +1,265 @@
+"""The followers' frames, encoded once per process: a follower's frame is the lead's frame.
+
+Every follower of a process draws the same motion (the hub's shared
+:class:`~poinsot.app.construction.sampled.motion.Motion`) at the same time (the hub's clock,
+:meth:`~.follow.FollowHub.now`), so a frame's three pose messages (the body frame's orientation,
+the tip's position, the ω arrow's points) are the same for all of them. :class:`FollowCast` (one
+per process, one thread) makes them once per frame and group of followers drawing the same
+motion on the same nodes, encodes and compresses them once as viser's own window
+(:func:`poinsot.app.viser_private.encode_window`), and hands the same bytes to each follower's
+socket (:func:`~poinsot.app.viser_private.send_each`).
+
+- A follower that falls behind is sent fewer frames, as a slow session is
+  (:mod:`..hardening.pacing`): a follower whose last window is not yet written, or with more than
+  ``MAX_UNACKED`` bytes of its own queue not acknowledged, is skipped this frame (counted), and
+  never holds the others (each socket's write is a task of its own on viser's loop).
+- What differs between followers stays each one's own, drawn by its own session at
+  :func:`own_fps`: the traces (its own history of the motion), the labels laid out for its own
+  camera, the ω plot and the time readout (widgets of its own page). The pose is then left out
+  of its frames (``PoinsotScene.send_pose``).
+- A follower whose frame is not the lead's falls back to its own frames at its own rate at once
+  (its session calls :meth:`SharedFrames.update` with None): the lead shows a lecture scene (its
+  frame is the scene's own drawing), the follower's ghost is on, its camera rides along with the
+  body, or its rebuild is pending. "Explore from here" leaves the cast the same way.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import threading
+import time
+from collections.abc import Callable, Hashable
+from typing import Any
+
+import numpy as np
+import viser
+
+from poinsot.app.construction.construction import PoinsotScene
+from poinsot.app.construction.sampled.motion import Motion
+from poinsot.app.live.hardening.pacing import MAX_UNACKED, Outbox, Pacer, next_due
+from poinsot.app.viser_private import (
+    WindowSocket,
+    encode_window,
+    orientation_message,
+    position_message,
+    props_message,
+    send_each,
+)
+
+log = logging.getLogger(__name__)
+
+#: The followers' shared frames a second (above a classroom's 30, with room to skip a few);
+#: never more than the server's own cap (:attr:`FollowCast.fps`).
+CAST_FPS = 40.0
+#: A shared follower's own frames a second (its traces, labels, plot and time readout), at most,
+#: and at least; a process's followers share OWN_PROCESS_FRAMES of them a second between them
+#: (:func:`own_fps`): each own frame costs about a session's frame, so their sum must not grow
+#: with the hall.
+OWN_FPS = 6.0
+OWN_MIN_FPS = 2.0
+OWN_PROCESS_FRAMES = 120.0
+
+
+def own_fps(members: int) -> float:
+    """Each shared follower's own frame rate when ``members`` share its process's cast."""
+    return min(OWN_FPS, max(OWN_MIN_FPS, OWN_PROCESS_FRAMES / max(members, 1)))
+
+
+@dataclasses.dataclass(frozen=True)
+class Source:
+    """What a follower's frame is drawn from: ``motion``, posing the nodes ``body``, ``tip``
+    and ``arrow`` (None: no ω arrow drawn)."""
+
+    motion: Motion
+    body: str
+    tip: str
+    arrow: str | None
+
+    @classmethod
+    def of(cls, scene: PoinsotScene) -> Source | None:
+        """The motion ``scene`` shows and the nodes it poses (None: no body loaded)."""
+        motion = scene.motion
+        if motion is None:
+            return None
+        return cls(motion, *scene.pose_nodes())
+
+    @property
+    def key(self) -> Hashable:
+        """Followers with the same key are sent the same bytes."""
+        return (id(self.motion), self.body, self.tip, self.arrow)
+
+    def messages(self, k: int) -> list[Any]:
+        """The frame at grid index ``k``: the messages the session's own frame would send
+        (``PoinsotScene.advance`` through ``construction/updates.py``), in the same order."""
+        batch = self.motion.frames(k, k)
+        j = k - batch.k0
+        q, p = batch.wxyz[j], batch.tip[j]
+        messages = [
+            orientation_message(self.body, (float(q[0]), float(q[1]), float(q[2]), float(q[3]))),
+            position_message(self.tip, (float(p[0]), float(p[1]), float(p[2]))),
+        ]
+        if self.arrow is not None:
+            points = np.array(batch.arrow[j], dtype=np.float32)
+            messages.append(props_message(self.arrow, {"points": points}))
+        return messages
+
+
+class Member:
+    """One follower in the cast: its socket, how far its client has taken its own queue, what
+    it shows (``source``, set by its session's thread) and the frame it was last sent."""
+
+    def __init__(self, client: viser.ClientHandle) -> None:
+        self.socket = WindowSocket(client)
+        self.outbox = Outbox(client)
+        self.source: Source | None = None
+        self.shown: tuple[Hashable, int] | None = None
+        self.skipped = 0
+
+    def ready(self) -> bool:
+        """Whether it may be sent a frame now (else it is skipped: the slow client's rule)."""
+        if self.socket.busy or self.outbox.closed():
+            return False
+        return self.outbox.unacknowledged() <= MAX_UNACKED
+
+
+class FollowCast:
+    """One per process (the hub's): :meth:`join` and :meth:`leave` from the sessions' threads;
+    its own thread draws, encodes and sends at ``fps`` while it has members."""
+
+    def __init__(self, now: Callable[[], float | None], fps: float = CAST_FPS) -> None:
+        self._now, self.fps = now, float(fps)
+        self._lock = threading.Lock()
+        self._members: dict[int, Member] = {}
+        self._wake, self._stop = threading.Event(), threading.Event()
+        self._thread: threading.Thread | None = None
+        #: Windows encoded, handed to sockets, and followers skipped (tests, load test).
+        self.encoded = 0
+        self.handed = 0
+        self.skipped = 0
+        #: The thread's CPU time [s] (load test).
+        self.cpu_seconds = 0.0
+        self._error = ""
+
+    def join(self, key: int, client: viser.ClientHandle) -> Member | None:
+        """``client`` is sent the shared frames from now on (None if its socket cannot be
+        reached: it keeps its own)."""
+        member = Member(client)
+        if not member.socket.usable:
+            return None
+        with self._lock:
+            self._members[key] = member
+            if self._thread is None:
+                self._thread = threading.Thread(target=self._run, name="poinsot-cast", daemon=True)
+                self._thread.start()
+        self._wake.set()
+        return member
+
+    def leave(self, key: int) -> None:
+        with self._lock:
+            self._members.pop(key, None)
+
+    @property
+    def members(self) -> int:
+        with self._lock:
+            return len(self._members)
+
+    def close(self) -> None:
+        self._stop.set()
+        self._wake.set()
+
+    def tick(self) -> int:
+        """One frame for every member: returns the windows encoded (one per group)."""
+        t = self._now()
+        if t is None:
+            return 0
+        with self._lock:
+            members = list(self._members.values())
+        groups: dict[Hashable, tuple[Source, list[Member]]] = {}
+        for member in members:
+            source = member.source
+            if source is not None:
+                groups.setdefault(source.key, (source, []))[1].append(member)
+        encoded = 0
+        for key, (source, group) in groups.items():
+            k = source.motion.sampler.index(t)
+            ready = [m for m in group if m.shown != (key, k) and self._ready(m)]
+            if ready:
+                data = encode_window(source.messages(k))
+                encoded += 1
+                self.handed += send_each([m.socket for m in ready], data)
+                for member in ready:
+                    member.shown = (key, k)
+        self.encoded += encoded
+        return encoded
+
+    def _ready(self, member: Member) -> bool:
+        if member.ready():
+            return True
+        member.skipped += 1
+        self.skipped += 1
+        return False
+
+    def _run(self) -> None:
+        due = time.monotonic()
+        while not self._stop.is_set():
+            with self._lock:
+                idle = not self._members
+            if idle:
+                self._wake.wait()
+                self._wake.clear()
+                due = time.monotonic()
+                continue
+            delay = due - time.monotonic()
+            if delay > 0:
+                self._stop.wait(delay)
+            cpu = time.thread_time()
+            try:
+                self.tick()
+            except Exception as exc:  # the thread must survive; said once per new error
+                message = f"{type(exc).__name__}: {exc}"
+                if message != self._error:
+                    self._error = message
+                    log.exception("followers' shared frames: %s", message)
+            self.cpu_seconds += time.thread_time() - cpu
+            due = next_due(due, time.monotonic(), 1.0 / self.fps)
+
+
+class SharedFrames:
+    """A session's side of the cast (its frame thread only): :meth:`update` after its work."""
+
+    def __init__(
+        self, cast: FollowCast, client: viser.ClientHandle, pacer: Pacer, scene: PoinsotScene
+    ) -> None:
+        self.cast, self.client, self.pacer, self.scene = cast, client, pacer, scene
+        #: Makes its frame loop's next frame due at once (set once the loop exists).
+        self.draw_now: Callable[[], None] = lambda: None
+        self.member: Member | None = None
+
+    @property
+    def shared(self) -> bool:
+        return self.member is not None
+
+    def update(self, source: Source | None) -> None:
+        """Join the cast with ``source``, or leave it at once (None)."""
+        if source is None:
+            self.leave()
+            return
+        member = self.member
+        if member is None:
+            member = self.member = self.cast.join(id(self), self.client)
+            if member is None:  # its socket cannot be reached: its own frames, as ever
+                return
+            self.scene.send_pose = False
+        self.pacer.cap = own_fps(self.cast.members)
+        member.source = source
+
+    def leave(self) -> None:
+        """Its own frames again, the next one at once, pose included."""
+        if self.member is None:
+            return
+        self.cast.leave(id(self))
+        self.member = None
+        self.scene.send_pose = True
+        self.pacer.cap = None
+        self.draw_now()

@@ -1,0 +1,184 @@
+"""The followers' frames encoded once per process (:mod:`poinsot.app.live.classroom.cast`).
+
+Probes stand for the browsers; every wait is on an event they receive or a count the server
+keeps, never on wall-clock time.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import threading
+
+import numpy as np
+
+from poinsot.app.devtools.probe import Probe, decode_frame
+from poinsot.app.live.classroom.cast import OWN_FPS, OWN_MIN_FPS, OWN_PROCESS_FRAMES, own_fps
+from tests.app.test_follow import _follow, _lead, _ready, _says, _set
+from tests.conftest import wait_until
+
+POSE = "/space/body"
+
+
+class Frames:
+    """The raw frames a probe receives that carry the body's pose, and their messages."""
+
+    def __init__(self, probe: Probe) -> None:
+        self.raw: list[bytes] = []
+        self._lock = threading.Lock()
+        probe.add_raw_listener(self._on_frame)
+
+    def _on_frame(self, frame: bytes) -> None:
+        messages = decode_frame(frame)
+        if any(m["type"] == "SetOrientationMessage" and m.get("name") == POSE for m in messages):
+            with self._lock:
+                self.raw.append(frame)
+
+    def since(self, start: int) -> list[bytes]:
+        with self._lock:
+            return self.raw[start:]
+
+    def __len__(self) -> int:
+        with self._lock:
+            return len(self.raw)
+
+
+def _class(app, make_probe, followers: int = 2):
+    lead = _ready(make_probe(app))
+    _lead(lead, app.follow.code)
+    probes = [_ready(make_probe(app)) for _ in range(followers)]
+    frames = [Frames(p) for p in probes]
+    for probe in probes:
+        _follow(probe)
+    sessions = sorted(app.sessions().values(), key=lambda s: s.client.client_id)[1:]
+    assert wait_until(lambda: all(s.shared.shared for s in sessions), 30), "never shared"
+    return lead, probes, frames, sessions
+
+
+def test_followers_of_one_worker_receive_byte_identical_frames(poinsot_app, make_probe):
+    _, probes, frames, sessions = _class(poinsot_app, make_probe)
+    cast = poinsot_app.follow.cast
+    starts = [len(f) for f in frames]
+    assert wait_until(
+        lambda: all(len(f) >= s + 20 for f, s in zip(frames, starts, strict=True)), 30
+    )
+    first, second = (set(f.since(s)) for f, s in zip(frames, starts, strict=True))
+    common = first & second
+    # The frames both received are the very same bytes (one encoding for both), and most are
+    # common: a frame one of them skipped (still writing the last) is the only difference.
+    assert len(common) >= 10, (len(first), len(second), len(common))
+    assert cast.encoded > 0 and cast.handed >= 2 * len(common)
+    # What they are: viser's own window of the body's pose, its tip and the ω arrow, which
+    # the probe (a decoder of viser's wire format) reads as any frame of a session's own.
+    messages = decode_frame(next(iter(common)))
+    assert [m["type"] for m in messages][:2] == ["SetOrientationMessage", "SetPositionMessage"]
+    assert np.isclose(np.linalg.norm(messages[0]["wxyz"]), 1.0)
+    # Their sessions draw their own frames (traces, labels, plot) at the follower's low rate,
+    # without the pose: the session's frames are far fewer than the frames received.
+    for session in sessions:
+        assert session.pacer.cap == OWN_FPS and session.scene.send_pose is False
+
+
+def test_a_detached_follower_encodes_its_own_frames_again(poinsot_app, make_probe):
+    _, probes, frames, sessions = _class(poinsot_app, make_probe)
+    cast = poinsot_app.follow.cast
+    detached, kept = sessions
+    _set(probes[0], "Explore from here")
+    assert probes[0].wait_for(lambda p: _says(p, "Exploring on your own"), 30)
+    assert wait_until(lambda: not detached.shared.shared, 30)
+    assert cast.members == 1 and kept.shared.shared
+    assert detached.pacer.cap is None and detached.scene.send_pose is True
+    # From now on its poses come from its own session's frames, each encoded for it alone:
+    # none of its frames is one the kept follower received.
+    drawn = detached.stats.frames
+    start0, start1 = len(frames[0]), len(frames[1])
+    assert wait_until(lambda: len(frames[0]) >= start0 + 20 and len(frames[1]) >= start1 + 5, 30)
+    assert detached.stats.frames >= drawn + 15  # its own frame rate again, not OWN_FPS
+    # (its first frame may have been handed to the socket before it left the cast)
+    assert not set(frames[0].since(start0 + 1)) & set(frames[1].since(start1))
+
+
+class _Stuck:
+    """A follower's connection whose writes never end until released (a socket that does not
+    drain: its browser reads nothing, or the network to it is gone)."""
+
+    def __init__(self, connection, loop) -> None:
+        self.connection, self.loop = connection, loop
+        self.release = asyncio.Event()
+        self.writes = 0
+
+    async def send(self, data: bytes) -> None:
+        self.writes += 1
+        await self.release.wait()
+        await self.connection.send(data)
+
+
+def test_a_slow_follower_does_not_hold_the_others(poinsot_app, make_probe):
+    _, probes, frames, sessions = _class(poinsot_app, make_probe, followers=3)
+    cast = poinsot_app.follow.cast
+    slow = sessions[0].shared.member
+    assert slow is not None
+    stuck = _Stuck(slow.socket.connection, slow.socket.loop)
+    slow.socket.connection = stuck
+    assert wait_until(lambda: slow.skipped >= 20, 60), "the stuck follower was never skipped"
+    # Meanwhile the others go on receiving the frames the cast makes, and the stuck one was
+    # handed one window only: its backlog is that window, whatever the others are sent.
+    starts = [len(f) for f in frames[1:]]
+    skipped = slow.skipped
+    assert wait_until(
+        lambda: all(len(f) >= s + 40 for f, s in zip(frames[1:], starts, strict=True)), 60
+    )
+    assert slow.skipped >= skipped + 30 and stuck.writes == 1 and slow.socket.busy
+    assert cast.members == 3
+    # Its socket drains again: it is sent frames again.
+    count = len(frames[0])
+    stuck.loop.call_soon_threadsafe(stuck.release.set)
+    assert wait_until(lambda: len(frames[0]) >= count + 10, 60)
+    assert stuck.writes >= 10
+
+
+def test_a_large_hall_s_followers_draw_fewer_own_frames_each():
+    assert own_fps(1) == own_fps(20) == OWN_FPS
+    assert own_fps(40) == OWN_PROCESS_FRAMES / 40 < OWN_FPS
+    assert own_fps(75) == own_fps(300) == OWN_MIN_FPS  # traces and plot twice a second
+    assert max(n * own_fps(n) for n in range(1, 61)) <= OWN_PROCESS_FRAMES + 1e-9  # bounded
+
+
+def test_a_follower_s_own_view_falls_back_to_its_own_frames_and_back(poinsot_app, make_probe):
+    """A ride-along camera or a ghost is the follower's own: its session draws all of its
+    frames again (the pose included) while it lasts, and shares the lead's once it ends."""
+    _, _, _, sessions = _class(poinsot_app, make_probe)
+    own, kept = sessions
+    cast = poinsot_app.follow.cast
+    for start, end in (
+        (lambda: own.lecture.set_camera("ride-along"), lambda: own.lecture.set_camera("default")),
+        (lambda: own.ghost.configure(enabled=True), lambda: own.ghost.configure(enabled=False)),
+    ):
+        start()
+        own.loop.wake()
+        assert wait_until(lambda: not own.shared.shared, 30), "never fell back"
+        assert own.scene.send_pose and own.pacer.cap is None and cast.members == 1
+        assert kept.shared.shared
+        end()
+        own.loop.wake()
+        assert wait_until(lambda: own.shared.shared, 30), "never shared again"
+        assert not own.scene.send_pose and cast.members == 2
+
+
+def test_a_follower_drawing_other_nodes_is_sent_its_own_group_s_window(poinsot_app, make_probe):
+    """Followers are grouped by what they pose: one without the ω arrow (not drawn in its
+    scene) gets a window of its own group, encoded once for that group, without the arrow."""
+    _, probes, frames, sessions = _class(poinsot_app, make_probe)
+    member = sessions[0].shared.member
+    assert member is not None and member.source is not None and member.source.arrow
+    # What its session's frame thread would set if its scene drew no ω arrow.
+    source = member.source
+    without = type(source)(source.motion, source.body, source.tip, None)
+    sessions[0].shared.update = lambda _source: None  # its own thread leaves it as set here
+    member.source = without
+    start = len(frames[0])
+    encoded = poinsot_app.follow.cast.encoded
+    assert wait_until(lambda: len(frames[0]) >= start + 10, 30)
+    types = [[m["type"] for m in decode_frame(f)] for f in frames[0].since(start + 2)]
+    assert types and all(t == ["SetOrientationMessage", "SetPositionMessage"] for t in types)
+    # Two groups now: two windows a frame (one each), never one per follower of a group.
+    assert poinsot_app.follow.cast.encoded - encoded >= len(types)
