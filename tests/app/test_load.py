@@ -18,6 +18,7 @@ from poinsot.app.devtools.load.figures import COMPLETES, Figure, at_least, at_mo
 from poinsot.app.devtools.load.procfs import usage
 from poinsot.app.devtools.load.raw import client_frame
 from poinsot.app.devtools.load.server_process import error_lines, thread_kind
+from poinsot.app.devtools.load.workloads import following
 from poinsot.app.devtools.load.workloads.storm import KINDS
 
 TINY = Config(
@@ -67,9 +68,16 @@ def report() -> Report:
 
 @pytest.fixture(scope="module")
 def follow_report() -> Report:
-    """The follow phase (not in ``make load``'s defaults): one lead, three followers; a move is
-    lost only if a follower has not redrawn it in 60 s (the count is asserted, not the time)."""
-    tiny = dataclasses.replace(TINY, followers=(3,), follow_seconds=2.0, follow_redraw_timeout=60.0)
+    """The follow phase (not in ``make load``'s defaults): one lead, three followers in two
+    client processes; a move is lost only if a follower has not redrawn it in 60 s (the count
+    is asserted, not the time)."""
+    tiny = dataclasses.replace(
+        TINY,
+        followers=(3,),
+        follow_seconds=2.0,
+        follow_redraw_timeout=60.0,
+        followers_per_process=2,  # two client processes: the lead's and another
+    )
     return run(("follow",), tiny, False)
 
 
@@ -166,7 +174,28 @@ def test_follow_phase_measures_followers_and_their_cost(follow_report):
     assert moves["moves"] >= 2 and moves["lost"] == 0 and moves["redraws"] == 3 * moves["moves"]
     cost = report.figure("follow", "3 followers: server CPU per frame").detail
     assert cost["explored"] == 1.0 and cost["follower_ms"] > 0 and cost["session_ms"] > 0
-    assert cost["clients_cpu"] > 0  # the clients' own process, measured beside the server
+    cores = report.figure("follow", "3 followers: the machine's cores").detail
+    # The clients' two processes, measured beside the server; its own cores while still.
+    assert cores["processes"] == 2 and cores["clients_cpu"] > 0 and cores["server_cores"] > 0
+    assert any(n.startswith("follow, 3 followers: the server used") for n in report.notes)
+
+
+def test_the_followers_are_spread_evenly_over_as_few_processes_as_hold_them():
+    assert following.chunks(30, 40) == [30]
+    assert following.chunks(60, 40) == [30, 30]
+    assert following.chunks(150, 40) == [38, 38, 37, 37]
+    assert sum(following.chunks(301, 40)) == 301 and max(following.chunks(301, 40)) <= 40
+
+
+@pytest.mark.parametrize(
+    ("server", "clients", "processes", "limit"),
+    [(0.5, 0.6, 2, "server"), (0.4, 1.9, 2, "clients"), (1.2, 1.0, 4, "machine")],
+)
+def test_the_phase_says_who_limits_the_frame_rates(monkeypatch, server, clients, processes, limit):
+    monkeypatch.setattr(following.os, "cpu_count", lambda: 2)
+    load = following.Load(server, clients, processes)
+    assert load.limit == limit
+    assert ("not the server" in load.text()) == (limit != "server")
 
 
 # -- the goals, judged on the same figures -----------------------------------------------------

@@ -102,6 +102,12 @@ def _add_follow(parser: argparse.ArgumentParser, cfg: Config) -> None:
         default=cfg.follow_redraw_timeout,
         help="seconds after which a lead's move not yet on a follower counts as lost",
     )
+    parser.add_argument(
+        "--followers-per-process",
+        type=positive_int,
+        default=cfg.followers_per_process,
+        help="followers in each client process (as many processes as they need)",
+    )
 
 
 def _options(args: argparse.Namespace) -> tuple[list[str], Config, Bounds]:

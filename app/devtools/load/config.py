@@ -43,6 +43,9 @@ class Config:
     followers: tuple[int, ...] = (30, 60)  # the follow phase's sizes, one lead each
     follow_seconds: float = 15.0  # each of its windows (following, then exploring)
     follow_redraw_timeout: float = 5.0  # a lead's move not on a follower by then is lost [s]
+    #: Followers per client process. One interpreter decodes about 60 followers' frames at 30
+    #: fps in 0.65 of a core (measured): at 40 a process, the clients do not limit their rates.
+    followers_per_process: int = 40
 
     @property
     def lifetime(self) -> float:
