@@ -182,3 +182,13 @@ def test_a_follower_drawing_other_nodes_is_sent_its_own_group_s_window(poinsot_a
     assert types and all(t == ["SetOrientationMessage", "SetPositionMessage"] for t in types)
     # Two groups now: two windows a frame (one each), never one per follower of a group.
     assert poinsot_app.follow.cast.encoded - encoded >= len(types)
+
+
+def test_a_follower_that_leaves_leaves_the_cast(poinsot_app, make_probe):
+    _, probes, frames, sessions = _class(poinsot_app, make_probe)
+    cast = poinsot_app.follow.cast
+    assert cast.members == 2
+    probes[0].close()
+    assert wait_until(lambda: cast.members == 1, 30), "the departed follower is still sent frames"
+    start = len(frames[1])
+    assert wait_until(lambda: len(frames[1]) >= start + 10, 30)  # the other one goes on

@@ -173,7 +173,9 @@ class FollowCast:
         t = self._now()
         if t is None:
             return 0
-        with self._lock:
+        with self._lock:  # a follower whose client left is dropped here, whatever its session did
+            for key in [k for k, m in self._members.items() if m.outbox.closed()]:
+                del self._members[key]
             members = list(self._members.values())
         groups: dict[Hashable, tuple[Source, list[Member]]] = {}
         for member in members:
