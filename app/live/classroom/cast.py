@@ -59,6 +59,8 @@ CAST_FPS = 40.0
 OWN_FPS = 6.0
 OWN_MIN_FPS = 2.0
 OWN_PROCESS_FRAMES = 120.0
+#: A follower's unacknowledged bytes are read every this many of the cast's frames.
+CHECK_TICKS = 8
 
 
 def own_fps(members: int) -> float:
@@ -115,12 +117,17 @@ class Member:
         self.source: Source | None = None
         self.shown: tuple[Hashable, int] | None = None
         self.skipped = 0
+        self._behind, self._looked = False, -CHECK_TICKS  # its socket's backlog, as last read
 
-    def ready(self) -> bool:
-        """Whether it may be sent a frame now (else it is skipped: the slow client's rule)."""
+    def ready(self, tick: int) -> bool:
+        """Whether it may be sent a frame at the cast's ``tick`` (else it is skipped: the slow
+        client's rule). Its socket's backlog is read every :data:`CHECK_TICKS` ticks (a system
+        call, which lets every other thread of the process take the interpreter)."""
         if self.socket.busy or self.outbox.closed():
             return False
-        return self.outbox.unacknowledged() <= MAX_UNACKED
+        if tick - self._looked >= CHECK_TICKS:
+            self._behind, self._looked = self.outbox.unacknowledged() > MAX_UNACKED, tick
+        return not self._behind
 
 
 class FollowCast:
@@ -139,6 +146,7 @@ class FollowCast:
         self.skipped = 0
         #: The thread's CPU time [s] (load test).
         self.cpu_seconds = 0.0
+        self.ticks = 0
         self._error = ""
 
     def join(self, key: int, client: viser.ClientHandle) -> Member | None:
@@ -173,6 +181,7 @@ class FollowCast:
         t = self._now()
         if t is None:
             return 0
+        self.ticks += 1
         with self._lock:  # a follower whose client left is dropped here, whatever its session did
             for key in [k for k, m in self._members.items() if m.outbox.closed()]:
                 del self._members[key]
@@ -196,7 +205,7 @@ class FollowCast:
         return encoded
 
     def _ready(self, member: Member) -> bool:
-        if member.ready():
+        if member.ready(self.ticks):
             return True
         member.skipped += 1
         self.skipped += 1
