@@ -183,8 +183,8 @@ class FollowCast:
             return 0
         self.ticks += 1
         with self._lock:  # a follower whose client left is dropped here, whatever its session did
-            for key in [k for k, m in self._members.items() if m.outbox.closed()]:
-                del self._members[key]
+            for gone in [k for k, m in self._members.items() if m.outbox.closed()]:
+                del self._members[gone]
             members = list(self._members.values())
         groups: dict[Hashable, tuple[Source, list[Member]]] = {}
         for member in members:
