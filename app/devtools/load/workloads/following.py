@@ -44,6 +44,8 @@ if TYPE_CHECKING:
 
 FOLLOW_LABEL = "Follow the lecturer"
 EXPLORE_LABEL = "Explore from here"
+#: Words of the lecture tools' line of keys (:mod:`poinsot.app.live.lecture.lecture`).
+READY_WORDS = "Keys: **space**"
 
 
 def _says(probe: Probe, words: str) -> bool:
@@ -52,6 +54,13 @@ def _says(probe: Probe, words: str) -> bool:
 
 def _press(probe: Probe, label: str, value: Any = True) -> None:
     probe.set_value(probe.widget(label)[0], value)
+
+
+def _ready(probe: Probe) -> bool:
+    """The page is whole: its panel, and the lecture tools' line of keys, which the session
+    mounts last (a widget arrives before its callback is bound: a press of the "Class" folder's
+    buttons as soon as they show can be lost on a busy machine)."""
+    return probe.has_widget(EXPLORE_LABEL) and _says(probe, READY_WORDS)
 
 
 def _why(probe: Probe, since: float) -> str:
@@ -81,7 +90,7 @@ def _followers(port: int, count: int, deadline: float, probes: list[Probe]) -> l
         probes.append(made[-1])
     for probe in made:
         timeout = max(1.0, min(SCENE_TIMEOUT, deadline - time.monotonic()))
-        if not probe.wait_for(lambda p: p.has_widget(EXPLORE_LABEL), timeout):
+        if not probe.wait_for(_ready, timeout):
             raise RuntimeError("a client never received its panel")
     return made
 
