@@ -314,8 +314,12 @@ def _viser_s_own_window(messages: list) -> bytes:
         buffer.flush()
         await _infra._message_producer(Socket(), buffer, client_id=0)  # type: ignore[arg-type]
 
-    asyncio.run(produce())
-    assert len(sent) == 1, WRITTEN_FOR
+    # On a thread of its own: this one may hold the event loop of a real-browser test that ran
+    # before, in this worker.
+    thread = threading.Thread(target=asyncio.run, args=(produce(),))
+    thread.start()
+    thread.join(30)
+    assert not thread.is_alive() and len(sent) == 1, WRITTEN_FOR
     return sent[0]
 
 
