@@ -84,7 +84,6 @@ class Core:
     retirement: Retirement
     frames: FrameWork
     loop: FrameLoop
-    shared: SharedFrames
 
 
 @dataclasses.dataclass(frozen=True)
@@ -200,7 +199,6 @@ def _frame_thread(
         retirement=retirement,
         frames=frames,
         loop=loop,
-        shared=frames.shared,
     )
 
 

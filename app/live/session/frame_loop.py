@@ -1,9 +1,8 @@
-"""One session's frame thread: it wakes at its client's frame time (or when an action is
-posted), runs the session's queued work, and draws a frame if the browser has taken the one
-before (:class:`~..hardening.pacing.Pacer`). Frames are due on a cadence
-(:func:`~..hardening.pacing.next_due`): a
-frame drawn late shortens the wait for the next, so that the rate is the pacer's, not the
-pacer's less the frames' own delays.
+"""One session's frame thread: it wakes at its client's frame time (or when an action is posted),
+runs the session's queued work, and draws a frame if the browser has taken the one before
+(:class:`~..hardening.pacing.Pacer`). Frames are due on a cadence
+(:func:`~..hardening.pacing.next_due`): a frame drawn late shortens the wait for the next, so
+that the rate is the pacer's, not the pacer's less the frames' own delays.
 
 While another session rebuilds, a due frame waits for that rebuild to end
 (:meth:`~..hardening.budget.RebuildGate.hold` wakes it) for at most :data:`HOLD_SECONDS`, so that a

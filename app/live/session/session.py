@@ -74,7 +74,7 @@ class Session:
         )
         self.refresh, self.retirement = core.refresh, core.retirement
         #: A follower's poses, sent by the process's cast (:mod:`..classroom.cast`).
-        self.shared = core.shared
+        self.shared = core.frames.shared
         self.ghost, self.uploads, self.follow = tools.ghost, tools.uploads, tools.follow
         self.lecture, self.layout = tools.lecture, tools.layout
         self.pointer, self.sphere_pointer = tools.pointer, tools.sphere_pointer
