@@ -93,10 +93,13 @@ class Probe:
         keep_batches: bool = True,
         origin: str | None = None,
         size: tuple[int, int] = (1280, 720),
+        source: str | None = None,
     ):
         """``origin``: the ``Origin`` header a browser would send (a page's
         ``scheme://host:port``); None sends none, as tools that are not browsers do. ``size``:
-        the picture's width and height it reports [px] (a phone's is narrow)."""
+        the picture's width and height it reports [px] (a phone's is narrow). ``source``: the
+        local address it connects from (a loopback address, so that a balancer hashing the
+        client's address sees distinct browsers)."""
         self.uri = f"ws://{host}:{port}"
         self.size = size
         self.nodes: dict[str, Node] = {}
@@ -118,6 +121,7 @@ class Probe:
             # would miss the pong and print a traceback; the server's pings watch the line.
             ping_interval=None,
             origin=None if origin is None else websockets.Origin(origin),
+            **self._source(source),
         )
         self._closed = False
         self._reading = threading.Event()
@@ -125,6 +129,11 @@ class Probe:
         self._thread = threading.Thread(target=self._receive, daemon=True, name="viser-probe")
         self._thread.start()
         self._send_first_camera()
+
+    @staticmethod
+    def _source(source: str | None) -> dict[str, Any]:
+        """The socket's local address, if given (passed on to ``socket.create_connection``)."""
+        return {} if source is None else {"source_address": (source, 0)}
 
     def _send_first_camera(self) -> None:
         """The camera message that makes viser call a client connected. A server that refuses

@@ -12,14 +12,25 @@ import struct
 
 import pytest
 
-from poinsot.app.devtools.load import PHASES, Bounds, Config, Report, cli, exit_status, run
+from poinsot.app.devtools.load import (
+    PHASES,
+    Bounds,
+    Config,
+    Report,
+    cli,
+    exit_status,
+    run,
+    services,
+)
 from poinsot.app.devtools.load.config import server_processes
 from poinsot.app.devtools.load.figures import COMPLETES, Figure, at_least, at_most, percentile
 from poinsot.app.devtools.load.procfs import usage
 from poinsot.app.devtools.load.raw import client_frame
 from poinsot.app.devtools.load.server_process import error_lines, thread_kind
-from poinsot.app.devtools.load.workloads import following
+from poinsot.app.devtools.load.workloads import follow_fleet, following
+from poinsot.app.devtools.load.workloads import hosts as hosts_workload
 from poinsot.app.devtools.load.workloads.storm import KINDS
+from tests.app.test_nginx import service_or_skip
 
 TINY = Config(
     clients=3,
@@ -47,6 +58,8 @@ LENIENT = Bounds(
     max_hostile_rss_growth=10.0,
     min_innocent_keep=0.01,
     max_follow_ms=60_000.0,
+    max_hosts_follow_ms=60_000.0,
+    max_recovery_s=60.0,
 )
 LENIENT_ARGS = [
     "--min-fps=1",
@@ -58,6 +71,8 @@ LENIENT_ARGS = [
     "--max-hostile-rss-growth=10",
     "--min-innocent-keep=0.01",
     "--max-follow-ms=60000",
+    "--max-hosts-follow-ms=60000",
+    "--max-recovery-s=60",
 ]
 
 
@@ -77,6 +92,23 @@ def follow_report() -> Report:
         follow_seconds=2.0,
         follow_redraw_timeout=60.0,
         followers_per_process=2,  # two client processes: the lead's and another
+    )
+    return run(("follow",), tiny, False)
+
+
+@pytest.fixture(scope="module")
+def hosts_report() -> Report:
+    """The follow phase on two hosts (``--hosts 2``): a real redis-server, two servers linked
+    to it and nginx in front; one lead, four followers (two on each host) in two client
+    processes; Redis killed and started again once. Lost only after 60 s (counts asserted)."""
+    service_or_skip(services.check_installed)
+    tiny = dataclasses.replace(
+        TINY,
+        hosts=2,
+        followers=(4,),
+        follow_seconds=2.0,
+        follow_redraw_timeout=60.0,
+        followers_per_process=2,
     )
     return run(("follow",), tiny, False)
 
@@ -181,10 +213,10 @@ def test_follow_phase_measures_followers_and_their_cost(follow_report):
 
 
 def test_the_followers_are_spread_evenly_over_as_few_processes_as_hold_them():
-    assert following.chunks(30, 40) == [30]
-    assert following.chunks(60, 40) == [30, 30]
-    assert following.chunks(150, 40) == [38, 38, 37, 37]
-    assert sum(following.chunks(301, 40)) == 301 and max(following.chunks(301, 40)) <= 40
+    assert follow_fleet.chunks(30, 40) == [30]
+    assert follow_fleet.chunks(60, 40) == [30, 30]
+    assert follow_fleet.chunks(150, 40) == [38, 38, 37, 37]
+    assert sum(follow_fleet.chunks(301, 40)) == 301 and max(follow_fleet.chunks(301, 40)) <= 40
 
 
 @pytest.mark.parametrize(
@@ -198,10 +230,50 @@ def test_the_phase_says_who_limits_the_frame_rates(monkeypatch, server, clients,
     assert ("not the server" in load.text()) == (limit != "server")
 
 
+@pytest.mark.slow
+def test_the_follow_phase_on_two_hosts_follows_through_redis_and_recovers(hosts_report):
+    """Half the followers are on the other host: every lead's move reaches them through Redis,
+    none is lost; Redis killed: each is told it keeps the last state, the lead's move then is
+    followed on its own host only, and reaches them once Redis is back."""
+    report = hosts_report
+    failures = [f.text for f in report.figures if f.name == "completed"]
+    assert not failures, (failures, report.notes)
+    name = "2 hosts, 4 followers"
+    moves = report.figure("follow", f"{name}: lead's move on the other hosts").detail
+    assert moves["moves"] >= 2 and moves["lost"] == 0
+    assert moves["redraws"] == moves["same_host"] == 2 * moves["moves"]
+    restart = report.figure("follow", f"{name}: Redis stopped and started")
+    counts = {k: restart.detail[k] for k in ("others", "told", "early", "lost")}
+    assert counts == {"others": 2, "told": 2, "early": 0, "lost": 0}
+    assert math.isfinite(restart.value)
+    assert report.figure("follow", f"{name}: fps each").value > 0
+    assert report.figure("follow", f"{name}: servers' CPU per frame").detail["follower_ms"] > 0
+    # The link's own line when Redis was killed is expected; nothing else was logged.
+    assert report.figure("follow", "server log errors").value == 0, report.notes
+
+
+def test_the_followers_are_seated_evenly_on_the_hosts():
+    addresses, hosts = hosts_workload.seats(5, [["a1", "a2"], ["b1"]])
+    assert hosts == [0, 1, 0, 1, 0]
+    assert addresses == ["a1", "b1", "a2", "b1", "a1"]
+
+
+def test_hosts_are_for_the_follow_phase_alone():
+    for argv in (
+        ["--phase", "soak", "--hosts", "2"],
+        ["--phase", "follow", "--hosts", "2", "--workers", "2"],
+    ):
+        with pytest.raises(SystemExit) as exc:
+            cli.main(argv)
+        assert exc.value.code == 2
+
+
 # -- the goals, judged on the same figures -----------------------------------------------------
 @pytest.mark.slow
-def test_met_bounds_give_zero_and_each_impossible_bound_gives_one(report, follow_report):
-    figures = report.figures + follow_report.figures
+def test_met_bounds_give_zero_and_each_impossible_bound_gives_one(
+    report, follow_report, hosts_report
+):
+    figures = report.figures + follow_report.figures + hosts_report.figures
     assert exit_status(figures, LENIENT) == 0
     impossible = {
         "min_fps": 1e9,
@@ -213,6 +285,8 @@ def test_met_bounds_give_zero_and_each_impossible_bound_gives_one(report, follow
         "max_hostile_rss_growth": -1.0,
         "min_innocent_keep": 1e9,
         "max_follow_ms": -1.0,
+        "max_hosts_follow_ms": -1.0,
+        "max_recovery_s": -1.0,
     }
     assert set(impossible) == {f.name for f in dataclasses.fields(Bounds)}
     for name, value in impossible.items():

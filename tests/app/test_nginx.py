@@ -9,105 +9,49 @@ that ``hash $remote_addr`` has addresses to spread. Skipped when nginx is missin
 
 from __future__ import annotations
 
-import functools
-import re
-import shutil
-import socket
-import subprocess
 import urllib.request
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from unittest import mock
+from typing import TypeVar
 
 import pytest
-import websockets.sync.client
 
+from poinsot.app.devtools.load import services
 from poinsot.app.devtools.probe import Probe
 from poinsot.app.live.server import PoinsotApp
 from tests.conftest import in_ci, wait_until
 
-GUIDE = Path(__file__).resolve().parents[2] / "docs" / "how-to" / "classroom.md"
 SOURCES = [f"127.0.0.{i}" for i in range(1, 17)]
 
 pytestmark = pytest.mark.slow
+T = TypeVar("T")
 
 
-def nginx_or_skip() -> str:
-    """nginx's executable; skip (locally) or fail (CI) with how to install it."""
-    path = shutil.which("nginx") or shutil.which("nginx", path="/usr/sbin:/sbin")
-    if path:
-        return path
-    message = "nginx not found: run `make chromium` (installs Debian's nginx-light) or apt"
-    if in_ci():
-        pytest.fail(message + " [CI=true: the load-balancer test must run]")
-    pytest.skip(message)
-
-
-def readme_config() -> str:
-    """The nginx block of the guide's classroom page."""
-    text = GUIDE.read_text()
-    section = text[text.index("## Several machines") :]
-    return re.search(r"```nginx\n(.*?)```", section, re.DOTALL).group(1)
-
-
-def nginx_conf(tmp: Path, listen: int, backends: list[int]) -> str:
-    servers = "".join(f"    server 127.0.0.1:{port};\n" for port in backends)
-    block = re.sub(r"(    server [\d.:]+;\n)+", servers, readme_config())
-    block = re.sub(r"listen \d+;", f"listen 127.0.0.1:{listen};", block)
-    assert servers in block and f"127.0.0.1:{listen}" in block, "the guide's block changed"
-    temps = "".join(
-        f"    {kind}_temp_path {tmp}/{kind};\n"
-        for kind in ("client_body", "proxy", "fastcgi", "uwsgi", "scgi")
-    )
-    return (
-        f"daemon off;\nworker_processes 1;\npid {tmp}/nginx.pid;\nerror_log {tmp}/error.log;\n"
-        f"events {{ worker_connections 256; }}\n"
-        f"http {{\n    access_log off;\n{temps}{block}}}\n"
-    )
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
+def service_or_skip(make: Callable[[], T]) -> T:
+    """``make()``, or skip (locally) / fail (CI) with how to install what is missing."""
+    try:
+        return make()
+    except services.Missing as exc:
+        if in_ci():
+            pytest.fail(f"{exc} [CI=true: the classroom's programs must run]")
+        pytest.skip(str(exc))
 
 
 @pytest.fixture
 def balancer(tmp_path: Path, make_app) -> Iterator[tuple[int, list[PoinsotApp]]]:
     """Two Poinsot servers behind nginx: (nginx's port, the servers)."""
-    nginx = nginx_or_skip()
     apps = [make_app(), make_app()]
-    port = free_port()
-    conf = tmp_path / "nginx.conf"
-    conf.write_text(nginx_conf(tmp_path, port, [app.port for app in apps]))
-    process = subprocess.Popen(
-        [nginx, "-p", str(tmp_path), "-c", str(conf)],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    nginx = service_or_skip(lambda: services.Nginx(tmp_path, [app.port for app in apps]))
+    nginx.start()
     try:
-        assert wait_until(lambda: _listening(port) or process.poll() is not None, 30)
-        assert process.poll() is None, f"nginx did not start: {process.stderr.read()}"
-        yield port, apps
+        yield nginx.port, apps
     finally:
-        process.terminate()
-        process.wait(30)
-
-
-def _listening(port: int) -> bool:
-    try:
-        socket.create_connection(("127.0.0.1", port), timeout=1).close()
-        return True
-    except OSError:
-        return False
+        nginx.stop()
 
 
 def probe_from(source: str, port: int) -> Probe:
     """A headless browser on ``source`` (a loopback address), through ``port``."""
-    connect = functools.partial(websockets.sync.client.connect, source_address=(source, 0))
-    with mock.patch.object(websockets.sync.client, "connect", connect):
-        return Probe(port)
+    return Probe(port, source=source)
 
 
 def _arrive(apps: list[PoinsotApp], source: str, port: int, probes: list[Probe]) -> int:

@@ -8,71 +8,27 @@ count the links keep.
 
 from __future__ import annotations
 
-import shutil
-import socket
 import subprocess
 import sys
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
+from poinsot.app.devtools.load import services
 from poinsot.app.live import broker
 from poinsot.app.live.classroom.follow import FollowHub
 from tests.app.test_follow import _follow, _lead, _ready, _says, _set
-from tests.conftest import in_ci, wait_until
+from tests.app.test_nginx import service_or_skip
+from tests.conftest import wait_until
 
 redis = pytest.importorskip("redis")
 pytestmark = pytest.mark.slow
 D = "D = |L|²/2T"
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
-class RedisServer:
-    """Debian's redis-server on loopback, no persistence; :meth:`kill` and :meth:`start` again
-    on the same port."""
-
-    def __init__(self, tmp: Path) -> None:
-        path = shutil.which("redis-server") or shutil.which("redis-server", path="/usr/sbin")
-        if path is None:
-            message = "redis-server not found: run `make chromium` (installs Debian's redis)"
-            if in_ci():
-                pytest.fail(message + " [CI=true: the Redis test must run]")
-            pytest.skip(message)
-        self.path, self.tmp, self.port = path, tmp, _free_port()
-        self.url = f"redis://127.0.0.1:{self.port}/0"
-        self.process: subprocess.Popen[bytes] | None = None
-
-    def start(self) -> RedisServer:
-        args = [self.path, "--port", str(self.port), "--bind", "127.0.0.1", "--save", ""]
-        args += ["--appendonly", "no", "--dir", str(self.tmp)]
-        self.process = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-        client = redis.Redis.from_url(self.url, socket_connect_timeout=1)
-        assert wait_until(lambda: _answers(client), 30), "redis-server never answered"
-        return self
-
-    def kill(self) -> None:
-        if self.process is not None:
-            self.process.kill()
-            self.process.wait(30)
-            self.process = None
-
-
-def _answers(client) -> bool:
-    try:
-        return bool(client.ping())
-    except redis.RedisError:
-        return False
-
-
 @pytest.fixture
-def redis_server(tmp_path) -> Iterator[RedisServer]:
-    server = RedisServer(tmp_path).start()
+def redis_server(tmp_path) -> Iterator[services.RedisServer]:
+    server = service_or_skip(lambda: services.RedisServer(tmp_path)).start()
     yield server
     server.kill()
 
@@ -150,7 +106,7 @@ def test_a_junk_message_on_the_channel_is_refused_and_counted(two_hosts, redis_s
 
 
 def test_unreachable_redis_at_start_is_one_line_and_following_stays_on_the_host():
-    url = f"redis://127.0.0.1:{_free_port()}/0"
+    url = f"redis://127.0.0.1:{services.free_port()}/0"
     code, line, ok = broker.shared_code(url, "given7", "fallback")
     assert code == "given7" and not ok
     assert "unreachable" in line and "within this host" in line and "\n" not in line

@@ -69,6 +69,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_follow(parser, cfg)
     add("--debug", action="store_true", help="show the traceback of a failure (else one line)")
+    _add_goals(parser, bounds)
+    return parser
+
+
+def _add_goals(parser: argparse.ArgumentParser, bounds: Bounds) -> None:
+    """The goals' bounds (:class:`Bounds`), each an option."""
     goals = parser.add_argument_group("goals")
     goals.add_argument("--min-fps", type=non_negative_float, default=bounds.min_fps)
     goals.add_argument("--max-redraw-ms", type=positive_float, default=bounds.max_redraw_ms)
@@ -81,7 +87,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     goals.add_argument("--min-innocent-keep", type=fraction, default=bounds.min_innocent_keep)
     goals.add_argument("--max-follow-ms", type=positive_float, default=bounds.max_follow_ms)
-    return parser
+    goals.add_argument(
+        "--max-hosts-follow-ms", type=positive_float, default=bounds.max_hosts_follow_ms
+    )
+    goals.add_argument("--max-recovery-s", type=positive_float, default=bounds.max_recovery_s)
 
 
 def _add_follow(parser: argparse.ArgumentParser, cfg: Config) -> None:
@@ -101,6 +110,13 @@ def _add_follow(parser: argparse.ArgumentParser, cfg: Config) -> None:
         type=positive_float,
         default=cfg.follow_redraw_timeout,
         help="seconds after which a lead's move not yet on a follower counts as lost",
+    )
+    parser.add_argument(
+        "--hosts",
+        type=positive_int,
+        default=cfg.hosts,
+        help="hosts of the follow phase: more than 1 runs them linked by a local redis-server "
+        "behind nginx (both from make chromium), the lead on the first",
     )
     parser.add_argument(
         "--followers-per-process",
@@ -124,6 +140,8 @@ def _check(parser: argparse.ArgumentParser, phases: list[str], cfg: Config) -> N
     """What the converters cannot see alone (each option is checked by its ``type``)."""
     if cfg.workers > 1 and set(phases) - {"soak", "follow"}:
         parser.error("--workers more than 1 only with --phase soak or follow")
+    if cfg.hosts > 1 and (phases != ["follow"] or cfg.workers > 1):
+        parser.error("--hosts more than 1 only with --phase follow alone, one process per host")
     if {"stall", "flood"} & set(phases) and cfg.clients < 2:
         parser.error("stall and flood need --clients >= 2 (one stalls, the others are measured)")
 

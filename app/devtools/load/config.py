@@ -46,6 +46,9 @@ class Config:
     #: Followers per client process. One interpreter decodes about 60 followers' frames at 30
     #: fps in 0.65 of a core (measured): at 40 a process, the clients do not limit their rates.
     followers_per_process: int = 40
+    #: Hosts of the follow phase: more than 1 runs that many servers (one process each) linked
+    #: by a local Redis behind nginx (:mod:`poinsot.app.devtools.load.workloads.hosts`).
+    hosts: int = 1
 
     @property
     def lifetime(self) -> float:

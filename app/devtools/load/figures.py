@@ -25,6 +25,8 @@ class Bounds:
     max_hostile_rss_growth: float = 0.05  # after the hostile phase's bad handshakes
     min_innocent_keep: float = 0.95  # of its frame rate, for a client while the hostile plays
     max_follow_ms: float = 150.0  # a lead's slider move on every follower's screen, p95
+    max_hosts_follow_ms: float = 250.0  # the same on the other hosts (through Redis), p95
+    max_recovery_s: float = 5.0  # Redis back: until every other host's follower has the lead
 
 
 @dataclasses.dataclass(frozen=True)

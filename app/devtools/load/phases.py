@@ -8,7 +8,8 @@ misbehaves;
 - ``hostile`` (:mod:`poinsot.app.devtools.load.workloads.hostile`): crafted messages, handshakes and
 inputs;
 - ``follow`` (:mod:`poinsot.app.devtools.load.workloads.following`, on request): a lead and its
-followers.
+followers; with ``--hosts 2`` (:mod:`poinsot.app.devtools.load.workloads.hosts`) on two hosts
+linked by Redis behind nginx.
 """
 
 from __future__ import annotations
@@ -17,12 +18,15 @@ import math
 import os
 import time
 from collections.abc import Callable
+from typing import Any
 
 from poinsot.app.devtools.load import procfs
 from poinsot.app.devtools.load.config import Config, Report, Say, server_processes
 from poinsot.app.devtools.load.figures import COMPLETES, Figure, at_most, info
 from poinsot.app.devtools.load.server_process import ServerProcess
 from poinsot.app.devtools.load.workloads import contention, following, hostile, soak, storm
+from poinsot.app.devtools.load.workloads.hosts import Classroom
+from poinsot.app.devtools.load.workloads.hosts import phase as hosts_phase
 
 Phase = Callable[[ServerProcess, Config, Report, Say], None]
 BODIES: dict[str, Phase] = {
@@ -42,8 +46,13 @@ def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:
     """Run one phase with a server child of its own. A phase that fails (a child that does
     not start, clients that never get their scene) misses its "completed" goal; the server's
     log is read in every case, and judged in the soak."""
+    hosts = name == "follow" and cfg.hosts > 1
+    server: Any
     try:
-        server = ServerProcess(cfg.lifetime, workers=server_processes(cfg, name))
+        if hosts:  # a classroom of hosts linked by Redis, behind nginx
+            server = Classroom(cfg.hosts, cfg.lifetime)
+        else:
+            server = ServerProcess(cfg.lifetime, workers=server_processes(cfg, name))
     except Exception as exc:
         report.add(Figure(name, "completed", 0.0, f"failed: {exc}", COMPLETES))
         return
@@ -52,7 +61,7 @@ def run_phase(name: str, cfg: Config, report: Report, say: Say) -> None:
     server_cpu = _cpu_seconds(pids)
     try:
         say(f"{name}: server pid {server.pid}, port {server.port}")
-        BODIES[name](server, cfg, report, say)
+        (hosts_phase if hosts else BODIES[name])(server, cfg, report, say)
     except Exception as exc:
         failure = f"failed: {type(exc).__name__}: {exc}"
         report.add(Figure(name, "completed", 0.0, failure, COMPLETES))

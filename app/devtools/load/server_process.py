@@ -91,9 +91,43 @@ class _Classroom:
         self.relay.stop()
 
 
-def _main(conn: Connection, log_path: str, lifetime: float, workers: int = 1) -> None:
+def _linked_app(url: str) -> tuple[Any, Any]:
+    """One process whose hub is linked to the Redis at ``url``, as ``poinsot serve --redis URL
+    --workers 1`` runs on each host (:mod:`poinsot.app.live.broker`); the lecturer code is the
+    one shared there. (The app, its link.)"""
+    from poinsot.app.live import broker
+    from poinsot.app.live.classroom.follow import FollowHub, new_code
+    from poinsot.app.live.server import PoinsotApp
+
+    code, line, reachable = broker.shared_code(url, None, new_code())
+    if not reachable:
+        raise RuntimeError(line)
+    hub = FollowHub(code)
+    app = PoinsotApp("127.0.0.1", 0, follow=hub)
+    return app, broker.link_hub(hub, url)
+
+
+def _link_status(link: Any) -> dict[str, Any]:
+    """The Redis link's counts (none without one)."""
+    if link is None:
+        return {}
+    return {
+        "redis": {
+            "connected": link.connected.is_set(),
+            "lost": link.lost,
+            "received": link.received,
+            "refused": link.refused,
+            "published": link.published,
+        }
+    }
+
+
+def _main(
+    conn: Connection, log_path: str, lifetime: float, workers: int = 1, redis: str = ""
+) -> None:
     """The child: serve on a free port (through a landing port and ``workers`` processes if
-    more than one), answer the parent, stop within ``lifetime`` seconds."""
+    more than one; linked to the Redis at ``redis`` if given, in one process), answer the
+    parent, stop within ``lifetime`` seconds."""
     log = os.open(log_path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
     os.dup2(log, 1)
     os.dup2(log, 2)
@@ -104,7 +138,11 @@ def _main(conn: Connection, log_path: str, lifetime: float, workers: int = 1) ->
     )
     from poinsot.app.live.server import PoinsotApp
 
-    app: Any = PoinsotApp("127.0.0.1", 0) if workers == 1 else _Classroom(workers)
+    link = None
+    if redis:
+        app, link = _linked_app(redis)
+    else:
+        app = PoinsotApp("127.0.0.1", 0) if workers == 1 else _Classroom(workers)
     pids = [w.pid for w in app.workers] if workers > 1 else []
     code = app.code if workers > 1 else app.follow.code
     conn.send(("ready", (app.port, pids, code)))
@@ -118,10 +156,12 @@ def _main(conn: Connection, log_path: str, lifetime: float, workers: int = 1) ->
             except EOFError:  # the parent is gone
                 break
             if request == "status":
-                conn.send(_status(app) if workers == 1 else app.status())
+                conn.send({**_status(app), **_link_status(link)} if workers == 1 else app.status())
             elif request == "stop":
                 break
     finally:
+        if link is not None:
+            link.close()
         app.stop()
     try:
         conn.send(("stopped", None))
@@ -132,11 +172,16 @@ def _main(conn: Connection, log_path: str, lifetime: float, workers: int = 1) ->
 class ServerProcess(Child):
     """Start the server child; a context manager that stops and reaps it."""
 
-    def __init__(self, lifetime: float, start_timeout: float = 120.0, workers: int = 1):
+    def __init__(
+        self, lifetime: float, start_timeout: float = 120.0, workers: int = 1, redis: str = ""
+    ):
+        """``redis``: a Redis URL to link one process's hub to (a host of a classroom)."""
+        if redis and workers != 1:
+            raise ValueError("a host linked to Redis runs one process here")
         fd, path = tempfile.mkstemp(prefix="poinsot-load-server-", suffix=".log")
         os.close(fd)
         self.log_path = pathlib.Path(path)
-        super().__init__("server", _main, str(self.log_path), lifetime, workers)
+        super().__init__("server", _main, str(self.log_path), lifetime, workers, redis)
         self.port: int
         #: The worker processes' pids (none for one process): their CPU and memory count too.
         self.worker_pids: list[int]
