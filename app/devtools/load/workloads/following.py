@@ -93,6 +93,17 @@ class Load:
             return "machine"
         return "server"
 
+    def figure(self, name: str) -> Figure:
+        """The figure "``name``: the machine's cores" of the follow phase."""
+        return info(
+            "follow",
+            f"{name}: the machine's cores",
+            self.text(),
+            server_cores=self.server,
+            clients_cpu=self.clients,
+            processes=float(self.processes),
+        )
+
     def text(self) -> str:
         cores = os.cpu_count() or 1
         said = (
@@ -160,14 +171,7 @@ def _figures(
             session_ms=own_ms,
             explored=float(explored),
         ),
-        info(
-            "follow",
-            f"{name}: the machine's cores",
-            load.text(),
-            server_cores=load.server,
-            clients_cpu=load.clients,
-            processes=float(load.processes),
-        ),
+        load.figure(name),
     ]
 
 

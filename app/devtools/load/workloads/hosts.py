@@ -262,14 +262,7 @@ def _figures(
             f"{cost:.2f} ms per follower-frame (nothing moving, all hosts)",
             follower_ms=cost,
         ),
-        info(
-            "follow",
-            f"{name}: the machine's cores",
-            load.text(),
-            server_cores=load.server,
-            clients_cpu=load.clients,
-            processes=float(load.processes),
-        ),
+        load.figure(name),
     ]
 
 
