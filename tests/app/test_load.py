@@ -243,8 +243,9 @@ def test_the_follow_phase_on_two_hosts_follows_through_redis_and_recovers(hosts_
     assert moves["moves"] >= 2 and moves["lost"] == 0
     assert moves["redraws"] == moves["same_host"] == 2 * moves["moves"]
     restart = report.figure("follow", f"{name}: Redis stopped and started")
-    counts = {k: restart.detail[k] for k in ("others", "told", "early", "lost")}
-    assert counts == {"others": 2, "told": 2, "early": 0, "lost": 0}
+    counts = {k: restart.detail[k] for k in ("others", "told", "early", "lost", "refused")}
+    assert counts == {"others": 2, "told": 2, "early": 0, "lost": 0, "refused": 0}
+    assert restart.detail["links_lost"] == 2  # each host's link saw Redis go, once
     assert math.isfinite(restart.value)
     assert report.figure("follow", f"{name}: fps each").value > 0
     assert report.figure("follow", f"{name}: servers' CPU per frame").detail["follower_ms"] > 0

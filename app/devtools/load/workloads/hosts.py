@@ -192,7 +192,10 @@ def _outage(fleet: FollowFleet, classroom: Classroom, other: list[bool], cfg: Co
     classroom.redis.start()
     back = time.perf_counter()
     after = fleet.redraws(back, RECOVERY_TIMEOUT, other)
+    links = [server.status()["redis"] for server in classroom.servers]
     return {
+        "links_lost": sum(link["lost"] for link in links),  # each host's link, once
+        "refused": sum(link["refused"] for link in links),  # junk on the channel: none
         "told": sum(told),
         "told_s": told_s,
         "same_host": [x for x, s in zip(during, same, strict=True) if s and x is not None],
@@ -294,5 +297,6 @@ def _outage_text(outage: dict) -> str:
         f"{outage['told']} of {outage['others']} followers on the other hosts told they keep "
         f"the last state ({outage['told_s']:.2f} s after the kill); the lead's move meanwhile "
         f"reached them {after} after Redis answered again; {outage['lost']} never, "
-        f"{outage['early']} during the outage"
+        f"{outage['early']} during the outage; the hosts' links lost Redis "
+        f"{outage['links_lost']} times and refused {outage['refused']} messages"
     )
