@@ -48,9 +48,10 @@ RECOVERY_TIMEOUT = 30.0
 
 
 class Classroom:
-    """Redis, ``hosts`` servers linked to it, nginx in front: a context manager. It stands for
-    the phase's server (:func:`poinsot.app.devtools.load.phases.run_phase`): ``port`` is
-    nginx's, ``pid`` the first host's and ``worker_pids`` the others'; its logs are theirs."""
+    """Redis, ``hosts`` servers linked to it, nginx in front (:meth:`finish` stops them all; so
+    does a failure to start any). It stands for the phase's server
+    (:func:`poinsot.app.devtools.load.phases.run_phase`): ``port`` is nginx's, ``pid`` the
+    first host's and ``worker_pids`` the others'; its logs are theirs."""
 
     def __init__(self, hosts: int, lifetime: float) -> None:
         self._folder = tempfile.TemporaryDirectory(prefix="poinsot-load-hosts-")
