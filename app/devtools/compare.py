@@ -1,12 +1,14 @@
 """Today's benchmarks against another git revision, as ratios in one run.
 
-``python -m poinsot.app.devtools.compare --against REV [--rounds 3] [--physics] [--app]`` (or
+``python -m poinsot.app.devtools.compare --against REV [--rounds 4] [--physics] [--app]`` (or
 ``make bench-compare AGAINST=REV``).
 
 The other revision is checked out into a temporary ``git worktree`` (removed afterwards). Each
 round runs the physics benchmark and/or the app's benchmark of today's working tree and of that
-revision one after the other (new, old, new, old, ...: both see the same machine load), each
-in a fresh Python of this environment. The tool parses the figures each benchmark prints and
+revision one after the other, each side first in every other round (new, old, old, new, ...:
+both see the same machine load, and neither is always the first of a pair), each in a fresh
+Python of this environment. ``--against HEAD`` compares the tree with itself: its ratios show
+how far the machine's noise alone moves them. The tool parses the figures each benchmark prints and
 shows, per figure, the ratio new/old: the median over the rounds and the min–max. A cost
 (time, bytes) has not regressed when the median ratio is <= 1.10, a rate (frames per second)
 when it is >= 0.90. Controls (bare ``ellipj``, the bare viser server: no Poinsot code) are
@@ -346,18 +348,28 @@ def checkout(repo: pathlib.Path, revision: str) -> Iterator[pathlib.Path]:
             subprocess.run(["git", "-C", str(repo), "worktree", "prune"], check=False)
 
 
+def _order(
+    k: int, new: Tree, old: Tree, new_runs: list[Figures], old_runs: list[Figures]
+) -> tuple[tuple[str, Tree, list[Figures]], ...]:
+    """Round ``k``'s two runs: new first in even rounds, old first in odd ones. The first run
+    of a pair was measured slower than the second, the same tree on both sides (up to 1.14 in
+    every round of three), so each side goes first as often as the other."""
+    pair = (("new", new, new_runs), ("old", old, old_runs))
+    return pair if k % 2 == 0 else pair[::-1]
+
+
 def compare(
     new: Tree, old: Tree, benchmarks: Sequence[str], options: argparse.Namespace
 ) -> tuple[list[Ratio], list[str]]:
-    """Alternate the runs (new, old, new, old, ...) for ``options.rounds`` rounds; the ratios,
-    and the figures only one side printed."""
+    """Alternate the runs (new, old, old, new, new, old, ...: :func:`_order`) for
+    ``options.rounds`` rounds; the ratios, and the figures only one side printed."""
     rows: list[Ratio] = []
     unpaired: list[str] = []
     for benchmark in benchmarks:
         new_runs: list[Figures] = []
         old_runs: list[Figures] = []
         for k in range(options.rounds):
-            for label, tree, runs in (("new", new, new_runs), ("old", old, old_runs)):
+            for label, tree, runs in _order(k, new, old, new_runs, old_runs):
                 print(f"  round {k + 1}/{options.rounds}: {benchmark} {label}", file=sys.stderr)
                 runs.append(run_benchmark(tree, benchmark, options))
         rows += ratios(new_runs, old_runs)
@@ -382,7 +394,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="python -m poinsot.app.devtools.compare", description=__doc__.split("\n\n")[0]
     )
     parser.add_argument("--against", required=True, metavar="REV", help="git revision to beat")
-    parser.add_argument("--rounds", type=int, default=3, help="alternating runs of each side")
+    parser.add_argument("--rounds", type=int, default=4, help="alternating runs of each side")
     parser.add_argument("--physics", action="store_true", help="the physics benchmark")
     parser.add_argument("--app", action="store_true", help="the app benchmark")
     parser.add_argument("-n", type=int, default=1_000_000, help="physics: times per call")

@@ -301,3 +301,16 @@ def test_the_real_physics_benchmark_of_head_against_head(capsys):
     assert len(rows) == 3 * 6 + 3 and unpaired == []
     assert all(len(r.ratios) == 1 and r.median > 0 for r in rows)
     assert _worktree_paths(REPO) == worktrees
+
+
+def test_each_side_runs_first_in_every_other_round(monkeypatch):
+    """The first run of a pair is the slower one on this machine, the same tree on both sides:
+    neither side may always be first."""
+    order: list[str] = []
+    monkeypatch.setattr(
+        compare, "run_benchmark", lambda tree, benchmark, options: order.append(tree) or {}
+    )
+    options = compare.build_parser().parse_args(["--against", "HEAD"])
+    assert options.rounds == 4
+    compare.compare("new", "old", ["app"], options)  # type: ignore[arg-type]
+    assert order == ["new", "old", "old", "new", "new", "old", "old", "new"]

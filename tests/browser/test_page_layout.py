@@ -162,6 +162,11 @@ def test_a_phone_s_sheet_is_full_width_with_t_and_the_regime_and_44_px_targets(
     header = re.compile(r"t = \d+\.\d · polhode around the major axis")
     assert wait_until(lambda: header.fullmatch(session.layout.header) is not None, 20)
     assert wait_until(lambda: header.search(sheet.inner_text()) is not None, 20)
+    # The page folds the sheet once it is there (one tap on its bar): a tap before that fold
+    # would fold it itself, and the page's fold would then find nothing to do.
+    folded = "() => window.poinsotSheetFolded === true"
+    assert wait_until(lambda: page.page.evaluate(folded), 30)
+    assert wait_until(lambda: page.page.evaluate(SHEET_BOX_JS)["height"] < 100, 20)
     # Opened: every target a finger meets is 44 px tall, the Preset menu's rows too.
     page.page.get_by_text(header).first.click()
     assert wait_until(lambda: page.page.evaluate(SHEET_BOX_JS)["height"] > 200, 20)
