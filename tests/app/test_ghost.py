@@ -196,9 +196,15 @@ def test_changing_method_or_setting_restarts_from_the_exact_state(poinsot_app, p
     started = ghost.started
     uuid, _ = probe.widget("Step h")
     probe.set_value(uuid, "T/200")
-    assert wait_until(lambda: ghost.config.divisions == 200 and ghost.started > started, 5)
-    h = ghost.propagation.setting
-    assert h == pytest.approx(time_scale(session.scene.body) / 200)
+    h = time_scale(session.scene.body) / 200
+    assert wait_until(  # the restart with the new step (its propagation, then its start time)
+        lambda: (
+            ghost.config.divisions == 200
+            and ghost.started > started
+            and ghost.propagation.setting == pytest.approx(h)
+        ),
+        20,
+    ), ghost.propagation.setting
     # Just after a restart the ghost is the exact body (errors at rounding level), measured on
     # the first frame after it.
     assert wait_until(lambda: ghost.errors is not None, 10)

@@ -281,7 +281,6 @@ class Ghost:
     def restart(self, body: FreeRigidBody, geometry: Geometry, frame: Frame) -> None:
         """Start again from the exact state shown in ``frame`` (a new body: sizes too)."""
         self.body, self.geometry = body, geometry
-        self.started = float(frame.t)
         self.propagation = Propagation(
             self.config.method,
             body.inertia,
@@ -290,6 +289,7 @@ class Ghost:
             self.config.setting(body),
             t0=frame.t,
         )
+        self.started = float(frame.t)  # after its propagation: a new start has it (other threads)
         self.state = None
         self.errors = None
         self.behind = 0.0
