@@ -440,3 +440,34 @@ def test_a_playing_lead_publishes_its_clock_at_the_state_s_own_instant(poinsot_a
     playing = [s for s in published if not s.paused and s.speed == clock.speed]
     assert len(playing) >= 3
     assert [s.t for s in playing] == pytest.approx([clock.at(s.at) for s in playing], abs=1e-12)
+
+
+def test_a_state_published_again_wakes_no_follower_and_a_change_does():
+    """A lead publishes its state a few times a second; the same state again (its clock
+    re-anchored where it had got to) wakes no follower, since they read the time from the hub.
+    Something shown, another lead, or a jump in time wakes them once each."""
+    hub = FollowHub("abcdef")
+    woken: list[int] = []
+    hub.watch(1, lambda: woken.append(1))
+    hub.deliver(("lead", "tok"))
+    assert len(woken) == 1
+    first = LeadState("tok", "preset=major", 1.0, 10.0, False, 0.5)
+    hub.deliver(("state", first))
+    assert len(woken) == 2 and hub.state is first
+    again = LeadState("tok", "preset=major", 1.125, 10.25, False, 0.5)  # where its clock got to
+    hub.deliver(("state", again))
+    assert len(woken) == 2 and hub.state is again and hub.quiet == 1
+    assert hub.now() is not None and hub.delivered == 2
+    changes = [
+        LeadState("tok", "preset=minor", 1.25, 10.5, False, 0.5),  # another body
+        LeadState("tok", "preset=minor", 1.25, 10.5, True, 0.5),  # paused
+        LeadState("tok", "preset=minor", 3.0, 10.75, True, 0.5),  # a jump in time
+        LeadState("tok", "preset=minor", 3.0, 11.0, True, 0.5, trail=100),  # the trail
+    ]
+    for k, state in enumerate(changes, start=3):
+        hub.deliver(("state", state))
+        assert len(woken) == k, state
+    hub.deliver(("state", LeadState("tok", "preset=minor", 3.0, 11.25, True, 0.5, trail=100)))
+    assert len(woken) == 6 and hub.quiet == 2
+    hub.deliver(("gone", "tok", "left"))  # the lead left: told
+    assert len(woken) == 7

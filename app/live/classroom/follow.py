@@ -32,6 +32,8 @@ from poinsot.app.live.classroom.cast import FollowCast
 
 #: Wrong codes from one client before its connection is closed.
 MAX_WRONG_CODES = 5
+#: A lead's time this far from the time its followers extrapolate is a jump [time units].
+JUMP = 1e-3
 #: The code's alphabet: no 0/O, 1/l/I to misread from a projector.
 _ALPHABET = "23456789abcdefghjkmnpqrstuvwxyz"
 LEFT = "The lecturer left; you keep the last state (Explore from here to go on yourself)."
@@ -67,6 +69,34 @@ class LeadState:
         """Simulation time at monotonic time ``now``."""
         return self.t if self.paused else self.t + self.speed * (now - self.at)
 
+    def shown(self) -> tuple[Any, ...]:
+        """What a follower shows of this state, its time apart."""
+        return (
+            self.query,
+            self.paused,
+            self.speed,
+            self.camera,
+            self.trail,
+            self.hidden,
+            self.parts,
+        )
+
+    def jumped_from(self, before: LeadState) -> bool:
+        """Whether this state's time is not where ``before``'s clock had got to (a jump: a
+        time set by hand, a step)."""
+        return abs(self.t - before.time(self.at)) > JUMP * max(1.0, abs(self.speed))
+
+    def news(self, before: LeadState | None) -> bool:
+        """Whether a follower showing ``before`` has anything to change for this state (another
+        lead, something shown, a jump in time): a state published again only re-anchors the
+        clock, which every follower of a process reads from the hub (:meth:`FollowHub.now`)."""
+        return (
+            before is None
+            or self.leader != before.leader
+            or self.shown() != before.shown()
+            or self.jumped_from(before)
+        )
+
 
 class Claim:
     """The answer to "Lead this class": ``ok``, its message, and whether to close the client."""
@@ -91,8 +121,10 @@ class FollowHub:
         self.gone = ""  # why there is no lead any more (followers keep the last state)
         self._watchers: dict[int, Callable[[], None]] = {}
         self._wrong: dict[int, int] = {}
-        #: States delivered to this process (tests, load test).
+        #: States delivered to this process, and those of them that woke no follower (the
+        #: same state again, its clock re-anchored) (tests, load test).
         self.delivered = 0
+        self.quiet = 0
         #: The lead's bodies, built once for the lead and the followers of this process.
         self.motions = MotionCache()
         #: The lead's scenes (their models and motions), built once for this process's followers.
@@ -169,8 +201,12 @@ class FollowHub:
                 if self._lead is not None and self._lead_token != token:
                     deposed, self._lead, self._lead_token = self._lead, None, ""
             elif kind == "state" and token.leader == self.token:
+                news = token.news(self.state) or bool(self.gone)
                 self.state, self.gone = token, ""
                 self.delivered += 1
+                if not news:  # the same state again: the followers' clock is the hub's
+                    self.quiet += 1
+                    return
             elif kind == "gone" and token == self.token:
                 self.token, self.gone = "", message[2]
             else:

@@ -40,8 +40,6 @@ from poinsot.app.model.presets import PRESETS, Preset
 FOLDER_ORDER = 44.0
 #: Seconds between two publications of an unchanged lead state.
 REPUBLISH = 0.25
-#: A lead's time this far from the time its followers extrapolate is a jump [time units].
-JUMP = 1e-3
 #: The link parameters a state carries on their own.
 _CLOCK_KEYS = ("t", "speed", "paused", "view")
 HELD = (
@@ -285,12 +283,7 @@ class LeadControls:
             return
         state = self._state(token, now)
         last = self._published
-        if (
-            last is None
-            or now - last.at >= REPUBLISH
-            or _shown(state) != _shown(last)
-            or abs(state.t - last.time(now)) > JUMP * max(1.0, abs(state.speed))
-        ):
+        if last is None or now - last.at >= REPUBLISH or state.news(last):
             self._published = state
             self.hub.publish(self, state)
 
@@ -320,16 +313,3 @@ class LeadControls:
         self.hub.unwatch(id(self))
         self.hub.forget(id(self.client))
         self.hub.leave(self)
-
-
-def _shown(state: LeadState) -> tuple[Any, ...]:
-    """What a follower shows of a state, its time apart."""
-    return (
-        state.query,
-        state.paused,
-        state.speed,
-        state.camera,
-        state.trail,
-        state.hidden,
-        state.parts,
-    )
