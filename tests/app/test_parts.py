@@ -271,7 +271,7 @@ def test_cli_serves_the_page_and_prints_the_url(argv):
     finally:
         proc.terminate()
         proc.wait(10)
-    assert wait_until(lambda: proc.poll() is not None, 5)
+    assert wait_until(lambda: proc.poll() is not None, 30)
 
 
 @pytest.mark.server  # it starts a process of its own

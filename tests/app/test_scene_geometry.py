@@ -102,16 +102,16 @@ def test_ellipsoid_touches_the_plane_exactly_at_the_tip_of_omega(preset, make_ap
     assert wait_until(lambda: session.stats.frames > 5, 30)
     pause, _ = probe.widget("Pause")
     probe.set_value(pause, True)
-    assert wait_until(lambda: session.clock.paused, 5)
+    assert wait_until(lambda: session.clock.paused, 30)
     step, _ = probe.widget("Step")
     for k in range(3):
         t = session.clock.now()
         if k:
             probe.set_value(step, True)
-            assert wait_until(lambda t=t: session.clock.now() > t, 5)
+            assert wait_until(lambda t=t: session.clock.now() > t, 30)
         t = session.scene.shown_time(session.clock.now())
         # Paused: once the browser holds the frame of time t, nothing moves any more.
-        assert wait_until(lambda t=t: session.frame is not None and session.frame.t == t, 5)
+        assert wait_until(lambda t=t: session.frame is not None and session.frame.t == t, 30)
         expected_tip = session.frame.contact
         assert probe.wait_for(
             lambda p, e=expected_tip: np.allclose(p.nodes["/space/tip"].position, e), 5

@@ -241,7 +241,7 @@ def test_long_cylinder_progress_along_the_polhode(make_app, make_probe):
     assert wait_until(lambda: session.frame.t > 0.35 * period, 20)
     session.clock.paused = True
     shown = session.clock.now()
-    assert wait_until(lambda: session.frame.t == session.scene.shown_time(shown), 5)
+    assert wait_until(lambda: session.frame.t == session.scene.shown_time(shown), 30)
     expected = f"{100.0 * float(model.arc.fraction(session.frame.t)[0]):.2f} %"
     assert probe.wait_for(
         lambda p: wait_readouts(p, spec.readouts)["travelled along the polhode"][0] == expected, 10

@@ -193,7 +193,7 @@ def test_the_loop_stops_when_the_client_leaves(poinsot_app, make_probe):
     session = session_of(poinsot_app)
     assert wait_until(lambda: session.running and session.stats.frames > 5, 30)
     probe.close()
-    assert wait_until(lambda: not session.running, 5)
+    assert wait_until(lambda: not session.running, 30)
     assert poinsot_app.sessions() == {}
     assert wait_until(lambda: not session.running, 10)  # the frame thread ended
     frames = session.stats.frames
@@ -238,7 +238,7 @@ def test_a_stalled_client_does_not_stall_the_others(poinsot_app, make_probe):
     )
     assert len(slow.batches) == received  # while the stalled browser read nothing
     slow.stall(False)
-    assert slow.wait_for(lambda p: len(p.batches) > received, 5)
+    assert slow.wait_for(lambda p: len(p.batches) > received, 30)
 
 
 def test_two_clients_have_independent_sessions(poinsot_app, make_probe):
@@ -258,7 +258,7 @@ def test_two_clients_have_independent_sessions(poinsot_app, make_probe):
         10,
     )
     after_frames(sb)  # b's session has drained whatever reached it meanwhile
-    assert b.wait_for(lambda p: len(p.batches) > 0, 5)
+    assert b.wait_for(lambda p: len(p.batches) > 0, 30)
     assert sb.params.inertia == DEFAULT_PRESET.inertia and sb.preset is DEFAULT_PRESET
     a_scale = a.snapshot()[0]["/space/body/ellipsoid"].props["scale"]
     b_scale = b.snapshot()[0]["/space/body/ellipsoid"].props["scale"]
@@ -276,7 +276,7 @@ def test_an_impossible_body_is_refused_and_the_last_scene_kept(poinsot_app, prob
     session.wait_applied(generation)
     assert "No real body has these moments" in session.status
     assert "I3 = 3.5 is larger than I1 + I2 = 3" in session.status
-    assert probe.wait_for(lambda p: any("No real body" in t for t in markdown_texts(p)), 5)
+    assert probe.wait_for(lambda p: any("No real body" in t for t in markdown_texts(p)), 30)
     assert session.body is body_before
     received = len(probe.batches)
     after_frames(session)  # frames after the refusal reached the probe, no new ellipsoid
@@ -288,7 +288,7 @@ def test_an_impossible_body_is_refused_and_the_last_scene_kept(poinsot_app, prob
     probe.set_value(uuid, 2.9)  # valid again
     session.wait_applied(generation)
     assert session.status == "" and session.body is not body_before
-    assert probe.wait_for(lambda p: not any("No real body" in t for t in markdown_texts(p)), 5)
+    assert probe.wait_for(lambda p: not any("No real body" in t for t in markdown_texts(p)), 30)
     assert probe.wait_for(
         lambda p: not np.allclose(p.nodes["/space/body/ellipsoid"].props["scale"], scale_before), 5
     )
@@ -344,10 +344,10 @@ def test_visibility_trail_length_and_time_controls(poinsot_app, probe):
     assert wait_until(lambda: session.stats.frames > 10, 30)
     uuid, _ = probe.widget(ELEMENT_LABELS[Element.POLHODE_FULL])
     probe.set_value(uuid, False)
-    assert probe.wait_for(lambda p: not p.nodes["/space/body/polhode_full"].visible, 5)
+    assert probe.wait_for(lambda p: not p.nodes["/space/body/polhode_full"].visible, 30)
     uuid, _ = probe.widget("Trail length")
     probe.set_value(uuid, 100)
-    assert wait_until(lambda: session.scene.trail_points == 100, 5)
+    assert wait_until(lambda: session.scene.trail_points == 100, 30)
     after_frames(session, 120)  # two seconds of trail at 60 Hz, more than 100 points
     for element in (Element.POLHODE, Element.HERPOLHODE):
         trail = session.scene.trail(element)
@@ -357,19 +357,19 @@ def test_visibility_trail_length_and_time_controls(poinsot_app, probe):
     assert len(chunks) <= max(100, 2 * CHUNK_SEGMENTS) // CHUNK_SEGMENTS + 2
     # Pause freezes time; Step advances it by STEP_SECONDS x speed; Reset goes back to 0.
     probe.set_value(probe.widget("Pause")[0], True)
-    assert wait_until(lambda: session.clock.paused, 5)
+    assert wait_until(lambda: session.clock.paused, 30)
     t = session.clock.now()
     after_frames(session)  # frames go on, time stands still
     assert session.clock.now() == t
     probe.set_value(probe.widget("Step")[0], True)
-    assert wait_until(lambda: session.clock.now() > t, 5)
+    assert wait_until(lambda: session.clock.now() > t, 30)
     assert session.clock.now() == pytest.approx(t + STEP_SECONDS * session.clock.speed)
     probe.set_value(probe.widget("Speed")[0], 2.0)
-    assert wait_until(lambda: session.clock.speed == 2.0, 5)
+    assert wait_until(lambda: session.clock.speed == 2.0, 30)
     probe.set_value(probe.widget("Reset")[0], True)
-    assert wait_until(lambda: session.clock.now() == 0.0, 5)
+    assert wait_until(lambda: session.clock.now() == 0.0, 30)
     probe.set_value(probe.widget("Play")[0], True)
-    assert wait_until(lambda: not session.clock.paused and session.clock.now() > 0.2, 5)
+    assert wait_until(lambda: not session.clock.paused and session.clock.now() > 0.2, 30)
     assert session.stats.errors == 0, session.stats.last_error
 
 

@@ -157,7 +157,7 @@ def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_p
     assert page.dropdown_value("Picture size") == "1920×1080"
     # Current view: the 3D view's size, opaque on the dark theme's background.
     page.choose("Picture size", "current view")
-    assert wait_until(lambda: lecture.size.value == "current view", 5)
+    assert wait_until(lambda: lecture.size.value == "current view", 30)
     name, image = download_png(page)
     width, height = session.client.camera.image_width, session.client.camera.image_height
     view = page.canvas_box()  # the 3D view, between the docked columns
@@ -175,7 +175,7 @@ def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_p
     # 1920×1080, transparent: RGBA, clear where nothing is drawn.
     page.choose("Picture size", "1920×1080")
     page.set_checkbox("Transparent PNG", True)
-    assert wait_until(lambda: lecture.transparent.value and lecture.size.value == "1920×1080", 5)
+    assert wait_until(lambda: lecture.transparent.value and lecture.size.value == "1920×1080", 30)
     name, image = download_png(page)
     assert image.size == (1920, 1080) and image.mode == "RGBA"
     rgba = np.asarray(image)

@@ -51,7 +51,7 @@ def started(app, frames: int = 20):
 
 def pause(page, session) -> None:
     page.click_button("Pause")
-    assert wait_until(lambda: session.clock.paused, 5)
+    assert wait_until(lambda: session.clock.paused, 30)
 
 
 @pytest.fixture(scope="module")
@@ -115,7 +115,7 @@ def test_canvas_shows_the_ellipsoid(shared):
     shown = canvas_pixels(page)
     page.open_folder("Show")  # collapsed by default
     page.set_checkbox("energy ellipsoid", False)
-    assert wait_until(lambda: not session.scene.is_visible(Element.ELLIPSOID), 5)
+    assert wait_until(lambda: not session.scene.is_visible(Element.ELLIPSOID), 30)
     page.drawn_after(session.client)
     hidden = canvas_pixels(page)
     # The semi-transparent amber ellipsoid covers a good part of the view; only it is amber.

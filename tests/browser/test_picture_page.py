@@ -151,7 +151,7 @@ def set_theme(page, session, theme: str) -> None:
 
 def pause(page, session) -> None:
     page.click_button("Pause")
-    assert wait_until(lambda: session.clock.paused, 5)
+    assert wait_until(lambda: session.clock.paused, 30)
     # The traces are sent in chunks: paused, the last one goes out at the next frame. Until
     # then a picture could change between two screenshots for a reason of its own.
     assert wait_until(lambda: session.scene.traces_complete, 10)

@@ -97,7 +97,7 @@ def test_an_uploaded_mesh_becomes_the_body(shared):
     page, session = open_entry(shared, MESH_BODY.label, MESH)
     if not session.clock.paused:  # (the module's page: as the test before left it)
         page.click_button("Pause")
-    assert wait_until(lambda: session.clock.paused, 5)
+    assert wait_until(lambda: session.clock.paused, 30)
     page.set_live_view(True)
     page.drawn_after(session.client)
     before = page.screenshot_rgb()
