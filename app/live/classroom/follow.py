@@ -201,7 +201,7 @@ class FollowHub:
                 if self._lead is not None and self._lead_token != token:
                     deposed, self._lead, self._lead_token = self._lead, None, ""
             elif kind == "state" and token.leader == self.token:
-                news = token.news(self.state) or bool(self.gone)
+                news = token.news(self.state)
                 self.state, self.gone = token, ""
                 self.delivered += 1
                 if not news:  # the same state again: the followers' clock is the hub's
