@@ -20,6 +20,7 @@ from poinsot.app.devtools.probe import Probe
 from poinsot.app.live.classroom import links
 from poinsot.app.live.classroom.follow import ENDED, MAX_WRONG_CODES, FollowHub, LeadState
 from poinsot.app.live.classroom.lead import HELD
+from poinsot.app.live.panel.body_controls import run_writes
 from poinsot.app.live.relay import Relay
 from poinsot.app.model.elements import Element
 from poinsot.app.viser_private import wire_message
@@ -282,6 +283,44 @@ def test_followers_share_one_build_mirror_what_is_shown_and_cannot_point(poinsot
     assert probe.wait_for(lambda p: _says(p, "Exploring on your own"), 30)
     _run(pointer._on_click(click))
     assert wait_until(lambda: pointer.starts == 1, 30)
+
+
+def test_a_follower_mirrors_a_move_into_its_sliders_in_one_wake_of_its_loop(
+    poinsot_app, make_probe
+):
+    """A follower shows each body the lead moves to in its sliders with one call to viser's
+    event loop for the whole body (its writes in order), not one a slider: a class of
+    followers wakes the loop once each for a move of the lecturer's."""
+    lead, probes, _, followers = _class_of_three(poinsot_app, make_probe)
+    loop = poinsot_app.server.get_event_loop()
+    threads = {follower.loop.name: follower for follower in followers}
+    calls: dict[str, list[Any]] = {name: [] for name in threads}
+    real = loop.call_soon_threadsafe
+
+    def counting(callback, *args, **kwargs):
+        name = threading.current_thread().name
+        if name in calls:
+            calls[name].append(callback)
+        return real(callback, *args, **kwargs)
+
+    before = {name: follower.generation for name, follower in threads.items()}
+    loop.call_soon_threadsafe = counting  # type: ignore[method-assign]
+    try:
+        for value in (2.3, 2.2):
+            _set(lead, D, value)
+            for probe in probes:
+                assert probe.wait_for(lambda p, v=value: _value(p, D) == pytest.approx(v), 30)
+        for name, follower in threads.items():  # (the sliders are shown before it ends)
+            assert wait_until(lambda f=follower, n=name: f.generation >= before[n] + 2, 30)
+    finally:
+        del loop.call_soon_threadsafe  # the loop's own method again
+    for name, follower in threads.items():
+        rebuilds = follower.generation - before[name]
+        mirrors = [c for c in calls[name] if c is run_writes]
+        # one call per body shown (a rebuild begun before the count may have mirrored already)
+        assert 2 <= len(mirrors) <= rebuilds, (name, rebuilds, calls[name])
+        alone = [c for c in calls[name] if "_mirror" in getattr(c, "__qualname__", "")]
+        assert alone == [], alone  # never a slider on its own
 
 
 def test_followers_share_one_build_of_the_lead_s_scene(poinsot_app, make_probe):

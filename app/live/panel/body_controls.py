@@ -160,17 +160,21 @@ class BodyControls:
         return [slider]
 
     def show(self, params: Parameters) -> None:
-        """Mirror parameters into the sliders (and the D slider's range and marks)."""
+        """Mirror parameters into the sliders (and the D slider's range and marks). The
+        sliders' values are written on viser's event loop in one call (:meth:`_mirror`): one
+        wake-up of the loop for the whole body, not one a slider (a class of followers mirrors
+        every move of the lecturer's)."""
         w = self.widgets
+        writes: list[Callable[[], None]] = []
         lo, hi = slider_range(INERTIA_RANGE, params.inertia)
         for i, (slider, moment) in enumerate(zip(w.inertia, params.inertia, strict=False)):
             if (slider.min, slider.max) != (lo, hi):
                 slider.min, slider.max = lo, hi
-            self._mirror(f"I{i}", slider, float(moment))
+            writes.append(self._mirror(f"I{i}", slider, float(moment)))
         if w.energy is not None:
             w.energy.min, w.energy.max = params.D_range
             set_marks(w.energy, energy_marks(params))
-            self._mirror("D", w.energy, float(params.D))
+            writes.append(self._mirror("D", w.energy, float(params.D)))
         if w.side is not None and w.side.visible != params.has_separatrix:
             w.side.visible = params.has_separatrix  # a symmetric body has no separatrix
         if w.side is not None and self._pole is not None:
@@ -180,7 +184,9 @@ class BodyControls:
             lo, hi = slider_range(OMEGA_NORM_RANGE, (params.omega_norm,))
             if (w.omega_norm.min, w.omega_norm.max) != (lo, hi):
                 w.omega_norm.min, w.omega_norm.max = lo, hi
-            self._mirror("omega", w.omega_norm, float(params.omega_norm))
+            writes.append(self._mirror("omega", w.omega_norm, float(params.omega_norm)))
+        if writes:
+            self._loop.call_soon_threadsafe(run_writes, writes)
 
     # -- a slider moved in the browser, and the body shown ----------------------------------
     def _edit(self, key: str, sent: Sent, change: Callable[[Parameters], Parameters]) -> None:
@@ -197,18 +203,20 @@ class BodyControls:
 
         self.edit(apply)
 
-    def _mirror(self, key: str, slider: Any, value: float) -> None:
-        """Show ``value`` in slider ``key``, unless the browser has sent it a newer value than
-        the parameters shown hold: a body built for an older value (keys pressed faster than
-        the body is rebuilt) would put the thumb back under the user's hand, and the next key
-        would step from there. The newer value is shown once applied (snapped if need be).
+    def _mirror(self, key: str, slider: Any, value: float) -> Callable[[], None]:
+        """The write that shows ``value`` in slider ``key``, unless the browser has sent it a
+        newer value than the parameters shown hold: a body built for an older value (keys
+        pressed faster than the body is rebuilt) would put the thumb back under the user's
+        hand, and the next key would step from there. The newer value is shown once applied
+        (snapped if need be).
 
-        The check and the write run on viser's event loop (called from the frame thread).
-        viser stores a browser's value in the handle there, then runs the callbacks that count
-        it (:func:`~.widgets.on_user`); a write from the frame thread landing between the two
-        would replace the user's value before it is counted, and the edit would ask for the
-        mirrored one. The count the shown parameters hold is read here, when they are shown:
-        by the time the loop writes, the frame thread may have applied a newer value."""
+        The check and the write run on viser's event loop (made on the frame thread, run there
+        by :meth:`show`). viser stores a browser's value in the handle there, then runs the
+        callbacks that count it (:func:`~.widgets.on_user`); a write from the frame thread
+        landing between the two would replace the user's value before it is counted, and the
+        edit would ask for the mirrored one. The count the shown parameters hold is read here,
+        when they are shown: by the time the loop writes, the frame thread may have applied a
+        newer value."""
         sent = self._sent.get(key)
         applied = 0
         if sent is not None:
@@ -221,4 +229,10 @@ class BodyControls:
                 return  # the browser's newer value is on its way to the parameters
             set_value(slider, value)
 
-        self._loop.call_soon_threadsafe(write)
+        return write
+
+
+def run_writes(writes: list[Callable[[], None]]) -> None:
+    """On viser's event loop: the sliders' writes of one :meth:`BodyControls.show`, in order."""
+    for write in writes:
+        write()
