@@ -109,7 +109,6 @@ def _serve_one(
 ) -> int:
     """``poinsot serve --workers 1``: one process, until Ctrl-C."""
     from poinsot.app.live.hardening.network import board, port_problem
-    from poinsot.app.live.hardening.upkeep import tune_collector
     from poinsot.app.live.server import PoinsotApp
     from poinsot.app.live.workers import lecturer_line
 
@@ -120,7 +119,6 @@ def _serve_one(
         app.stop()
         print(f"poinsot serve: {port_problem(host, port)}", file=sys.stderr)
         return 2
-    tune_collector()
     print(board(host, app.port, link or ""), flush=True)
     print(lecturer_line(app.follow.code), flush=True)
     try:

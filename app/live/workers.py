@@ -29,7 +29,6 @@ from typing import TYPE_CHECKING, Any
 
 from poinsot.app.live.classroom.follow import new_code
 from poinsot.app.live.hardening.network import PortError, check_port, port_problem
-from poinsot.app.live.hardening.upkeep import tune_collector
 
 if TYPE_CHECKING:
     from poinsot.app.live.server import PoinsotApp
@@ -87,7 +86,6 @@ def _worker_main(
             conn.send(("error", port_problem(host, port)))
             return
         _count_clients(app.server, load)
-        tune_collector()
         conn.send(("ready", app.port))
         while (request := conn.recv()) != "stop":  # EOFError: the parent is gone
             _, look = request  # ("inspect", function of the app): the load test's questions

@@ -3,8 +3,6 @@ departures (counted, never timed)."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import threading
 
 from conftest import wait_until
@@ -41,53 +39,6 @@ def test_memory_is_trimmed_once_after_a_burst_of_departures():
         assert wait_until(lambda: trim.trims == 2, 10)
     finally:
         trim.stop()
-
-
-#: A process with a server's worth of long-lived objects, then a churn of lists each kept a
-#: while, a cycle left behind, and a session's departure: it prints its whole-process collections
-#: during the churn, and whether the cycle was freed by the departure's trim.
-COLLECTOR_SCRIPT = """
-import collections, gc, sys, time, weakref
-from poinsot.app.live.hardening.upkeep import COLLECTOR_THRESHOLDS, MemoryTrim, tune_collector
-if sys.argv[1] == "tuned":
-    tune_collector()
-    assert gc.get_threshold() == COLLECTOR_THRESHOLDS and gc.get_freeze_count() > 0
-kept = [{"i": i} for i in range(200_000)]  # the sessions' objects, made while serving
-class Node: pass
-node = Node(); node.me = node; left = weakref.ref(node); del node  # a cycle left behind
-full = gc.get_stats()[2]["collections"]
-frames = collections.deque(maxlen=100_000)  # what the frames make, kept a while
-for i in range(6_000_000):
-    frames.append([i])
-full = gc.get_stats()[2]["collections"] - full
-trim = MemoryTrim(quiet_seconds=0.0)
-trim.departed()
-while trim.trims == 0:
-    time.sleep(0.01)
-print(full, left() is None)
-"""
-
-
-def _collector_run(mode: str) -> tuple[int, bool]:
-    done = subprocess.run(
-        [sys.executable, "-c", COLLECTOR_SCRIPT, mode],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=True,
-    )
-    full, freed = done.stdout.split()
-    return int(full), freed == "True"
-
-
-def test_a_serving_process_collects_the_whole_heap_rarely_and_still_frees_what_is_left():
-    """Python's own settings scan the whole process again and again under a churn of
-    allocations (each scan holds every session); a server's (``tune_collector``) not once,
-    and a departure's trim still frees the cycles left behind."""
-    default_full, default_freed = _collector_run("default")
-    tuned_full, tuned_freed = _collector_run("tuned")
-    assert default_full >= 1 and tuned_full == 0, (default_full, tuned_full)
-    assert default_freed and tuned_freed
 
 
 def test_a_server_builds_sessions_on_its_fixed_pool(make_app, make_probe):

@@ -11,7 +11,6 @@ the parent goes away, or after ``lifetime`` seconds, whichever comes first.
 from __future__ import annotations
 
 import collections
-import gc
 import logging
 import os
 import pathlib
@@ -25,7 +24,6 @@ from typing import Any
 
 from poinsot.app import viser_private
 from poinsot.app.devtools.load.children import Child
-from poinsot.app.live.hardening.upkeep import COLLECTOR_THRESHOLDS, tune_collector
 
 #: What counts as an error in the server's log (case-insensitive).
 ERROR_PATTERN = re.compile(r"traceback|error", re.IGNORECASE)
@@ -55,10 +53,6 @@ def _status(app: Any) -> dict[str, Any]:
         "connections": viser_private.connection_count(app.server),
         "disconnected": app.guard.disconnected,  # cut off for exceeding the message budget
         "threads": dict(kinds),
-        # The cyclic collector's whole-process collections so far, and whether its settings
-        # are a server's (upkeep.tune_collector).
-        "full_collections": gc.get_stats()[2]["collections"],
-        "untuned": int(gc.get_threshold() != COLLECTOR_THRESHOLDS or not gc.get_freeze_count()),
     }
 
 
@@ -141,8 +135,6 @@ def _main(
         app, link = _linked_app(redis)
     else:
         app = PoinsotApp("127.0.0.1", 0) if workers == 1 else _Classroom(workers)
-    if workers == 1:  # as poinsot serve tunes its one process (a classroom's workers their own)
-        tune_collector()
     pids = [w.pid for w in app.workers] if workers > 1 else []
     code = app.code if workers > 1 else app.follow.code
     conn.send(("ready", (app.port, pids, code)))

@@ -9,15 +9,6 @@ threads, and memory handed back once sessions are gone.
   collect reference cycles and hand the heap's free pages back to the system (glibc's
   ``malloc_trim``). Without it, a storm of 200 visits left the server 17 % larger, in freed
   but kept memory, long after the last visitor left.
-- :func:`tune_collector`: a serving process's cyclic garbage collector, set once it serves.
-  Python's defaults collect the youngest objects every 700 allocations and scan every object
-  of the process every hundred of those: with a hall of followers (150 on two workers, the
-  load test's follow phase) each worker paused for a whole collection ten times a minute, up
-  to 0.29 s each, every session's frames held meanwhile (2.5 s of every minute in the
-  collector). The objects made before serving (modules, the viser client, the presets) are
-  frozen out of the collector's scans, and the collections come rarer: in the same phase, two
-  full collections in a worker's whole run instead of ten. What a session leaves behind is
-  still collected by :class:`MemoryTrim` once it is gone.
 """
 
 from __future__ import annotations
@@ -34,10 +25,6 @@ from typing import Any
 POOL_THREADS = 4
 #: Seconds without a departure before memory is trimmed (a storm is trimmed once, after it).
 QUIET_SECONDS = 2.0
-#: The collector's thresholds in a serving process (:func:`tune_collector`; Python's are
-#: (700, 10, 10)): allocations between collections of the youngest generation, and collections
-#: of each generation between two of the next.
-COLLECTOR_THRESHOLDS = (50_000, 20, 100)
 
 
 def fixed_pool(threads: int = POOL_THREADS, name: str = "poinsot-pool") -> ThreadPoolExecutor:
@@ -48,14 +35,6 @@ def fixed_pool(threads: int = POOL_THREADS, name: str = "poinsot-pool") -> Threa
         pool.submit(barrier.wait)
     barrier.wait()
     return pool
-
-
-def tune_collector() -> None:
-    """Once a process serves (not in a test's or a notebook's process): collect, freeze what
-    exists (never garbage: scanned no more) and set :data:`COLLECTOR_THRESHOLDS`."""
-    gc.collect()
-    gc.freeze()
-    gc.set_threshold(*COLLECTOR_THRESHOLDS)
 
 
 def _malloc_trim() -> Any:

@@ -21,7 +21,6 @@ from typing import TYPE_CHECKING, Any
 from poinsot.app.devtools.load.children import Child
 from poinsot.app.devtools.load.fleet import SCENE_TIMEOUT, SLIDER_LABEL, SLIDER_VALUES
 from poinsot.app.devtools.load.fleet import _Client as Counter
-from poinsot.app.live.hardening.upkeep import tune_collector
 
 if TYPE_CHECKING:
     from poinsot.app.devtools.probe import Probe
@@ -161,9 +160,6 @@ def _main(
         followers = _followers(port, sources, deadline, probes)
         _follow(followers)
         clients = _Clients(leading, followers)
-        # The clients stand for browsers, each on a device of its own: a pause of this whole
-        # interpreter to collect cycles (up to 0.28 s with 38 followers) is no server's delay.
-        tune_collector()
         conn.send(("ready", len(sources)))
         while time.monotonic() < deadline and conn.poll(lifetime):
             request = conn.recv()

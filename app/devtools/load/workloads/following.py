@@ -53,49 +53,20 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         ) as fleet:
             time.sleep(warmup(cfg.follow_seconds))
             pids = server.worker_pids or [server.pid]
-            before = server.status()
             following = fleet.window(
                 cfg.follow_seconds, cfg.slider_period, cfg.follow_redraw_timeout
             )
             cpu0 = _cpu(pids)
             still = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu1 = _cpu(pids)
-            after = server.status()
             explored = fleet.explore()
             cpu2 = _cpu(pids)
             own = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu3 = _cpu(pids)
         costs = (_ms_per_frame(cpu1 - cpu0, still), _ms_per_frame(cpu3 - cpu2, own))
         load = Load((cpu1 - cpu0) / still["seconds"], following["clients"], processes)
-        collector = Collector(
-            after["full_collections"] - before["full_collections"], after["untuned"]
-        )
-        report.add(
-            *_figures(count, following, still, own, costs, explored, load), collector.figure(count)
-        )
+        report.add(*_figures(count, following, still, own, costs, explored, load))
         report.notes.append(f"follow, {count} followers: {load.text()}")
-
-
-@dataclasses.dataclass(frozen=True)
-class Collector:
-    """The server processes' cyclic garbage collector while the lead moved and while nothing
-    moved: its whole-process collections (each holds every session's frames for as long as it
-    scans), and how many processes are not set as a server's
-    (:func:`~poinsot.app.live.hardening.upkeep.tune_collector`)."""
-
-    full_collections: int
-    untuned: int
-
-    def figure(self, count: int) -> Figure:
-        tuned = "as a server's" if not self.untuned else f"left as Python's in {self.untuned}"
-        return info(
-            "follow",
-            f"{count} followers: the server's garbage collector",
-            f"{self.full_collections} whole-process collection(s) in the two windows "
-            f"(the collector {tuned})",
-            full_collections=float(self.full_collections),
-            untuned=float(self.untuned),
-        )
 
 
 #: A client process this busy [cores] limits the frame rates it counts, not the server.
