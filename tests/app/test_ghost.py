@@ -136,7 +136,7 @@ def test_switching_on_creates_it_and_off_removes_it(poinsot_app, probe):
     session = session_of(poinsot_app)
     recorder = Recorder(probe)
     ghost = switch_on(probe, session)
-    assert probe.wait_for(lambda p: "ω error" in ghost_readout(p), 5), ghost_readout(probe)
+    assert probe.wait_for(lambda p: "ω error" in ghost_readout(p), 30), ghost_readout(probe)
     first = ghost_readout(probe)
     assert "RK45" in first and f"tol 1e-{round(-math.log10(DEFAULT_TOLERANCE))}" in first
     # The readout refreshes as the ghost runs, and the plot receives finite positive errors.

@@ -111,7 +111,7 @@ def test_screenshot_that_never_renders_gives_a_message_not_a_hang(live):
     assert not any(n.endswith(".png") for n in downloads.complete())
     # The panel shows the message too (what the probe, i.e. the browser, received).
     assert probe.wait_for(
-        lambda p: any("Screenshot failed" in str(w.props) for w in p.widgets.values()), 5
+        lambda p: any("Screenshot failed" in str(w.props) for w in p.widgets.values()), 30
     )
     # A second attempt is not blocked by the first.
     lecture.message.content = ""

@@ -114,7 +114,7 @@ def test_ellipsoid_touches_the_plane_exactly_at_the_tip_of_omega(preset, make_ap
         assert wait_until(lambda t=t: session.frame is not None and session.frame.t == t, 30)
         expected_tip = session.frame.contact
         assert probe.wait_for(
-            lambda p, e=expected_tip: np.allclose(p.nodes["/space/tip"].position, e), 5
+            lambda p, e=expected_tip: np.allclose(p.nodes["/space/tip"].position, e), 30
         )
         check_finite(probe)
         check_rolling_contact(sent_geometry(probe))
