@@ -73,9 +73,11 @@ Inventory (section, private name, what it is used for):
 *Window* (:mod:`poinsot.app.viser_private.window`)
   - ``viser.infra._infra._message_producer``'s wire format (its ``_append_aligned_buffers``,
     ``Message.as_serializable_dict``, zstd level 1): a window of messages encoded once and
-    written to many clients' connections (the followers' shared frames), each with websockets'
-    public ``ServerConnection.send`` as a task on its loop (:func:`encode_window`,
-    :class:`WindowSocket`, :func:`send_each`).
+    written to many clients' connections (the followers' shared frames) in one call on their
+    loop, each as websockets' ``ServerConnection.send`` writes a message, without its task: the
+    connection's Sans-I/O ``protocol.send_binary`` and its ``send_data``, ``paused`` (flow
+    control), ``drain`` and ``send_in_progress`` (:func:`encode_window`, :class:`WindowSocket`,
+    :func:`send_each`).
 
 *Messages*
   - ``viser._messages``: the client-to-server message classes whose fields

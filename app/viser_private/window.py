@@ -11,10 +11,16 @@ websocket connection on its event loop, without waiting for any of them:
   zstd-compressed msgpack of {"messages", "timestampSec", "binaryBufferLengths"}, then the
   binary buffers, each 8-byte aligned`` (``_infra._append_aligned_buffers``), each message
   serialised by ``Message.as_serializable_dict`` (its numpy arrays put in the binary buffers);
-- the client's connection and loop (:func:`~.transport.connection_of`), on which
-  ``ServerConnection.send(bytes)`` (websockets' public coroutine) runs as a task of its own, so
-  that a client whose socket does not drain holds only its own task (:class:`WindowSocket` sends it
-  nothing more until that task ends).
+- the client's connection and loop (:func:`~.transport.connection_of`), on which one call
+  writes the window to every socket of the loop as ``ServerConnection.send(bytes)`` (websockets'
+  coroutine) writes a message: its Sans-I/O protocol frames it (``protocol.send_binary``) and
+  ``send_data`` hands the frame to the transport, which never blocks. A task a socket, as
+  ``send`` is run, kept the loop of a process of 150 followers behind the cast's frames (see
+  ``docs/measurements/classroom.md``). What
+  ``send`` awaits after writing is websockets' flow control (``drain``: the transport's buffer
+  past its high-water mark): a socket whose transport paused writing stays busy, in a task of
+  its own that drains it, and :class:`WindowSocket` hands it nothing more until it has drained,
+  so that a client whose socket does not drain holds only that task and one window.
 
 ``tests/app/test_viser_private.py`` checks that a window encoded here decodes to what viser's own
 producer sends for the same messages.
@@ -71,8 +77,9 @@ def encode_window(messages: Sequence[Any]) -> bytes:
 
 
 class WindowSocket:
-    """One client's websocket, for windows encoded once. ``busy`` while a window handed to it
-    is not yet written (its send task not ended); ``sent`` and ``failed`` count the windows."""
+    """One client's websocket, for windows encoded once. ``busy`` from a window's handing to
+    its writing, and while its transport has paused writing; ``sent`` and ``failed`` count the
+    windows."""
 
     def __init__(self, client: viser.ClientHandle) -> None:
         self.connection, self.loop = connection_of(client)
@@ -85,17 +92,34 @@ class WindowSocket:
         """False if viser's names moved, or the client left before it was reached."""
         return self.connection is not None and isinstance(self.loop, asyncio.AbstractEventLoop)
 
-    def _ended(self, task: asyncio.Task[None]) -> None:
-        self.busy = False
-        if task.cancelled() or task.exception() is not None:  # the client left meanwhile
+    def write(self, data: bytes) -> None:
+        """On its loop: ``data`` written as ``ServerConnection.send`` writes a message, then
+        busy until its transport drains, if it paused writing (see the module)."""
+        connection = self.connection
+        try:
+            if connection.send_in_progress is not None:  # a fragmented message (viser sends none)
+                raise RuntimeError("a message is being sent in fragments")
+            connection.protocol.send_binary(data)  # raises unless the connection is open
+            connection.send_data()
+        except Exception:  # the client left meanwhile
+            self.busy = False
             self.failed += 1
+            return
+        self.sent += 1
+        if connection.paused:
+            self.loop.create_task(connection.drain()).add_done_callback(self._drained)
         else:
-            self.sent += 1
+            self.busy = False
+
+    def _drained(self, task: asyncio.Task[None]) -> None:
+        self.busy = False
+        if not task.cancelled():
+            task.exception()  # the client left while it drained: retrieved, nothing to do
 
 
 def send_each(sockets: Sequence[WindowSocket], data: bytes) -> int:
-    """Hand ``data`` to every socket, each as a task on its loop (any thread; never waits).
-    Returns how many were handed it (a closed loop takes none)."""
+    """Hand ``data`` to every socket, one call on each loop for its sockets (any thread; never
+    waits). Returns how many were handed it (a closed loop takes none)."""
     by_loop: dict[Any, list[WindowSocket]] = {}
     for socket in sockets:
         socket.busy = True
@@ -112,7 +136,6 @@ def send_each(sockets: Sequence[WindowSocket], data: bytes) -> int:
 
 
 def _start(group: list[WindowSocket], data: bytes) -> None:
-    """On the sockets' loop: one send task each."""
+    """On the sockets' loop: each written."""
     for socket in group:
-        task = socket.loop.create_task(socket.connection.send(data))
-        task.add_done_callback(socket._ended)
+        socket.write(data)

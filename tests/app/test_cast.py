@@ -98,18 +98,28 @@ def test_a_detached_follower_encodes_its_own_frames_again(poinsot_app, make_prob
 
 
 class _Stuck:
-    """A follower's connection whose writes never end until released (a socket that does not
-    drain: its browser reads nothing, or the network to it is gone)."""
+    """A follower's connection whose transport has paused writing until released (a socket that
+    does not drain: its browser reads nothing, or the network to it is gone). Its writes reach
+    the real connection."""
 
     def __init__(self, connection, loop) -> None:
         self.connection, self.loop = connection, loop
         self.release = asyncio.Event()
         self.writes = 0
+        self.paused = True
+        self.send_in_progress = None
+        self.protocol = self  # its protocol's send_binary is its own (counted)
 
-    async def send(self, data: bytes) -> None:
+    def send_binary(self, data: bytes) -> None:
         self.writes += 1
+        self.connection.protocol.send_binary(data)
+
+    def send_data(self) -> None:
+        self.connection.send_data()
+
+    async def drain(self) -> None:
         await self.release.wait()
-        await self.connection.send(data)
+        self.paused = False
 
 
 def test_a_slow_follower_does_not_hold_the_others(poinsot_app, make_probe):
