@@ -16,11 +16,11 @@ websocket connection on its event loop, without waiting for any of them:
   coroutine) writes a message: its Sans-I/O protocol frames it (``protocol.send_binary``) and
   ``send_data`` hands the frame to the transport, which never blocks. A task a socket, as
   ``send`` is run, kept the loop of a process of 150 followers behind the cast's frames (see
-  ``docs/measurements/classroom.md``). What
-  ``send`` awaits after writing is websockets' flow control (``drain``: the transport's buffer
-  past its high-water mark): a socket whose transport paused writing stays busy, in a task of
-  its own that drains it, and :class:`WindowSocket` hands it nothing more until it has drained,
-  so that a client whose socket does not drain holds only that task and one window.
+  ``docs/measurements/classroom.md``). What ``send`` awaits after writing is websockets' flow
+  control (``drain``: the transport's buffer past its high-water mark): a socket whose
+  transport paused writing stays busy, in a task of its own that drains it, and
+  :class:`WindowSocket` hands it nothing more until it has drained, so that a client whose
+  socket does not drain holds only that task and one window.
 
 ``tests/app/test_viser_private.py`` checks that a window encoded here decodes to what viser's own
 producer sends for the same messages.
@@ -96,12 +96,14 @@ class WindowSocket:
         """On its loop: ``data`` written as ``ServerConnection.send`` writes a message, then
         busy until its transport drains, if it paused writing (see the module)."""
         connection = self.connection
-        try:
-            if connection.send_in_progress is not None:  # a fragmented message (viser sends none)
-                raise RuntimeError("a message is being sent in fragments")
-            connection.protocol.send_binary(data)  # raises unless the connection is open
-            connection.send_data()
-        except Exception:  # the client left meanwhile
+        written = connection.send_in_progress is None  # else a message sent in fragments
+        if written:  # (viser sends none; ``send`` would wait for it, this frame is skipped)
+            try:
+                connection.protocol.send_binary(data)  # raises unless the connection is open
+                connection.send_data()
+            except Exception:  # the client left meanwhile
+                written = False
+        if not written:
             self.busy = False
             self.failed += 1
             return
