@@ -22,6 +22,11 @@ from poinsot.app.live.session.session import PLOT_MIN_FRAMES
 from poinsot.app.model.parameters import Parameters
 from poinsot.app.model.presets import DEFAULT_PRESET
 
+#: The most frames a plot's sending waits past its first possible frame: a layout step every
+#: other frame and the traces every TRAIL_EVERY frames, never together, leave a free frame
+#: within three (at most 3 measured, alone and beside three busy loops).
+PLOT_WAIT = 4
+
 
 def _reference_choice(boxes: np.ndarray, reach: np.ndarray) -> tuple[list[int], list[float]]:
     """The choice as arrays give it: each label's costs in full (reach plus overlap with the
@@ -136,12 +141,11 @@ def test_a_layout_outdated_by_a_new_body_sends_nothing(scene_and_sent):
     assert scene.lay_out_labels(_camera())  # a new layout does place them
 
 
-@pytest.mark.serial  # the plot samples by the clock and sends by frames: it needs the frame rate
 def test_a_frame_carries_at_most_one_of_traces_plot_and_a_layout_step(make_app, make_probe):
     """In a live session, per frame drawn: at most one step of the labels' layout, and never
-    with the traces or the plot on the same frame; layouts still complete, in five steps, and
-    the traces and the plot keep their rates (at the server's own frame rate: the rates are
-    shares of its frames)."""
+    with the traces or the plot on the same frame; layouts still complete, in five steps, the
+    traces keep their share of the frames, and the plot is sent within a few frames of each
+    sample (all counted in frames: what the clock brings a frame is the machine's)."""
     app = make_app(max_fps=MAX_FPS)
     make_probe(app)
     session = session_of(app)
@@ -170,10 +174,9 @@ def test_a_frame_carries_at_most_one_of_traces_plot_and_a_layout_step(make_app, 
             frames.append(set(current) | ({"traces"} if session.scene.sent_traces else set()))
         return drawn
 
-    samples = [0]
     wrap(display, "_step", "step")
     wrap(motion, "send_plot", "plot")
-    wrap(motion, "record_plot", "sample", samples)
+    wrap(motion, "record_plot", "sample")
     wrap(session.scene, "label_steps", "begin", begun)
     session.frames.draw = frame  # type: ignore[method-assign]
     assert wait_until(lambda: len(frames) > 240, 30)
@@ -184,11 +187,26 @@ def test_a_frame_carries_at_most_one_of_traces_plot_and_a_layout_step(make_app, 
     assert begun[0] >= 3, begun  # ~2 layouts a second under a still camera
     assert steps >= 5 * (begun[0] - 1)
     assert sum("traces" in f for f in kinds) >= len(kinds) // TRAIL_EVERY - 2
-    # The plot waits a frame or two, not a sample (a step every other frame leaves it room):
-    # (nearly) every sample is sent, unless the frame rate caps the plot's (a window at most
-    # every PLOT_MIN_FRAMES frames).
-    sent = sum("plot" in f for f in kinds)
-    assert sent >= 0.9 * min(samples[0], len(kinds) / PLOT_MIN_FRAMES), (sent, samples, len(kinds))
+    # The plot waits a frame or two, not a sample (a step every other frame leaves it room).
+    waits = plot_waits(kinds)
+    assert len(waits) >= 3 and max(waits) <= PLOT_WAIT, waits
+
+
+def plot_waits(kinds: list[set[str]]) -> list[int]:
+    """For each sending of the plot, the frames it waited past the first frame that could
+    carry its samples (the later of the first sample's frame and PLOT_MIN_FRAMES after the last
+    sending). In frames: the samples come by the clock, and how many come a frame is the
+    machine's."""
+    waits: list[int] = []
+    last_sent, pending = -PLOT_MIN_FRAMES, None
+    for i, kind in enumerate(kinds):
+        if "sample" in kind and pending is None:
+            pending = i
+        if "plot" in kind:
+            if pending is not None:  # (the first may carry a sample from before the count)
+                waits.append(i - max(pending, last_sent + PLOT_MIN_FRAMES))
+            last_sent, pending = i, None
+    return waits
 
 
 def test_a_view_of_another_height_is_laid_out_again():

