@@ -337,9 +337,6 @@ SLEEPS_ALLOWED: dict[tuple[str, str], str] = {
     ("tests/app/test_server.py", "test_random_input_never_raises_nor_sends_nan"): (
         "the storm's irregular rhythm of input, not a wait"
     ),
-    ("tests/app/test_wire.py", "frames_in"): (
-        "two equal windows, quiet and flooded, in which the frames are counted and compared"
-    ),
     ("tests/app/test_wire.py", "poll"): "the sampling period of a peak-memory poller",
 }
 #: Browser tests: the same reason as above, for each module (the page gives no "drawn" event).
