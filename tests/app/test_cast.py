@@ -180,11 +180,14 @@ def test_a_follower_drawing_other_nodes_is_sent_its_own_group_s_window(poinsot_a
     _, probes, frames, sessions = _class(poinsot_app, make_probe)
     member = sessions[0].shared.member
     assert member is not None and member.source is not None and member.source.arrow
-    # What its session's frame thread would set if its scene drew no ω arrow.
+    # What its session's frame thread would set before each frame if its scene drew no ω
+    # arrow. An update already under way sets the source with the arrow once more: two frames
+    # later, none is.
     source = member.source
     without = type(source)(source.motion, source.body, source.tip, None)
-    sessions[0].shared.update = lambda _source: None  # its own thread leaves it as set here
-    member.source = without
+    sessions[0].shared.update = lambda _source: setattr(member, "source", without)
+    drawn = sessions[0].stats.frames
+    assert wait_until(lambda: sessions[0].stats.frames >= drawn + 2, 30)
     start = len(frames[0])
     encoded = poinsot_app.follow.cast.encoded
     pose = ["SetOrientationMessage", "SetPositionMessage"]
