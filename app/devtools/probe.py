@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import socket
 import threading
 import time
 from collections.abc import Callable
@@ -94,12 +95,15 @@ class Probe:
         origin: str | None = None,
         size: tuple[int, int] = (1280, 720),
         source: str | None = None,
+        receive_buffer: int | None = None,
     ):
         """``origin``: the ``Origin`` header a browser would send (a page's
         ``scheme://host:port``); None sends none, as tools that are not browsers do. ``size``:
         the picture's width and height it reports [px] (a phone's is narrow). ``source``: the
         local address it connects from (a loopback address, so that a balancer hashing the
-        client's address sees distinct browsers)."""
+        client's address sees distinct browsers). ``receive_buffer``: its socket's receive
+        buffer [bytes], set before it connects (a small one: a stalled client's socket fills
+        sooner)."""
         self.uri = f"ws://{host}:{port}"
         self.size = size
         self.nodes: dict[str, Node] = {}
@@ -121,7 +125,7 @@ class Probe:
             # would miss the pong and print a traceback; the server's pings watch the line.
             ping_interval=None,
             origin=None if origin is None else websockets.Origin(origin),
-            **self._source(source),
+            sock=self._socket(host, port, source, receive_buffer),
         )
         self._closed = False
         self._reading = threading.Event()
@@ -131,9 +135,30 @@ class Probe:
         self._send_first_camera()
 
     @staticmethod
-    def _source(source: str | None) -> dict[str, Any]:
-        """The socket's local address, if given (passed on to ``socket.create_connection``)."""
-        return {} if source is None else {"source_address": (source, 0)}
+    def _socket(
+        host: str, port: int, source: str | None, receive_buffer: int | None
+    ) -> socket.socket | None:
+        """The connection's socket when it needs more than websockets makes (None: its own):
+        bound to ``source``, its receive buffer set before it connects. A buffer shrunk on an
+        open connection shrinks the window under the data in flight: the kernel drops what no
+        longer fits and the sender retransmits it with back-off, seconds at a time (a close
+        then waits for its timeout)."""
+        if source is None and receive_buffer is None:
+            return None
+        family, kind, proto, _, address = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0]
+        sock = socket.socket(family, kind, proto)
+        try:
+            if receive_buffer is not None:
+                sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, receive_buffer)
+            if source is not None:
+                sock.bind((source, 0))
+            sock.settimeout(10.0)
+            sock.connect(address)
+            sock.settimeout(None)
+        except OSError:
+            sock.close()
+            raise
+        return sock
 
     def _send_first_camera(self) -> None:
         """The camera message that makes viser call a client connected. A server that refuses

@@ -4,7 +4,6 @@ takes (app/live/hardening/pacing.py). Counts and events only, never wall-clock b
 from __future__ import annotations
 
 import collections
-import socket
 import warnings
 
 import viser
@@ -18,6 +17,7 @@ from poinsot.app.live.hardening.pacing import (
     Pacer,
     next_due,
 )
+from poinsot.app.live.session.builder import MAX_FPS
 from poinsot.app.model.parameters import Parameters
 from poinsot.app.model.presets import DEFAULT_PRESET
 
@@ -198,15 +198,16 @@ def test_a_frame_of_the_default_preset_sends_three_messages_and_traces_every_fou
         assert {kind for kind, _ in frame[3:]} == {"SceneNodeUpdateMessage"}
 
 
-def test_a_stalled_client_gets_fewer_frames_and_a_bounded_queue(poinsot_app, make_probe):
+def test_a_stalled_client_gets_fewer_frames_and_a_bounded_queue(make_app, make_probe):
     """A client that stops reading: once its socket is full its session skips frames at a
     lowered rate and its queue stays within a few frames' messages, while another client
-    keeps getting frames."""
-    slow = make_probe(poinsot_app)
+    keeps getting frames (at the server's own frame rate: the socket fills in as many frames,
+    in a third of the time)."""
+    poinsot_app = make_app(max_fps=MAX_FPS)
+    slow = make_probe(poinsot_app, receive_buffer=4096)  # fills sooner
     slow_session = session_of(poinsot_app, 1)
     fast = make_probe(poinsot_app)
     fast_session = session_of(poinsot_app, 2)
-    slow._ws.socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)  # fills sooner
     assert wait_until(lambda: fast_session.stats.frames > 10, 30)
     slow.stall()
     assert wait_until(lambda: slow_session.pacer.stats.skipped > 20, 120)  # the socket filled
