@@ -18,14 +18,12 @@ from poinsot.app.live.session.builder import MAX_FPS
 from poinsot.app.live.session.session import Session
 
 FAST = 0.05  # the watch's poll in these tests [s]: sooner events, same rules
-#: A stalled client's tests run at the server's own frame rate: its socket fills in as many
-#: frames, a third of the time the suite's 20 frames a second would take.
-STALL_FPS = MAX_FPS
 
 
 def _stalled(app: PoinsotApp, make_probe, skips: int = 20) -> tuple[Probe, Session, Probe, Session]:
     """Two clients; the first stops reading, with a small socket buffer that fills sooner,
-    until its session skips ``skips`` frames (its socket is full)."""
+    until its session skips ``skips`` frames (its socket is full). ``app`` runs at the
+    server's own frame rate: the socket fills in as many frames, a third of the time."""
     slow = make_probe(app, receive_buffer=4096)
     slow_session = session_of(app, 1)
     fast = make_probe(app)
@@ -41,7 +39,7 @@ def test_a_stalled_client_within_the_bounds_keeps_a_small_queue_and_its_connecti
 ):
     """Frames are paced: while another client draws 200 frames, the stalled client's queue
     and unacknowledged bytes stay far below the default bounds, and it is not disconnected."""
-    app = make_app(backlog=BacklogLimit(poll=FAST), max_fps=STALL_FPS)
+    app = make_app(backlog=BacklogLimit(poll=FAST), max_fps=MAX_FPS)
     limit = app.backlog.limit
     slow, slow_session, _fast, fast_session = _stalled(app, make_probe)
     slow_id = slow_session.client.client_id
@@ -64,7 +62,7 @@ def test_a_client_over_its_unacknowledged_bound_past_the_grace_is_disconnected(
     the grace it is disconnected, once, with one log line; its session is closed and gone,
     and the other client goes on."""
     app = make_app(
-        backlog=BacklogLimit(max_unacked=8 * 1024, grace=0.5, poll=FAST), max_fps=STALL_FPS
+        backlog=BacklogLimit(max_unacked=8 * 1024, grace=0.5, poll=FAST), max_fps=MAX_FPS
     )
     with caplog.at_level(logging.WARNING, logger="poinsot.app.live.hardening.backlog"):
         slow, slow_session, fast, fast_session = _stalled(app, make_probe, skips=0)
