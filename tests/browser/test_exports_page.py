@@ -260,10 +260,13 @@ def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     page.set_checkbox("Large text", True)
     grown = before * LARGE_TEXT_PERCENT / 100
     assert wait_until(lambda: page.page.evaluate(root) >= grown - 0.5, 10), before
+    # The panel's labels follow (in one reading: while the panel is laid out again for the
+    # larger text, a label can be absent for a moment; 0 then).
     label = (
-        "parseFloat(getComputedStyle([...document.querySelectorAll('label')].find("
-        "l => l.textContent === 'Dark theme')).fontSize)"
+        "(() => { const l = [...document.querySelectorAll('label')].find("
+        "l => l.textContent === 'Dark theme');"
+        " return l ? parseFloat(getComputedStyle(l).fontSize) : 0; })()"
     )
-    assert page.page.evaluate(label) >= 1.2 * 12
+    assert wait_until(lambda: page.page.evaluate(label) >= 1.2 * 12, 10), page.page.evaluate(label)
     assert page.errors == []
     assert session.stats.errors == 0, session.stats.last_error
