@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pytest
 
+from poinsot.app import report as report_command
 from poinsot.app import viser_private
 from poinsot.app.cli.main import main as cli_main
 from poinsot.app.devtools.probe import Probe
@@ -44,10 +45,8 @@ from poinsot.app.live.panel.panel import shown_label
 from poinsot.app.live.server import PoinsotApp
 from poinsot.app.live.session.session import Session
 from poinsot.app.model.presets import DEFAULT_PRESET, Preset
-from poinsot.app.report.measure.cases import CASES, StudyConfig
-from poinsot.app.report.measure.exact import load_reference
-from poinsot.app.report.measure.progress import Progress
-from poinsot.app.report.measure.study import CaseResult, study_case
+from poinsot.app.report import ReportSummary
+from poinsot.app.report.measure.study import CaseResult
 
 if TYPE_CHECKING:
     from playwright.sync_api import FloatRect, Page
@@ -135,14 +134,20 @@ LONG_GROUPS = (
     "tests/app/test_server.py",
 )
 
+#: Modules that run in a browser file's group because they share a session fixture with it
+#: (built once in a worker): the guide's tests build the guide (``built_docs``) that the help
+#: page's test serves.
+WITH_BROWSER_FILE = {"tests/test_docs.py": "tests/browser/test_help_page.py"}
+
 
 def xdist_group(nodeid: str) -> str:
     """The worker group of a test (``make test``: pytest-xdist, ``--dist loadgroup``): the
     real-browser tests in the :data:`BROWSER_GROUPS`, so that each Chromium draws for one
     worker; tests/report/ in one (``quick_report`` and ``small_study`` are built once); every
-    other module in its own (its fixtures are built once). From the node id alone: xdist's
-    controller collects nothing."""
+    other module in its own (its fixtures are built once), but for :data:`WITH_BROWSER_FILE`.
+    From the node id alone: xdist's controller collects nothing."""
     path = nodeid.split("::")[0]
+    path = WITH_BROWSER_FILE.get(path, path)
     if path in BROWSER_APART:
         return path
     if path.startswith("tests/browser/") or nodeid.split("[")[0] in BROWSER_ELSEWHERE:
@@ -696,9 +701,9 @@ def open_module_page(chromium) -> Iterator[Callable[..., BrowserPage]]:
 # -- the report's study (one conftest for the whole suite: a second conftest.py in a subfolder
 # would shadow this module's name for the tests that import helpers from it) ----------------
 # ``quick_report``: one ``poinsot report --quick`` through the real command line (session
-# scope, ~30 s on the 2-core CI machine), for the tests that read the files it writes.
-# ``small_study``: three cases (Toutatis, 1 - m = 1e-14, the separatrix) at the ``--quick``
-# settings, run through the study itself without writing a report.
+# scope, ~25 s on the 2-core CI machine), for the tests that read the files it writes.
+# ``small_study``: three of that run's cases (Toutatis, 1 - m = 1e-14, the separatrix), for the
+# tests that draw the figures again from the study's results.
 SMALL_STUDY_CASES = ("Toutatis", "near-separatrix 1-m=1e-14", "separatrix")
 
 
@@ -707,24 +712,39 @@ STDERR_NAME = "stderr.txt"
 
 
 @pytest.fixture(scope="session")
-def quick_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def quick_run(tmp_path_factory: pytest.TempPathFactory) -> ReportSummary:
+    """``poinsot report --quick --out DIR`` through the real command line, and what its study
+    found: the summary :func:`~poinsot.app.report.write_report` returned to the command, kept
+    on its way (the study is run once for both)."""
     out = tmp_path_factory.mktemp("report")
+    summaries: list[ReportSummary] = []
+    write = report_command.write_report
+
+    def kept(*args, **kwargs) -> ReportSummary:
+        summaries.append(write(*args, **kwargs))
+        return summaries[-1]
+
     with pytest.MonkeyPatch.context() as patch:  # stderr is a file: no variable says otherwise
         for name in ("FORCE_COLOR", "TTY_COMPATIBLE", "TTY_INTERACTIVE"):
             patch.delenv(name, raising=False)
+        patch.setattr(report_command, "write_report", kept)
         with open(out / STDERR_NAME, "w") as err, contextlib.redirect_stderr(err):
             assert cli_main(["report", "--quick", "--out", str(out)]) == 0
-    return out
+    assert len(summaries) == 1 and summaries[0].out == out
+    return summaries[0]
 
 
 @pytest.fixture(scope="session")
-def small_study() -> list[CaseResult]:
-    by_name = {c.name: c for c in CASES}
-    quick = StudyConfig.for_mode(quick=True)
-    config = dataclasses.replace(quick, cases=tuple(by_name[n] for n in SMALL_STUDY_CASES))
-    reference_cls, _ = load_reference()
-    progress = Progress(1, enabled=False)
-    return [study_case(case, config, reference_cls, progress) for case in config.cases]
+def quick_report(quick_run: ReportSummary) -> Path:
+    """The folder ``poinsot report --quick`` wrote (its stderr in :data:`STDERR_NAME`)."""
+    return quick_run.out
+
+
+@pytest.fixture(scope="session")
+def small_study(quick_run: ReportSummary) -> list[CaseResult]:
+    """The quick run's results for :data:`SMALL_STUDY_CASES`, in that order."""
+    by_name = {result.case.name: result for result in quick_run.results}
+    return [by_name[name] for name in SMALL_STUDY_CASES]
 
 
 # -- the user guide ----------------------------------------------------------------------
