@@ -113,7 +113,13 @@ def _serve_one(
     from poinsot.app.live.workers import lecturer_line
 
     app = PoinsotApp(
-        host, port, preset=preset, scene=start_scene, allow_origins=allow_origin, follow=hub
+        host,
+        port,
+        preset=preset,
+        scene=start_scene,
+        allow_origins=allow_origin,
+        follow=hub,
+        settle=True,
     )
     if port and app.port != port:  # viser took the next free port: the board would be wrong
         app.stop()

@@ -66,6 +66,7 @@ class PoinsotApp:
         backlog: BacklogLimit | None = None,
         landing_port: int = 0,
         follow: FollowHub | None = None,
+        settle: bool = False,
     ) -> None:
         """Each new browser starts with ``preset``, or with ``scene`` if one is given. A
         browser's websocket is refused unless it comes from a page this server served, or from
@@ -73,10 +74,10 @@ class PoinsotApp:
         that leaves more than ``backlog`` untaken for longer than its grace is disconnected
         (:mod:`.hardening.backlog`; its defaults if None). ``landing_port``: a landing in front of
         this server (:mod:`.landing`), named by the links copied from the pages served here.
-        ``follow``: the lead and its followers (:mod:`.classroom.follow`; its own if None)."""
-        self.preset = preset
-        self.scene = scene
-        self.landing_port = landing_port
+        ``follow``: the lead and its followers (:mod:`.classroom.follow`; its own if None).
+        ``settle``: this process serves and nothing else (``poinsot serve``): once quiet after
+        sessions arrive or leave, a hall's heap is settled (:mod:`.hardening.upkeep`)."""
+        self.preset, self.scene, self.landing_port = preset, scene, landing_port
         #: The lecturer code, the lead and its followers (:mod:`.classroom.follow`).
         self.follow = follow if follow is not None else FollowHub()
         self.follow.cast.fps = min(self.follow.cast.fps, max_fps)  # the followers' poses too
@@ -107,11 +108,10 @@ class PoinsotApp:
         # stops a thread) and, once quiet, memory is handed back.
         self.pool = fixed_pool()
         self.server.get_event_loop().set_default_executor(self.pool)
-        self.memory = MemoryTrim()
+        self.memory = MemoryTrim(sessions=self._count if settle else None)
         self.server.on_client_connect(self._on_connect)
         self.server.on_client_disconnect(self._on_disconnect)
-        #: Closes the connection of a client that leaves too much untaken
-        #: (:mod:`.hardening.backlog`).
+        #: Closes the connection of a client leaving too much untaken (:mod:`.hardening.backlog`).
         self.backlog = BacklogWatch(self.sessions, backlog).start()
 
     @property
@@ -123,6 +123,10 @@ class PoinsotApp:
         host = self.server.get_host()
         shown = "localhost" if host in ("0.0.0.0", "::") else host
         return f"http://{shown}:{self.port}"
+
+    def _count(self) -> int:
+        with self._lock:
+            return len(self._sessions)
 
     def sessions(self) -> dict[int, Session]:
         with self._lock:
@@ -201,6 +205,8 @@ class PoinsotApp:
                 self._connected.notify_all()
         if left:
             session.close()
+        else:
+            self.memory.arrived()
 
     def _disconnect(self, client: viser.ClientHandle) -> None:
         with self._lock:

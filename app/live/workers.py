@@ -132,6 +132,7 @@ def _serve(
         allow_origins=origins,
         landing_port=landing,
         follow=hub,
+        settle=True,
     )
 
 

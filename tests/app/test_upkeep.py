@@ -3,11 +3,13 @@ departures (counted, never timed)."""
 
 from __future__ import annotations
 
+import gc
 import threading
+import weakref
 
 from conftest import wait_until
 
-from poinsot.app.live.hardening.upkeep import MemoryTrim, fixed_pool
+from poinsot.app.live.hardening.upkeep import SETTLE_SESSIONS, MemoryTrim, fixed_pool
 
 
 def _pool_threads(name: str) -> int:
@@ -37,6 +39,55 @@ def test_memory_is_trimmed_once_after_a_burst_of_departures():
         assert wait_until(lambda: trim.trims == 1, 10)
         trim.departed()
         assert wait_until(lambda: trim.trims == 2, 10)
+    finally:
+        trim.stop()
+
+
+class _Cycle:
+    """An object in a reference cycle: only the cyclic collector frees it."""
+
+    def __init__(self) -> None:
+        self.me = self
+
+
+def test_a_hall_s_heap_is_settled_after_an_arrival_and_scanned_again_after_a_departure():
+    """A serving process with a hall of sessions: the quiet moment after one arrives freezes
+    what is alive, so that a cycle among it that dies is left alone by the collector's scans;
+    the quiet moment after a departure scans it again and frees it; once the hall is smaller
+    than SETTLE_SESSIONS, the heap is no longer settled."""
+    alive_sessions = [SETTLE_SESSIONS]
+    trim = MemoryTrim(quiet_seconds=0.05, sessions=lambda: alive_sessions[0])
+    try:
+        cycle = _Cycle()
+        alive = weakref.ref(cycle)
+        trim.arrived()
+        assert wait_until(lambda: trim.trims == 1, 10)
+        assert trim.settled and gc.get_freeze_count() > 0
+        del cycle
+        gc.collect()
+        assert alive() is not None  # frozen: not scanned
+        trim.departed()
+        assert wait_until(lambda: trim.trims == 2, 10)
+        assert alive() is None
+        assert trim.settled  # settled again: still a hall
+        alive_sessions[0] = SETTLE_SESSIONS - 1
+        trim.departed()
+        assert wait_until(lambda: trim.trims == 3, 10)
+        assert not trim.settled and gc.get_freeze_count() == 0
+    finally:
+        trim.stop()
+    assert gc.get_freeze_count() == 0
+
+
+def test_a_process_that_only_serves_a_test_never_settles_its_heap():
+    """Without ``sessions`` (a test's or a notebook's process), arrivals trim nothing and a
+    departure's trim freezes nothing."""
+    trim = MemoryTrim(quiet_seconds=0.05)
+    try:
+        trim.arrived()
+        trim.departed()
+        assert wait_until(lambda: trim.trims == 1, 10)
+        assert not trim.settled and gc.get_freeze_count() == 0
     finally:
         trim.stop()
 
