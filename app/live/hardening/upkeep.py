@@ -117,7 +117,7 @@ class MemoryTrim:
 
     @property
     def settled(self) -> bool:
-        """Whether the heap is settled now (tests, load test)."""
+        """Whether the heap is settled now (tests)."""
         return self._frozen
 
     def _thaw(self) -> None:
