@@ -88,8 +88,12 @@ class MemoryTrim:
 
     def arrived(self) -> None:
         """A session started (only a hall's arrivals wait for a trim, to settle its heap)."""
-        if self._sessions is not None and self._sessions() >= SETTLE_SESSIONS:
+        if self._hall():
             self._later()
+
+    def _hall(self) -> bool:
+        """Whether this is a serving process that holds a hall (:data:`SETTLE_SESSIONS`)."""
+        return self._sessions is not None and self._sessions() >= SETTLE_SESSIONS
 
     def _later(self) -> None:
         with self._lock:
@@ -109,7 +113,7 @@ class MemoryTrim:
             gc.collect()
             if self._trim is not None:
                 self._trim(0)
-            if self._sessions is not None and self._sessions() >= SETTLE_SESSIONS:
+            if self._hall():
                 gc.freeze()
                 self._frozen = True
             with self._lock:
