@@ -112,6 +112,9 @@ class Probe:
         self.keep_batches = keep_batches
         self.bytes_received = 0
         self.messages_received = 0
+        #: Scene messages for a variant of a node the page does not show, dropped as viser's
+        #: client drops them (:meth:`_apply_node`).
+        self.dropped = 0
         self._cond = threading.Condition()
         self._listeners: list[Callable[[dict[str, Any], float], None]] = []
         self._raw_listeners: list[Callable[[bytes], None]] = []
@@ -264,7 +267,8 @@ class Probe:
         return all(seen.acquire(timeout=timeout) for _ in range(count))
 
     def add_listener(self, listener: Callable[[dict[str, Any], float], None]) -> None:
-        """``listener(message, arrival_time)`` for every decoded message (receiver thread)."""
+        """``listener(message, arrival_time)`` for every decoded message the page applies (not
+        those it drops: :meth:`_apply_node`) (receiver thread)."""
         self._listeners.append(listener)
 
     def add_raw_listener(self, listener: Callable[[bytes], None]) -> None:
@@ -285,8 +289,8 @@ class Probe:
                 with self._cond:
                     self.bytes_received += len(frame)
                     self.messages_received += len(messages)
-                    for message in messages:
-                        self._apply(message)
+                    applied = [message for message in messages if self._apply(message)]
+                    self.dropped += len(messages) - len(applied)
                     if self.keep_batches:
                         self.batches.append(
                             Batch(
@@ -297,7 +301,7 @@ class Probe:
                             )
                         )
                     self._cond.notify_all()
-                for message in messages:
+                for message in applied:
                     self._answer(message)
                     for listener in self._listeners:
                         listener(message, now)
@@ -321,16 +325,26 @@ class Probe:
                 )
             )
 
-    def _apply(self, m: dict[str, Any]) -> None:
+    def _apply(self, m: dict[str, Any]) -> bool:
+        """Apply ``m`` to the model; False if the page drops it (:meth:`_apply_node`)."""
         kind: str = m["type"]
         name = m.get("name")
         if isinstance(name, str):
-            self._apply_node(kind, name, m)
-        else:
-            self._apply_widget(kind, m)
+            return self._apply_node(kind, name, m)
+        self._apply_widget(kind, m)
+        return True
 
-    def _apply_node(self, kind: str, name: str, m: dict[str, Any]) -> None:
+    def _apply_node(self, kind: str, name: str, m: dict[str, Any]) -> bool:
+        """As viser's client routes a scene message by its owner (the scope that queued it:
+        ``""`` the broadcast one, a client's id its own): a client's own node is shown over the
+        broadcast one of its name, and an update or a removal addressed to the variant not
+        shown is dropped (False), as a pose sent for another scope's node is."""
         node = self.nodes.get(name)
+        owner = str(m.get("owner") or "")
+        if node is not None and name and owner != node.owner:
+            created = isinstance(m.get("props"), dict)
+            if not (created and owner):  # a client's own node replaces the broadcast one
+                return False
         if kind == "RemoveSceneNodeMessage":
             self.nodes.pop(name, None)
         elif kind == "SetOrientationMessage" and node is not None:
@@ -344,7 +358,8 @@ class Probe:
         elif kind == "SceneNodeUpdateMessage" and node is not None:
             node.props.update(m["updates"])
         elif isinstance(m.get("props"), dict):
-            self.nodes[name] = Node(kind, dict(m["props"]), owner=str(m.get("owner") or ""))
+            self.nodes[name] = Node(kind, dict(m["props"]), owner=owner)
+        return True
 
     def _apply_widget(self, kind: str, m: dict[str, Any]) -> None:
         if kind == "GuiRemoveMessage":

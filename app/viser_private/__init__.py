@@ -73,11 +73,13 @@ Inventory (section, private name, what it is used for):
 *Window* (:mod:`poinsot.app.viser_private.window`)
   - ``viser.infra._infra._message_producer``'s wire format (its ``_append_aligned_buffers``,
     ``Message.as_serializable_dict``, zstd level 1): a window of messages encoded once and
-    written to many clients' connections (the followers' shared frames) in one call on their
+    written to many clients' connections (the followers' shared frames), each client's copy
+    with the owner id viser stamps on its own scene's messages (``SceneApi._owner_id``, the
+    ``owner`` field its client routes a node's updates by), in one call on their
     loop, each as websockets' ``ServerConnection.send`` writes a message, without its task: the
     connection's Sans-I/O ``protocol.send_binary`` and its ``send_data``, ``paused`` (flow
-    control), ``drain`` and ``send_in_progress`` (:func:`encode_window`, :class:`WindowSocket`,
-    :func:`send_each`).
+    control), ``drain`` and ``send_in_progress`` (:func:`encode_window`, :class:`OwnedWindow`,
+    :class:`WindowSocket`, :func:`send_each`).
 
 *Messages*
   - ``viser._messages``: the client-to-server message classes whose fields
@@ -153,7 +155,13 @@ from poinsot.app.viser_private.transport import (
     set_on_its_loop_only,
 )
 from poinsot.app.viser_private.version import VISER_SERIES, ViserChanged
-from poinsot.app.viser_private.window import WindowSocket, encode_window, send_each
+from poinsot.app.viser_private.window import (
+    OwnedWindow,
+    WindowSocket,
+    client_owner,
+    encode_window,
+    send_each,
+)
 
 __all__ = [
     "ALLOWED",
@@ -202,7 +210,9 @@ __all__ = [
     "hooked_server",
     "message_type",
     "page_address",
+    "OwnedWindow",
     "WindowSocket",
+    "client_owner",
     "encode_window",
     "send_each",
     "orientation_message",

@@ -362,3 +362,47 @@ def test_a_window_encoded_once_is_the_window_viser_sends():
     ]
     np.testing.assert_array_equal(decoded[2]["updates"]["points"], points.ravel())
     assert ours[-points.nbytes :] == theirs[-points.nbytes :] == points.tobytes()
+
+
+def test_a_window_for_many_clients_is_each_one_s_window_of_its_own_nodes():
+    """Each client's copy of an owned window is the window viser sends that client had its own
+    scene queued the messages: stamped with its id (its browser applies a scene message to the
+    node of the scope that queued it only), the rest the same for all."""
+    import msgspec
+    import numpy as np
+    import zstandard
+
+    from poinsot.app.devtools.probe import decode_frame
+
+    points = np.arange(18, dtype=np.float32).reshape(3, 2, 3)
+
+    def messages(owner: str | None) -> list:
+        made = [
+            viser_private.orientation_message("/space/body", (0.5, 0.5, 0.5, 0.5)),
+            viser_private.position_message("/space/tip", (0.1, 0.2, 0.3)),
+            viser_private.props_message("/space/omega", {"points": points}),
+        ]
+        for message in made if owner is not None else ():
+            message.owner = owner  # as a client's SceneApi stamps its messages
+        return made
+
+    def inner(frame: bytes) -> dict:
+        size, compressed = (
+            int.from_bytes(frame[:8], "little"),
+            int.from_bytes(frame[8:16], "little"),
+        )
+        payload = zstandard.ZstdDecompressor().decompress(
+            frame[16 : 16 + compressed], max_output_size=size
+        )
+        decoded = msgspec.msgpack.decode(payload)
+        decoded.pop("timestampSec")
+        return decoded
+
+    window = viser_private.OwnedWindow(messages(None))
+    for owner in ("7", "1234", "18446744073709551615"):
+        ours, theirs = window.bytes_for(owner), _viser_s_own_window(messages(owner))
+        assert inner(ours) == inner(theirs), WRITTEN_FOR
+        decoded = decode_frame(ours)
+        assert {m["owner"] for m in decoded} == {owner}
+        np.testing.assert_array_equal(decoded[2]["updates"]["points"], points.ravel())
+        assert ours[-points.nbytes :] == points.tobytes()

@@ -16,8 +16,11 @@ import pytest
 from conftest import session_of, wait_until
 
 from poinsot.app.construction import palette
+from poinsot.app.devtools.probe import Probe
+from poinsot.app.live.classroom import links
 from poinsot.app.model.elements import Element
 from poinsot.app.model.presets import DEFAULT_PRESET, preset_by_key
+from tests.app.test_follow import _lead, _ready
 
 pytestmark = pytest.mark.browser
 
@@ -235,3 +238,30 @@ def test_a_real_browser_sends_only_what_the_wire_allows(shared):
     # makes Chromium note that viser's handler cannot cancel a passive event; nothing else may.
     errors = [e for e in page.errors if e != DRAG_BINDING]
     assert list(app.sessions().values()) == [session] and errors == []
+
+
+def test_a_follower_s_body_turns_in_the_browser(shared):
+    """Last: the page follows a lecturer (a probe; the page's panel is folded by the resize
+    before, so its session follows as a link with ``follow=1`` makes it). Its poses then come
+    from the process's cast, not its session's frames, and the view moves as the lecturer's
+    body turns: a pose sent for another scope's node would be dropped by viser's client, the
+    body standing still while only the traces grew."""
+    app, page, session = shared
+    page.page.set_viewport_size({"width": 1280, "height": 720})
+    page.set_live_view(True)
+    lead = _ready(Probe(app.port))
+    try:
+        _lead(lead, app.follow.code)
+        links.apply(session, links.opening(f"{app.url}/?follow=1", session.preset, None))
+        assert wait_until(lambda: session.shared.shared, 30), "the page never joined the cast"
+        cast = app.follow.cast
+        page.drawn_after(session.client)
+        before, handed = canvas_pixels(page), cast.handed
+        assert wait_until(lambda: cast.handed >= handed + 20, 30), "the cast sent no frames"
+        page.drawn_after(session.client)
+        after = canvas_pixels(page)
+        changed = np.mean(np.any(np.abs(after.astype(int) - before) > 24, axis=2))
+        assert changed > 0.01, f"only {changed:.4f} of the view changed"
+        assert page.errors == [] and session.stats.errors == 0, session.stats.last_error
+    finally:
+        lead.close()

@@ -5,9 +5,11 @@ Every follower of a process draws the same motion (the hub's shared
 :meth:`~.follow.FollowHub.now`), so a frame's three pose messages (the body frame's orientation,
 the tip's position, the ω arrow's points) are the same for all of them. :class:`FollowCast` (one
 per process, one thread) makes them once per frame and group of followers drawing the same
-motion on the same nodes, encodes and compresses them once as viser's own window
-(:func:`poinsot.app.viser_private.encode_window`), and hands the same bytes to each follower's
-socket (:func:`~poinsot.app.viser_private.send_each`).
+motion on the same nodes, serialises them once as viser's own window
+(:class:`poinsot.app.viser_private.OwnedWindow`), and hands each follower's socket its copy
+(:func:`~poinsot.app.viser_private.send_each`): the same messages, stamped with the follower's
+own id, as viser stamps a message of a client's own scene (its browser applies a pose to the
+node of that id only; a copy is the one msgpack with the id spliced in, then compressed).
 
 - A follower that falls behind is sent fewer frames, as a slow session is
   (:mod:`..hardening.pacing`): a follower whose last window is not yet written, or with more than
@@ -39,8 +41,9 @@ from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.sampled.motion import Motion
 from poinsot.app.live.hardening.pacing import MAX_UNACKED, Outbox, Pacer, next_due
 from poinsot.app.viser_private import (
+    OwnedWindow,
     WindowSocket,
-    encode_window,
+    client_owner,
     orientation_message,
     position_message,
     props_message,
@@ -88,7 +91,7 @@ class Source:
 
     @property
     def key(self) -> Hashable:
-        """Followers with the same key are sent the same bytes."""
+        """Followers with the same key are sent one window (each its copy)."""
         return (id(self.motion), self.body, self.tip, self.arrow)
 
     def messages(self, k: int) -> list[Any]:
@@ -113,6 +116,7 @@ class Member:
 
     def __init__(self, client: viser.ClientHandle) -> None:
         self.socket = WindowSocket(client)
+        self.owner = client_owner(client)  # the scope of its nodes, stamped on its copy
         self.outbox = Outbox(client)
         self.source: Source | None = None
         self.shown: tuple[Hashable, int] | None = None
@@ -196,9 +200,9 @@ class FollowCast:
             k = source.motion.sampler.index(t)
             ready = [m for m in group if m.shown != (key, k) and self._ready(m)]
             if ready:
-                data = encode_window(source.messages(k))
+                window = OwnedWindow(source.messages(k))
                 encoded += 1
-                self.handed += send_each([m.socket for m in ready], data)
+                self.handed += send_each([(m.socket, window.bytes_for(m.owner)) for m in ready])
                 for member in ready:
                     member.shown = (key, k)
         self.encoded += encoded
