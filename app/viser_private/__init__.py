@@ -54,8 +54,9 @@ Inventory (section, private name, what it is used for):
     ``api``) and ``SceneApi._queue_scene_message`` with ``SetOrientationMessage``,
     ``SetPositionMessage`` and ``SceneNodeUpdateMessage``: the frame path's setters without
     viser's comparison.
-  - ``viser._assignable_props_api.AssignablePropsBase._prop_hints``: replaced, class-wide, by a
-    property cached per properties class
+  - ``viser._assignable_props_api.AssignablePropsBase._prop_hints`` and
+    ``_cast_value_recursive`` (with ``colors_to_uint8``): replaced, class-wide, by a property
+    cached per properties class and by the same cast with its array hints made once
     (:func:`~poinsot.app.viser_private.scene.cache_property_hints`).
 
 *Transport* (:mod:`poinsot.app.viser_private.transport`)

@@ -406,3 +406,54 @@ def test_a_window_for_many_clients_is_each_one_s_window_of_its_own_nodes():
         assert {m["owner"] for m in decoded} == {owner}
         np.testing.assert_array_equal(decoded[2]["updates"]["points"], points.ravel())
         assert ours[-points.nbytes :] == points.tobytes()
+
+
+def test_the_cast_of_a_property_is_viser_s_own_for_every_hint_of_its_nodes_and_widgets():
+    """The patched cast (its array hints made once) gives what viser's own gives, for each
+    property hint of viser's scene nodes and widgets and values of every kind a caller sets."""
+    import typing
+
+    import numpy as np
+
+    from poinsot.app.viser_private import scene
+
+    base = viser._assignable_props_api.AssignablePropsBase
+    assert base.__dict__.get("_cast_value_recursive") is scene.cast_value, WRITTEN_FOR
+    props_classes = [
+        c
+        for c in vars(viser._messages).values()
+        if isinstance(c, type) and c.__name__.endswith("Props")
+    ]
+    hints = {(name, hint) for c in props_classes for name, hint in typing.get_type_hints(c).items()}
+    assert len(props_classes) > 20 and len(hints) > 100, WRITTEN_FOR
+    values = [
+        (0.5, 1.0, 2.0),
+        (1, 2, 3),
+        (255, 128, 0),
+        [0.1, 0.2],
+        np.arange(6, dtype=np.float64).reshape(2, 3),
+        np.arange(6, dtype=np.float32),
+        ((0.0, 1.0, 2.0), (3.0, 4.0, 5.0)),
+        (np.zeros(3), np.ones(3)),
+        "label",
+        3,
+        None,
+        True,
+    ]
+    handle = object.__new__(base)
+    for name, hint in sorted(hints, key=repr):
+        for value in values:
+            try:
+                theirs = scene.VISER_CAST(handle, hint, value, name)
+            except Exception as exc:  # noqa: BLE001 - the same error is asked of ours
+                with pytest.raises(type(exc)):
+                    scene.cast_value(handle, hint, value, name)
+                continue
+            ours = scene.cast_value(handle, hint, value, name)
+            assert type(ours) is type(theirs), (name, hint, value)
+            if isinstance(theirs, np.ndarray):
+                assert ours.dtype == theirs.dtype and np.array_equal(ours, theirs, equal_nan=True)
+            elif isinstance(theirs, tuple):
+                assert repr(ours) == repr(theirs), (name, hint, value)
+            else:
+                assert ours is theirs or ours == theirs, (name, hint, value)
