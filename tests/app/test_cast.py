@@ -238,3 +238,41 @@ def test_a_follower_that_leaves_leaves_the_cast(poinsot_app, make_probe):
     assert wait_until(lambda: cast.members == 1, 30), "the departed follower is still sent frames"
     start = len(frames[1])
     assert wait_until(lambda: len(frames[1]) >= start + 10, 30)  # the other one goes on
+
+
+def test_a_move_holds_the_cast_s_frames_until_its_followers_rebuilt_at_most_a_bound(
+    poinsot_app, make_probe
+):
+    """While every follower rebuilds the lead's new body, the cast sends nothing (the poses of
+    the old one are outdated, and the rebuilds have the interpreter to themselves); it goes on
+    once each poses the new motion, and a hold nobody ends (no follower rebuilds) lasts at most
+    its bound."""
+    lead, probes, frames, sessions = _class(poinsot_app, make_probe)
+    cast = poinsot_app.follow.cast
+    # A hold with nothing to end it: the frames stop (one tick's may still be in flight), then
+    # come again once its bound has passed.
+    held, handed = cast.held, cast.handed
+    cast.hold()
+    assert wait_until(lambda: cast.held >= held + 3, 30)
+    assert cast.handed <= handed + len(sessions)
+    assert wait_until(lambda: cast.handed > handed + 2 * len(sessions), 30)
+    # A move: the hub holds the cast when the lead's body changes; every follower rebuilds and
+    # poses the new motion, and the cast sends their frames again.
+    old = {id(s.shared.member.source.motion) for s in sessions}
+    generations = [s.generation for s in sessions]
+    _set(lead, "D = |L|²/2T", 2.3)
+    for session, generation in zip(sessions, generations, strict=True):
+        assert wait_until(lambda s=session, g=generation: s.generation > g, 30)
+    assert wait_until(
+        lambda: all(
+            s.shared.member is not None
+            and s.shared.member.source is not None
+            and id(s.shared.member.source.motion) not in old
+            for s in sessions
+        ),
+        30,
+    )
+    handed = cast.handed
+    assert wait_until(lambda: cast.handed >= handed + 2 * len(sessions), 30)
+    starts = [len(f) for f in frames]
+    assert wait_until(lambda: all(len(f) >= s + 2 for f, s in zip(frames, starts, strict=True)), 30)

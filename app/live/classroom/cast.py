@@ -19,6 +19,11 @@ node of that id only; a copy is the one msgpack with the id spliced in, then com
   :func:`own_fps`: the traces (its own history of the motion), the labels laid out for its own
   camera, the ω plot and the time readout (widgets of its own page). The pose is then left out
   of its frames (``PoinsotScene.send_pose``).
+- The lead's new body or scene is a rebuild in every follower: the cast then holds its frames
+  (:meth:`FollowCast.hold`) until every follower it poses has rebuilt (poses another motion)
+  or :data:`MOVE_HOLD` has passed, so that the rebuilds have the interpreter to themselves
+  and the move reaches the last follower of a hall sooner (the poses of the old body would be
+  outdated by then anyway).
 - A follower whose frame is not the lead's falls back to its own frames at its own rate at once
   (its session calls :meth:`SharedFrames.update` with None): the lead shows a lecture scene (its
   frame is the scene's own drawing), the follower's ghost is on, its camera rides along with the
@@ -64,6 +69,9 @@ OWN_MIN_FPS = 2.0
 OWN_PROCESS_FRAMES = 120.0
 #: A follower's unacknowledged bytes are read every this many of the cast's frames.
 CHECK_TICKS = 8
+#: The longest the cast holds its frames after the lead's new body or scene [s]
+#: (:meth:`FollowCast.hold`).
+MOVE_HOLD = 1.0
 
 
 def own_fps(members: int) -> float:
@@ -151,6 +159,9 @@ class FollowCast:
         #: The thread's CPU time [s] (load test).
         self.cpu_seconds = 0.0
         self.ticks = 0
+        #: Frames not sent while a move was held (:meth:`hold`).
+        self.held = 0
+        self._hold: tuple[float, list[Motion]] | None = None  # until when, the old motions
         self._error = ""
 
     def join(self, key: int, client: viser.ClientHandle) -> Member | None:
@@ -180,6 +191,27 @@ class FollowCast:
         self._stop.set()
         self._wake.set()
 
+    def hold(self) -> None:
+        """The lead's body or scene changed (any thread): no frame until no member poses a
+        motion it poses now (each has rebuilt, or left), or :data:`MOVE_HOLD` has passed."""
+        with self._lock:
+            old = {id(m.source.motion): m.source.motion for m in self._members.values() if m.source}
+        if old:
+            self._hold = (time.monotonic() + MOVE_HOLD, list(old.values()))
+
+    def _holding(self, members: list[Member]) -> bool:
+        hold = self._hold
+        if hold is None:
+            return False
+        until, old = hold
+        if time.monotonic() < until and any(
+            m.source is not None and any(m.source.motion is o for o in old) for m in members
+        ):
+            self.held += 1
+            return True
+        self._hold = None
+        return False
+
     def tick(self) -> int:
         """One frame for every member: returns the windows encoded (one per group)."""
         t = self._now()
@@ -190,6 +222,8 @@ class FollowCast:
             for gone in [k for k, m in self._members.items() if m.outbox.closed()]:
                 del self._members[gone]
             members = list(self._members.values())
+        if self._holding(members):
+            return 0
         groups: dict[Hashable, tuple[Source, list[Member]]] = {}
         for member in members:
             source = member.source

@@ -202,6 +202,8 @@ class FollowHub:
                     deposed, self._lead, self._lead_token = self._lead, None, ""
             elif kind == "state" and token.leader == self.token:
                 news = token.news(self.state)
+                if self.state is not None and token.query != self.state.query:
+                    self.cast.hold()  # every follower rebuilds: their poses wait (:mod:`.cast`)
                 self.state, self.gone = token, ""
                 self.delivered += 1
                 if not news:  # the same state again: the followers' clock is the hub's
