@@ -119,7 +119,7 @@ def _serve_one(
         scene=start_scene,
         allow_origins=allow_origin,
         follow=hub,
-        settle=True,
+        serving=True,
     )
     if port and app.port != port:  # viser took the next free port: the board would be wrong
         app.stop()

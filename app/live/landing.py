@@ -83,8 +83,11 @@ class Balancer:
 
     def load(self, index: int) -> int:
         """Connected clients plus browsers sent there and not arrived yet (under the lock);
-        0 for a dead backend."""
+        0 for a dead backend. The clients are read before the arrivals (a worker counts an
+        arrival before its client): a browser is never counted both as connected and as
+        still on its way."""
         backend, pending = self.backends[index], self._pending[index]
+        clients = self._clients(index)
         connects = backend.connects
         if connects < self._connects[index]:  # a new process: its count starts again
             self._connects[index] = connects
@@ -94,7 +97,7 @@ class Balancer:
             pending.popleft()
         while pending and (pending[0] < self._clock() - PENDING_SECONDS or not backend.alive):
             pending.popleft()
-        return self._clients(index) + len(pending)
+        return clients + len(pending)
 
     def choose(self, *, counted: bool = True) -> Backend | None:
         """The live backend with the smallest load (the first on a tie), counted as sent to

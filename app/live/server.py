@@ -20,6 +20,7 @@ from poinsot.app.live.classroom import links
 from poinsot.app.live.classroom.follow import FollowHub
 from poinsot.app.live.hardening.backlog import BacklogLimit, BacklogWatch
 from poinsot.app.live.hardening.budget import RebuildGate
+from poinsot.app.live.hardening.eventloop import serve_on_libuv
 from poinsot.app.live.hardening.guard import WireGuard, guarded_viser
 from poinsot.app.live.hardening.pacing import frame_share
 from poinsot.app.live.hardening.upkeep import MemoryTrim, fixed_pool
@@ -66,7 +67,7 @@ class PoinsotApp:
         backlog: BacklogLimit | None = None,
         landing_port: int = 0,
         follow: FollowHub | None = None,
-        settle: bool = False,
+        serving: bool = False,
     ) -> None:
         """Each new browser starts with ``preset``, or with ``scene`` if one is given. A
         browser's websocket is refused unless it comes from a page this server served, or from
@@ -75,8 +76,8 @@ class PoinsotApp:
         (:mod:`.hardening.backlog`; its defaults if None). ``landing_port``: a landing in front of
         this server (:mod:`.landing`), named by the links copied from the pages served here.
         ``follow``: the lead and its followers (:mod:`.classroom.follow`; its own if None).
-        ``settle``: this process serves and nothing else (``poinsot serve``): once quiet after
-        sessions arrive or leave, a hall's heap is settled (:mod:`.hardening.upkeep`)."""
+        ``serving``: this process only serves (``poinsot serve``): on libuv's event loop
+        (:mod:`.hardening.eventloop`), a hall's heap settled (:mod:`.hardening.upkeep`)."""
         self.preset, self.scene, self.landing_port = preset, scene, landing_port
         #: The lecturer code, the lead and its followers (:mod:`.classroom.follow`).
         self.follow = follow if follow is not None else FollowHub()
@@ -84,15 +85,15 @@ class PoinsotApp:
         self.max_fps = max_fps
         self._lock, self._stopping = threading.Lock(), threading.Event()  # set by stop()
         self._sessions: dict[int, Session] = {}
-        # Clients whose disconnect arrived while their session was still being built: viser runs
-        # sync callbacks on a thread pool, so the disconnect handler may run before (or while)
-        # the connect handler builds the session. Both handlers decide under ``_lock``.
+        # Clients whose disconnect came while their session was being built (viser's callbacks
+        # run on a pool, in either order): both handlers decide under ``_lock``.
         self._departed: set[int] = set()
         self._arrivals: set[asyncio.Task[None]] = set()  # pages asked for their address
-        #: Sessions built for a client that had already left, closed before they started.
-        self.discarded = 0
+        self.discarded = 0  # sessions built for a client that had left, closed unstarted
         self._connected = threading.Condition(self._lock)
         self.budget = RebuildGate()
+        if serving:  # before viser makes its event loop
+            serve_on_libuv()
         # Handshakes checked before viser sees them, the share tunnel off (:mod:`.hardening.guard`).
         self.server, gate = _guarded_viser(host, port, verbose=verbose, allow_origins=allow_origins)
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
@@ -108,7 +109,7 @@ class PoinsotApp:
         # stops a thread) and, once quiet, memory is handed back.
         self.pool = fixed_pool()
         self.server.get_event_loop().set_default_executor(self.pool)
-        self.memory = MemoryTrim(sessions=self._count if settle else None)
+        self.memory = MemoryTrim(sessions=self._count if serving else None)
         self.server.on_client_connect(self._on_connect)
         self.server.on_client_disconnect(self._on_disconnect)
         #: Closes the connection of a client leaving too much untaken (:mod:`.hardening.backlog`).

@@ -41,13 +41,15 @@ STOP_GRACE = 5.0
 
 def _count_clients(server: Any, load: Any) -> None:
     """Keep ``load[0]`` = clients connected, ``load[1]`` = clients ever connected. viser may
-    run a client's disconnect before its connect: the sums are right in either order."""
+    run a client's disconnect before its connect: the sums are right in either order. A
+    connect counts the arrival first: whoever reads the clients and then the arrivals
+    (:meth:`.landing.Balancer.load`) never sees a client that has not arrived."""
     lock = threading.Lock()
 
     def connected(_client: Any) -> None:
         with lock:
-            load[0] += 1
             load[1] += 1
+            load[0] += 1
 
     def disconnected(_client: Any) -> None:
         with lock:
@@ -132,7 +134,7 @@ def _serve(
         allow_origins=origins,
         landing_port=landing,
         follow=hub,
-        settle=True,
+        serving=True,
     )
 
 

@@ -124,3 +124,37 @@ def test_a_process_shares_its_frames_among_its_browsers(make_app, make_probe):
         probe.close()
     assert wait_until(lambda: len(app.sessions()) == 6, 30)
     assert {s.pacer.max_fps for s in app.sessions().values()} == {app.max_fps}
+
+
+#: A serving process, in a process of its own (the event loop policy is the whole process's):
+#: its viser loop, and whether a probe's frames come through it.
+SERVING = """
+from poinsot.app.devtools.probe import Probe
+from poinsot.app.live.hardening.eventloop import on_libuv
+from poinsot.app.live.server import PoinsotApp
+
+app = PoinsotApp("127.0.0.1", 0, serving=True)
+probe = Probe(app.port)
+try:
+    framed = probe.wait_frames(10, timeout=60)
+    print("serving:", on_libuv(app.server.get_event_loop()), framed)
+finally:
+    probe.close()
+    app.stop()
+"""
+
+
+def test_a_serving_process_runs_its_browsers_on_libuv_and_a_test_s_on_asyncio(make_app):
+    """``poinsot serve``'s process (and its workers', and the load test's servers) serves on
+    libuv's event loop; a test's own server keeps asyncio's (so does its browser driver)."""
+    import subprocess
+    import sys
+
+    from poinsot.app.live.hardening.eventloop import on_libuv
+
+    done = subprocess.run(
+        [sys.executable, "-c", SERVING], capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "serving: True True" in done.stdout, done.stdout[-500:]
+    assert not on_libuv(make_app().server.get_event_loop())

@@ -64,6 +64,71 @@ def test_balancer_skips_a_dead_worker_and_says_when_none_is_left():
     assert balancer.choose() is None
 
 
+class _Writes(list):
+    """A worker's two counters, recording the order they are written in."""
+
+    def __init__(self) -> None:
+        super().__init__([0, 0])
+        self.order: list[int] = []
+
+    def __setitem__(self, index, value) -> None:  # type: ignore[no-untyped-def]
+        self.order.append(index)
+        super().__setitem__(index, value)
+
+
+def test_a_browser_is_never_counted_both_connected_and_on_its_way():
+    """A worker counts a browser's arrival before the browser (``_count_clients``), and the
+    balancer reads the browsers before the arrivals: a connect landing between its two reads
+    is not counted twice (once connected, once still sent there), which once sent the next
+    browser to the busier worker."""
+    from poinsot.app.live import workers
+
+    callbacks: dict[str, object] = {}
+
+    class Server:
+        def on_client_connect(self, f) -> None:  # type: ignore[no-untyped-def]
+            callbacks["connect"] = f
+
+        def on_client_disconnect(self, f) -> None:  # type: ignore[no-untyped-def]
+            callbacks["disconnect"] = f
+
+    load = _Writes()
+    workers._count_clients(Server(), load)
+    callbacks["connect"](None)  # type: ignore[operator]
+    assert load.order == [1, 0] and list(load) == [1, 1]
+
+    class Connecting:
+        """A worker whose browser connects right after the balancer's first read of it."""
+
+        port, alive, pid = 2, True, None
+
+        def __init__(self) -> None:
+            self.counts = {"clients": 1, "connects": 1}
+            self.armed = False
+
+        def _read(self, name: str) -> int:
+            seen = self.counts[name]
+            if self.armed:  # the worker's order: the arrival, then the browser
+                self.armed = False
+                self.counts["connects"] += 1
+                self.counts["clients"] += 1
+            return seen
+
+        @property
+        def clients(self) -> int:
+            return self._read("clients")
+
+        @property
+        def connects(self) -> int:
+            return self._read("connects")
+
+    connecting = Connecting()
+    balancer = Balancer([FakeWorker(1, clients=2, connects=2), connecting])
+    assert balancer.choose() is connecting  # a browser sent to it: on its way, then it connects
+    connecting.armed = True
+    assert balancer.load(1) <= 2  # connected, or on its way: once (never 2 + 1)
+
+
 # -- a real classroom ----------------------------------------------------------------------
 @dataclasses.dataclass
 class Classroom:

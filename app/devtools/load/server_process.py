@@ -103,7 +103,7 @@ def _linked_app(url: str) -> tuple[Any, Any]:
     if not reachable:
         raise RuntimeError(line)
     hub = FollowHub(code)
-    app = PoinsotApp("127.0.0.1", 0, follow=hub, settle=True)
+    app = PoinsotApp("127.0.0.1", 0, follow=hub, serving=True)
     return app, broker.link_hub(hub, url)
 
 
@@ -134,7 +134,7 @@ def _main(
     if redis:
         app, link = _linked_app(redis)
     else:
-        app = PoinsotApp("127.0.0.1", 0, settle=True) if workers == 1 else _Classroom(workers)
+        app = PoinsotApp("127.0.0.1", 0, serving=True) if workers == 1 else _Classroom(workers)
     pids = [w.pid for w in app.workers] if workers > 1 else []
     code = app.code if workers > 1 else app.follow.code
     conn.send(("ready", (app.port, pids, code)))
