@@ -4,6 +4,7 @@ browser."""
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import functools
 import logging
 import threading
@@ -20,8 +21,8 @@ from poinsot.app.live.classroom import links
 from poinsot.app.live.classroom.follow import FollowHub
 from poinsot.app.live.hardening.backlog import BacklogLimit, BacklogWatch
 from poinsot.app.live.hardening.budget import RebuildGate
-from poinsot.app.live.hardening.eventloop import serve_on_libuv
-from poinsot.app.live.hardening.guard import WireGuard, guarded_viser
+from poinsot.app.live.hardening.eventloop import libuv_loops
+from poinsot.app.live.hardening.guard import HandshakeGate, WireGuard, guarded_viser
 from poinsot.app.live.hardening.pacing import frame_share
 from poinsot.app.live.hardening.upkeep import MemoryTrim, fixed_pool
 from poinsot.app.live.session.session import MAX_FPS, Session, SessionOptions
@@ -49,6 +50,15 @@ def guide_page(path: str) -> Response | None:
 
 #: The guarded viser server of :mod:`.hardening.guard`, answering the guide at /docs/ too.
 _guarded_viser = functools.partial(guarded_viser, pages=guide_page)
+
+
+def _viser(
+    host: str, port: int, verbose: bool, allow_origins: Iterable[str], serving: bool
+) -> tuple[viser.ViserServer, HandshakeGate]:
+    """The guarded viser server; a serving process's on libuv's event loop
+    (:mod:`.hardening.eventloop`: viser makes its loop while it starts)."""
+    with libuv_loops() if serving else contextlib.nullcontext():
+        return _guarded_viser(host, port, verbose=verbose, allow_origins=allow_origins)
 
 
 class PoinsotApp:
@@ -92,10 +102,8 @@ class PoinsotApp:
         self.discarded = 0  # sessions built for a client that had left, closed unstarted
         self._connected = threading.Condition(self._lock)
         self.budget = RebuildGate()
-        if serving:  # before viser makes its event loop
-            serve_on_libuv()
         # Handshakes checked before viser sees them, the share tunnel off (:mod:`.hardening.guard`).
-        self.server, gate = _guarded_viser(host, port, verbose=verbose, allow_origins=allow_origins)
+        self.server, gate = _viser(host, port, verbose, allow_origins, serving)
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
         self.server.scene.world_axes.visible = False
         # First of this app's handlers: every message passes the guard before viser's.

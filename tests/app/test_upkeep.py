@@ -126,35 +126,24 @@ def test_a_process_shares_its_frames_among_its_browsers(make_app, make_probe):
     assert {s.pacer.max_fps for s in app.sessions().values()} == {app.max_fps}
 
 
-#: A serving process, in a process of its own (the event loop policy is the whole process's):
-#: its viser loop, and whether a probe's frames come through it.
-SERVING = """
-from poinsot.app.devtools.probe import Probe
-from poinsot.app.live.hardening.eventloop import on_libuv
-from poinsot.app.live.server import PoinsotApp
+def test_a_serving_server_runs_on_libuv_and_leaves_the_process_s_other_loops_to_asyncio(
+    make_app, make_probe
+):
+    """``poinsot serve``'s server (and its workers', and the load test's) runs its browsers on
+    libuv's event loop; the process's loops made after it, a test's other server's, are
+    asyncio's (so is a browser driver's)."""
+    import asyncio
 
-app = PoinsotApp("127.0.0.1", 0, serving=True)
-probe = Probe(app.port)
-try:
-    framed = probe.wait_frames(10, timeout=60)
-    print("serving:", on_libuv(app.server.get_event_loop()), framed)
-finally:
-    probe.close()
-    app.stop()
-"""
+    import uvloop
 
+    from poinsot.app.live.hardening.eventloop import libuv_loops
 
-def test_a_serving_process_runs_its_browsers_on_libuv_and_a_test_s_on_asyncio(make_app):
-    """``poinsot serve``'s process (and its workers', and the load test's servers) serves on
-    libuv's event loop; a test's own server keeps asyncio's (so does its browser driver)."""
-    import subprocess
-    import sys
-
-    from poinsot.app.live.hardening.eventloop import on_libuv
-
-    done = subprocess.run(
-        [sys.executable, "-c", SERVING], capture_output=True, text=True, timeout=120
-    )
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert "serving: True True" in done.stdout, done.stdout[-500:]
-    assert not on_libuv(make_app().server.get_event_loop())
+    serving = make_app(serving=True)
+    assert isinstance(serving.server.get_event_loop(), uvloop.Loop)
+    assert make_probe(serving).wait_frames(10), "no frames through libuv's loop"
+    assert not isinstance(asyncio.get_event_loop_policy(), uvloop.EventLoopPolicy)
+    assert not isinstance(make_app().server.get_event_loop(), uvloop.Loop)
+    with libuv_loops():
+        loop = asyncio.new_event_loop()
+    assert isinstance(loop, uvloop.Loop)
+    loop.close()

@@ -9,26 +9,29 @@ held (``docs/measurements/classroom.md``, "A move held"): the slowest follower a
 20.5 fps while the lead moves (14.4 and 15.9 on asyncio's loop), the lead's move on every
 follower at p95 0.97 to 1.2 s (1.7 and 2.2 s).
 
-The choice is the process's (asyncio's event loop policy): only a process that serves and
-nothing else sets it (``poinsot serve`` and its workers, the load test's servers), before
-viser makes its loop. A test's process keeps asyncio's loop for its servers and for its
-browser driver's own loop.
+Only a server that serves a process and nothing else asks for it (``poinsot serve`` and its
+workers, the load test's servers: ``PoinsotApp(serving=True)``), and only while viser makes
+its loop (:func:`libuv_loops`: asyncio's policy is the process's, and viser's constructor
+waits until its loop runs): every other loop of the process (a test's servers, its browser
+driver's) stays asyncio's.
 """
 
 from __future__ import annotations
 
 import asyncio
+import contextlib
+from collections.abc import Iterator
 
 import uvloop
 
 
-def serve_on_libuv() -> None:
-    """Make the event loops this process creates from now on libuv's (viser creates its own
-    when its server starts). Idempotent."""
-    if not isinstance(asyncio.get_event_loop_policy(), uvloop.EventLoopPolicy):
-        asyncio.set_event_loop_policy(uvloop.EventLoopPolicy())
-
-
-def on_libuv(loop: asyncio.AbstractEventLoop) -> bool:
-    """Whether ``loop`` is libuv's."""
-    return isinstance(loop, uvloop.Loop)
+@contextlib.contextmanager
+def libuv_loops() -> Iterator[None]:
+    """The event loops made within are libuv's (viser makes its server's while it starts);
+    the process's policy is asyncio's again after."""
+    before = asyncio.get_event_loop_policy()
+    asyncio.set_event_loop_policy(uvloop.EventLoopPolicy())
+    try:
+        yield
+    finally:
+        asyncio.set_event_loop_policy(before)
