@@ -323,10 +323,27 @@ def _viser_s_own_window(messages: list) -> bytes:
     return sent[0]
 
 
-def test_a_window_encoded_once_is_the_window_viser_sends():
+def _header(frame: bytes) -> tuple[int, int]:
+    """A window's msgpack size and compressed size."""
+    return int.from_bytes(frame[:8], "little"), int.from_bytes(frame[8:16], "little")
+
+
+def _inner(frame: bytes) -> dict:
+    """A window's decompressed msgpack, viser's timestamp aside."""
     import msgspec
-    import numpy as np
     import zstandard
+
+    size, compressed = _header(frame)
+    payload = zstandard.ZstdDecompressor().decompress(
+        frame[16 : 16 + compressed], max_output_size=size
+    )
+    decoded = msgspec.msgpack.decode(payload)
+    decoded.pop("timestampSec")
+    return decoded
+
+
+def test_a_window_encoded_once_is_the_window_viser_sends():
+    import numpy as np
 
     from poinsot.app.devtools.probe import decode_frame
 
@@ -338,22 +355,10 @@ def test_a_window_encoded_once_is_the_window_viser_sends():
     ]
     ours, theirs = viser_private.encode_window(messages), _viser_s_own_window(messages)
 
-    def header(frame: bytes) -> tuple[int, int]:
-        return int.from_bytes(frame[:8], "little"), int.from_bytes(frame[8:16], "little")
-
     # The same msgpack size (the compressed size may differ by a byte: the timestamps differ).
-    assert header(ours)[0] == header(theirs)[0], WRITTEN_FOR
-
+    assert _header(ours)[0] == _header(theirs)[0], WRITTEN_FOR
     # The same messages, the same binary layout (only viser's timestamp differs).
-    def inner(frame: bytes) -> dict:
-        payload = zstandard.ZstdDecompressor().decompress(
-            frame[16 : 16 + header(frame)[1]], max_output_size=header(frame)[0]
-        )
-        decoded = msgspec.msgpack.decode(payload)
-        decoded.pop("timestampSec")
-        return decoded
-
-    assert inner(ours) == inner(theirs), WRITTEN_FOR
+    assert _inner(ours) == _inner(theirs), WRITTEN_FOR
     decoded = decode_frame(ours)
     assert [m["type"] for m in decoded] == [
         "SetOrientationMessage",
@@ -368,9 +373,7 @@ def test_a_window_for_many_clients_is_each_one_s_window_of_its_own_nodes():
     """Each client's copy of an owned window is the window viser sends that client had its own
     scene queued the messages: stamped with its id (its browser applies a scene message to the
     node of the scope that queued it only), the rest the same for all."""
-    import msgspec
     import numpy as np
-    import zstandard
 
     from poinsot.app.devtools.probe import decode_frame
 
@@ -386,22 +389,10 @@ def test_a_window_for_many_clients_is_each_one_s_window_of_its_own_nodes():
             message.owner = owner  # as a client's SceneApi stamps its messages
         return made
 
-    def inner(frame: bytes) -> dict:
-        size, compressed = (
-            int.from_bytes(frame[:8], "little"),
-            int.from_bytes(frame[8:16], "little"),
-        )
-        payload = zstandard.ZstdDecompressor().decompress(
-            frame[16 : 16 + compressed], max_output_size=size
-        )
-        decoded = msgspec.msgpack.decode(payload)
-        decoded.pop("timestampSec")
-        return decoded
-
     window = viser_private.OwnedWindow(messages(None))
     for owner in ("7", "1234", "18446744073709551615"):
         ours, theirs = window.bytes_for(owner), _viser_s_own_window(messages(owner))
-        assert inner(ours) == inner(theirs), WRITTEN_FOR
+        assert _inner(ours) == _inner(theirs), WRITTEN_FOR
         decoded = decode_frame(ours)
         assert {m["owner"] for m in decoded} == {owner}
         np.testing.assert_array_equal(decoded[2]["updates"]["points"], points.ravel())
