@@ -230,6 +230,22 @@ def test_the_phase_says_who_limits_the_frame_rates(monkeypatch, server, clients,
     assert ("not the server" in load.text()) == (limit != "server")
 
 
+def test_the_follow_figures_are_the_95th_percentile_of_the_redraws_not_the_slowest():
+    """100 redraws of 1 to 100 ms: the figure is 95 ms (the slowest, 100 ms, is not it), on
+    one host and on the other host of two."""
+    redraws = [[0.001 * (10 * m + f + 1) for f in range(10)] for m in range(10)]
+    moving = {"fps": [30.0] * 10, "latencies": sum(redraws, []), "redraws": redraws, "moves": 10}
+    load = following.Load(0.5, 0.5, 1)
+    one = following._figures(10, moving, moving, moving, (0.1, 0.5), True, load)
+    move = next(f for f in one if f.name == "10 followers: lead's slider move on every follower")
+    assert move.value == pytest.approx(95.0) and move.text.startswith("p95 95 ms over 100")
+    outage = {"recovery": [1.0], "lost": 0, "early": 0, "told": 1, "others": 1, "refused": 0}
+    outage |= {"links_lost": 1, "told_s": 0.5}
+    two = hosts_workload._figures("2 hosts", [1] * 10, moving, moving, 0.1, outage, load)
+    other = next(f for f in two if f.name == "2 hosts: lead's move on the other hosts")
+    assert other.value == pytest.approx(95.0)
+
+
 @pytest.mark.slow
 def test_the_follow_phase_on_two_hosts_follows_through_redis_and_recovers(hosts_report):
     """Half the followers are on the other host: every lead's move reaches them through Redis,
@@ -364,6 +380,8 @@ def test_percentile_thread_kinds_and_proc():
     assert percentile([], 0.5) != percentile([], 0.5)  # NaN
     assert percentile([3.0, 1.0, 2.0, 4.0], 0.5) == 2.0
     assert percentile([float(i) for i in range(1, 101)], 0.95) == 95.0
+    with pytest.raises(ValueError, match="fraction"):  # 95 for 0.95 would be the largest value
+        percentile([1.0, 2.0], 95)
     assert thread_kind("poinsot-session-12") == "poinsot-session"
     assert thread_kind("ThreadPoolExecutor-0_3") == "ThreadPoolExecutor"
     assert thread_kind("MainThread") == "MainThread"

@@ -116,7 +116,10 @@ def format_table(figures: list[Figure], bounds: Bounds) -> str:
 
 
 def percentile(values: list[float], q: float) -> float:
-    """The ``q``-quantile (0..1) by nearest rank; NaN for no values."""
+    """The ``q``-quantile (0..1) by nearest rank; NaN for no values. A ``q`` outside 0..1 (a
+    percentage, 95 for 0.95, would read as the largest value) is a ValueError."""
+    if not 0.0 <= q <= 1.0:
+        raise ValueError(f"percentile: q is a fraction from 0 to 1, not {q!r}")
     ordered = sorted(values)
     if not ordered:
         return math.nan

@@ -137,7 +137,7 @@ def _figures(
     not the server, limit them (:attr:`Load.limit`): the table says so instead."""
     fps, latencies = following["fps"], following["latencies"]
     lost = following["moves"] * count - len(latencies)
-    p95 = 1e3 * percentile(latencies, 95) if latencies else math.nan
+    p95 = 1e3 * percentile(latencies, 0.95) if latencies else math.nan
     follow_ms, own_ms = costs
     name = f"{count} followers"
     text = f"{fps_text(fps)} (nothing moving: {fps_text(still['fps'])})"

@@ -223,7 +223,7 @@ def _split(moving: dict, hosts: list[int]) -> tuple[list[float], list[float], in
 
 
 def _p95_ms(values: list[float]) -> float:
-    return 1e3 * percentile(values, 95) if values else math.nan
+    return 1e3 * percentile(values, 0.95) if values else math.nan
 
 
 def _figures(
