@@ -482,6 +482,37 @@ def test_a_playing_lead_publishes_its_clock_at_the_state_s_own_instant(poinsot_a
     assert [s.t for s in playing] == pytest.approx([clock.at(s.at) for s in playing], abs=1e-12)
 
 
+def test_a_lead_publishes_its_new_body_as_soon_as_it_is_rebuilt(poinsot_app, make_probe):
+    """The lead's new body is published right after its rebuild, before the lead draws another
+    frame: its followers start their rebuilds at once (not up to a frame interval later)."""
+    lead = _ready(make_probe(poinsot_app))
+    session = session_of(poinsot_app)
+    hub, build = session.follow.hub, session.build
+    rebuilt: list[tuple[int, int]] = []  # (generation, frames drawn) as each rebuild ended
+    published: list[tuple[str, int]] = []  # (query, frames drawn) at each publish
+    rebuild, publish = build.rebuild, hub.publish
+
+    def recorded_rebuild(showcase: Any) -> None:
+        rebuild(showcase)
+        rebuilt.append((build.generation, session.stats.frames))
+
+    def recorded_publish(controls: Any, state: LeadState) -> bool:
+        published.append((state.query, session.stats.frames))
+        return publish(controls, state)
+
+    build.rebuild = recorded_rebuild  # type: ignore[method-assign]
+    hub.publish = recorded_publish  # type: ignore[method-assign]
+    _lead(lead, poinsot_app.follow.code)
+    assert wait_until(lambda: len(published) >= 1, 30)
+    for value in (2.3, 2.2):
+        queries = {query for query, _ in published}
+        _set(lead, D, value)
+        assert wait_until(lambda q=queries: any(p[0] not in q for p in published), 30), value
+        query, frames = next(p for p in published if p[0] not in queries)
+        assert f"D={value:g}" in query, query
+        assert frames == rebuilt[-1][1], (frames, rebuilt)  # no frame drawn in between
+
+
 def test_a_state_published_again_wakes_no_follower_and_a_change_does():
     """A lead publishes its state a few times a second; the same state again (its clock
     re-anchored where it had got to) wakes no follower, since they read the time from the hub.

@@ -85,6 +85,9 @@ class FrameWork:
             self._drain()
             if self.build.dirty:
                 self.build.rebuild(self.choice.showcase)
+                # A lead's new body or scene goes to its followers now, not after its next
+                # frame (up to a frame interval later, every follower's rebuild waiting).
+                self.publish.on_frame(time.monotonic())
         self.shared.update(self._shared_source())
 
     def _shared_source(self) -> Source | None:
