@@ -81,12 +81,12 @@ def segments(node: Node) -> np.ndarray:
 
 
 def trail_points(nodes: dict[str, Node], group: str) -> np.ndarray:
-    """The points of a trail as sent: its chunks ``group/c<n>`` in order, chained."""
-    chunks = sorted(
-        (int(name.rsplit("/c", 1)[1]), node)
-        for name, node in nodes.items()
-        if name.startswith(group + "/c") and name.rsplit("/c", 1)[1].isdigit()
-    )
+    """The points of a trail as sent: the chunks ``group/g<layer>/c<n>`` of its newest layer
+    shown (a cleared layer is hidden, then removed), in order, chained."""
+    pattern = re.compile(re.escape(group) + r"/g(\d+)/c(\d+)")
+    found = [(m, node) for name, node in nodes.items() if (m := pattern.fullmatch(name))]
+    shown = [int(m[1]) for m, _ in found if nodes[f"{group}/g{m[1]}"].visible]
+    chunks = sorted((int(m[2]), node) for m, node in found if shown and int(m[1]) == max(shown))
     if not chunks:
         return np.zeros((0, 3))
     parts = [segments(node) for _, node in chunks]
@@ -114,9 +114,9 @@ def drawn_traces(session: Session, probe: Probe) -> dict[str, np.ndarray]:
 
 
 def scene_node_names(probe: Probe, trails: tuple[str, ...]) -> set[str]:
-    """The nodes as sent, without the chunks of the given trail groups."""
+    """The nodes as sent, without the layers and chunks of the given trail groups."""
     nodes, _ = probe.snapshot()
-    return {name for name in nodes if not any(name.startswith(group + "/c") for group in trails)}
+    return {name for name in nodes if not any(name.startswith(group + "/g") for group in trails)}
 
 
 def visible_labels(probe: Probe) -> set[str]:

@@ -9,12 +9,12 @@ Node tree (names are paths; a child inherits its parent's pose in the browser)::
     /space/omega            omega, an arrow from the origin to the contact point
     /space/tip              a frame at the contact point (the tip of omega on the plane):
     /space/tip/contact, /space/tip/omega_label      its marker and the omega label
-    /space/herpolhode/c*    herpolhode trail (space frame)
+    /space/herpolhode/g*/c*  herpolhode trail (space frame; one layer a clearing)
     /space/body             body frame: its wxyz is the attitude R(t)
     /space/body/ellipsoid   energy ellipsoid: unit icosphere scaled by the semi-axes
     /space/body/axis{1,2,3}, .../label     principal axes and their labels
     /space/body/solid       the solid body (box, disc, rod, T-handle)
-    /space/body/polhode_full, /space/body/polhode/c*   polhode (whole curve, live trail)
+    /space/body/polhode_full, /space/body/polhode/g*/c*   polhode (whole curve, live trail)
 
 Sizes are in display units (:mod:`poinsot.app.construction.geometry`); the nodes of each element are
 made by :mod:`poinsot.app.construction.nodes`.

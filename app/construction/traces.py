@@ -85,8 +85,7 @@ class Trace(Drawing):
 
     def remove(self) -> None:
         super().remove()
-        self.trail.clear()
-        self.trail.group.remove()
+        self.trail.remove()
 
 
 def draw_trace(element: Element, api: viser.SceneApi, root: str, trail_points: int) -> Trace:

@@ -10,6 +10,12 @@ size; the length stays within one chunk below ``max_points``.
 A dropped chunk is not removed but kept as a spare, shrunk to one point of the trail (hidden
 under it), and reused as the next head: a chunk's node is made once, and in the steady state
 an append sends only ``points`` updates (making a node costs many times an update in viser).
+
+A cleared trail (a new body, a jump in time) is not removed at once either: its chunks hang
+from a frame of their own (a *layer*, ``name/g<n>``), which is hidden in one message, and its
+chunks are removed :data:`RETIRE_PER_APPEND` at a time with the appends that follow. A trail
+a minute long is some seventy chunks: removed at once they were most of a new body's rebuild
+(about 1 ms of the interpreter, and seventy messages, for each follower of a lecture).
 """
 
 from __future__ import annotations
@@ -23,10 +29,16 @@ import viser
 CHUNK_SEGMENTS = 24
 #: Spare chunks kept for reuse (a shorter trail removes the rest).
 MAX_SPARE = 2
+#: A cleared layer's chunks removed with each append that follows.
+RETIRE_PER_APPEND = 4
+#: Cleared layers kept hidden at most: clearing another removes the oldest whole (a trail
+#: cleared again and again with no append between, as a slider dragged over a paused scene).
+MAX_RETIRED = 2
 
 
 class Trail:
-    """A polyline under scene node ``name`` (a group frame; its children are the chunks)."""
+    """A polyline under scene node ``name`` (a group frame; its children are the layers, whose
+    children are the chunks: the newest layer drawn, the cleared ones hidden)."""
 
     def __init__(
         self,
@@ -58,6 +70,11 @@ class Trail:
         self._n = 0
         self._last: np.ndarray | None = None
         self._counter = 0
+        self._layers = 0
+        self._layer: viser.FrameHandle | None = None  # made with its first chunk
+        #: Cleared layers, oldest first, with the chunks still to remove.
+        self._retired: collections.deque[tuple[viser.FrameHandle, list[viser.SceneNodeHandle]]]
+        self._retired = collections.deque()
 
     # -- state ---------------------------------------------------------------------------
     @property
@@ -97,18 +114,31 @@ class Trail:
 
     # -- mutation ------------------------------------------------------------------------
     def clear(self) -> None:
-        for handle in self._spare:
-            handle.remove()
+        """Empty the trail: its layer hidden at once, its chunks removed with the next appends
+        (:data:`RETIRE_PER_APPEND` each)."""
+        chunks: list[viser.SceneNodeHandle] = [*self._spare, *(h for h, _ in self._frozen)]
+        if self._head is not None:
+            chunks.append(self._head)
+        if self._layer is not None and chunks:
+            self._layer.visible = False
+            self._retired.append((self._layer, chunks))
+            self._layer = None
+            while len(self._retired) > MAX_RETIRED:
+                self._retired.popleft()[0].remove()  # its chunks with it
         self._spare.clear()
-        for handle, _ in self._frozen:
-            handle.remove()
         self._frozen.clear()
         self._frozen_segments = 0
-        if self._head is not None:
-            self._head.remove()
         self._head = None
         self._n = 0
         self._last = None
+
+    def remove(self) -> None:
+        """Remove the trail's nodes, its group included (the trail is not used again)."""
+        self.group.remove()  # its layers and their chunks with it
+        self._retired.clear()
+        self._spare.clear()
+        self._frozen.clear()
+        self._frozen_segments, self._head, self._layer, self._n = 0, None, None, 0
 
     def restyle(self, color: tuple[int, int, int], width_px: float) -> None:
         """New colour and width, for the pieces drawn already and those to come."""
@@ -151,6 +181,7 @@ class Trail:
             start += take
             self._send_head()
         self._trim()
+        self._retire(RETIRE_PER_APPEND)
 
     # -- internals -----------------------------------------------------------------------
     def _send_head(self) -> None:
@@ -160,7 +191,7 @@ class Trail:
         elif self._head is None:
             self._counter += 1
             self._head = self._api.add_line_segments(
-                f"{self._name}/c{self._counter}",
+                f"{self._current_layer().name}/c{self._counter}",
                 self._buffer[: self._n].copy(),  # the creation message keeps its array
                 self._color,
                 thickness=self._width,
@@ -186,3 +217,20 @@ class Trail:
             else:  # shrunk onto the trail's newest point, under the line: nothing shows of it
                 handle.points = np.broadcast_to(self._last, (1, 2, 3))
                 self._spare.append(handle)
+
+    def _current_layer(self) -> viser.FrameHandle:
+        if self._layer is None:
+            self._layers += 1
+            self._layer = self._api.add_frame(f"{self._name}/g{self._layers}", show_axes=False)
+        return self._layer
+
+    def _retire(self, count: int) -> None:
+        """Remove up to ``count`` chunks of the cleared layers, then each emptied layer."""
+        while self._retired and count > 0:
+            layer, chunks = self._retired[0]
+            while chunks and count > 0:
+                chunks.pop().remove()
+                count -= 1
+            if not chunks:
+                layer.remove()
+                self._retired.popleft()

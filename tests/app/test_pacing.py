@@ -191,7 +191,7 @@ def test_a_frame_of_the_default_preset_sends_three_messages_and_traces_every_fou
         if i not in with_traces:
             assert len(frame) == 3
             continue
-        traces = collections.Counter(name.split("/c")[0] for _, name in frame[3:])
+        traces = collections.Counter(name.split("/g")[0] for _, name in frame[3:])
         assert set(traces) == {"/space/herpolhode", "/space/body/polhode"}
         # One points update each; where the head fills, also the chunk dropped and reused.
         assert all(1 <= n <= 3 for n in traces.values()), frame

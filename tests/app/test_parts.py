@@ -17,7 +17,7 @@ from scipy.spatial.transform import Rotation
 from poinsot.app.cli import main as cli
 from poinsot.app.construction.meshes import solid_mesh
 from poinsot.app.construction.sampled.frames import rotation_from_wxyz, wxyz
-from poinsot.app.construction.trail import Trail
+from poinsot.app.construction.trail import MAX_RETIRED, RETIRE_PER_APPEND, Trail
 from poinsot.app.live.panel.clock import SimClock
 from poinsot.app.model.elements import ALL_ELEMENTS, Element
 from poinsot.app.model.parameters import Parameters
@@ -180,22 +180,37 @@ class FakeHandle:
         self.api.sent_bytes += self._points.nbytes
 
     def remove(self) -> None:
+        self.api.removed += 1
         self.api.live.discard(self.name)
+        self.api.live -= {n for n in self.api.live if n.startswith(self.name + "/")}
 
 
 class FakeApi:
-    """Records what a Trail sends, in place of a viser SceneApi."""
+    """Records what a Trail sends, in place of a viser SceneApi: the chunks alive, the frames
+    by name, the bytes of points and the removals."""
 
     def __init__(self) -> None:
         self.live: set[str] = set()
+        self.frames: dict[str, FakeHandle] = {}
         self.sent_bytes = 0
+        self.removed = 0
 
     def add_frame(self, name, **kwargs):
-        return FakeHandle(self, name, np.zeros((0, 3)))
+        self.frames[name] = FakeHandle(self, name, np.zeros((0, 3)))
+        return self.frames[name]
 
     def add_line_segments(self, name, points, color, **kwargs):
         self.live.add(name)
         return FakeHandle(self, name, points)
+
+    def shown(self) -> set[str]:
+        """The chunks alive whose frames are all visible."""
+        parents = lambda name: [name[:i] for i in range(len(name)) if name[i] == "/" and i]  # noqa: E731
+        return {
+            c
+            for c in self.live
+            if all(self.frames[p].visible for p in parents(c) if p in self.frames)
+        }
 
 
 def test_trail_is_bounded_and_sends_increments_only():
@@ -215,9 +230,41 @@ def test_trail_is_bounded_and_sends_increments_only():
     trail.max_points = 50
     assert trail.segment_count <= 50
     trail.clear()
-    assert trail.segment_count == 0 and api.live == set()
+    assert trail.segment_count == 0 and api.live and api.shown() == set()
     trail.append(points[:5])
     assert np.array_equal(trail.points(), points[:5])
+
+
+def test_a_cleared_trail_is_hidden_at_once_and_removed_a_few_chunks_an_append():
+    """A long trail cleared (a new body) is hidden in one message, not removed chunk by
+    chunk; its chunks go RETIRE_PER_APPEND with each append after; a trail cleared again and
+    again with no append keeps at most MAX_RETIRED hidden layers."""
+    api = FakeApi()
+    trail = Trail(api, "/t", (255, 0, 0), 2.0, max_points=10_000, chunk=8)
+    points = np.cumsum(np.ones((801, 3)), axis=0).astype(np.float32)
+    trail.append(points)
+    chunks = len(api.live)
+    assert chunks == 100 and api.shown() == api.live
+    removed = api.removed
+    trail.clear()
+    assert api.removed == removed and api.shown() == set() and len(api.live) == chunks
+    trail.append(points[:2])  # a first point, then a segment: one new chunk, shown
+    new = api.shown()
+    assert len(new) == 1 and len(api.live) == 1 + chunks - RETIRE_PER_APPEND
+    appends = 0
+    while len(api.live) > len(api.shown()):
+        trail.append(points[2 + appends][None])
+        appends += 1
+    assert appends == -(-(chunks - RETIRE_PER_APPEND) // RETIRE_PER_APPEND)
+    assert np.array_equal(trail.points(), points[: 2 + appends])
+    assert api.removed == removed + chunks + 1  # each chunk, then its emptied layer
+    for _ in range(MAX_RETIRED + 2):  # cleared again and again, each time with a chunk
+        trail.append(points[:2])
+        trail.clear()
+    hidden = {n.rsplit("/", 1)[0] for n in api.live}
+    assert len(hidden) <= MAX_RETIRED and api.shown() == set()
+    trail.remove()
+    assert api.live == set()
 
 
 def test_trail_appends_of_any_size_draw_one_unbroken_polyline():

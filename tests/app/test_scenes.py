@@ -205,5 +205,5 @@ def test_per_frame_only_poses_and_trail_increments(name, make_app, make_probe):
         for kind, node in zip(batch.types, batch.names, strict=True):
             assert kind in PER_FRAME_TYPES, (kind, node)
             if kind in ("LineSegmentsMessage", "RemoveSceneNodeMessage"):
-                assert node.startswith(tuple(t + "/c" for t in trails)), node
+                assert node.startswith(tuple(t + "/g" for t in trails)), node
     assert session.stats.errors == 0, session.stats.last_error

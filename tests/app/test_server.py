@@ -5,6 +5,7 @@ per frame, the frame rate, sessions, invalid input, and robustness."""
 from __future__ import annotations
 
 import random
+import re
 import time
 
 import numpy as np
@@ -20,7 +21,7 @@ from poinsot.app.model.elements import Control, Element, Plot
 from poinsot.app.model.parameters import Parameters
 from poinsot.app.model.presets import CUSTOM, DEFAULT_PRESET, PRESETS, preset_by_key
 
-#: Nodes each element creates (trail chunks "…/c<n>" come and go under their group).
+#: Nodes each element creates (trail chunks "…/g<layer>/c<n>" come and go under their group).
 ELEMENT_NODES: dict[Element, set[str]] = {
     Element.ELLIPSOID: {"/space/body/ellipsoid"},
     Element.AXES: {f"/space/body/axis{i}" for i in (1, 2, 3)}
@@ -353,7 +354,7 @@ def test_visibility_trail_length_and_time_controls(poinsot_app, probe):
         trail = session.scene.trail(element)
         assert trail.segment_count <= max(100, 2 * CHUNK_SEGMENTS) + CHUNK_SEGMENTS
     # On the wire too: the chunks the browser holds are bounded.
-    chunks = [n for n in probe.snapshot()[0] if n.startswith("/space/herpolhode/c")]
+    chunks = [n for n in probe.snapshot()[0] if re.match(r"/space/herpolhode/g\d+/c", n)]
     assert len(chunks) <= max(100, 2 * CHUNK_SEGMENTS) // CHUNK_SEGMENTS + 2
     # Pause freezes time; Step advances it by STEP_SECONDS x speed; Reset goes back to 0.
     probe.set_value(probe.widget("Pause")[0], True)

@@ -193,8 +193,7 @@ class Parts:
     def remove(self) -> None:
         for trails in self._trails.values():
             for trail in trails:
-                trail.clear()
-                trail.group.remove()
+                trail.remove()
         # Children before their parents: a parent's removal takes its children with it.
         handles = [h for hs in self._nodes.values() for h in hs]
         for handle in sorted(handles, key=lambda h: -h.name.count("/")):

@@ -76,9 +76,10 @@ class Part:
     """A drawing of the scene's own, shown and hidden as a whole by its checkbox.
 
     ``nodes``: the scene node names it creates; ``trails``: those of its nodes that are trail
-    groups (their chunks ``<group>/c<n>`` come and go); ``colors``: the colours of its lines,
-    drawn unlit in exactly these colours (a picture of the scene shows them); ``surface``: its
-    colour where it is a lit or translucent surface instead (shaded on screen), else None;
+    groups (their chunks ``<group>/g<layer>/c<n>`` come and go); ``colors``: the colours of its
+    lines, drawn unlit in exactly these colours (a picture of the scene shows them);
+    ``surface``: its colour where it is a lit or translucent surface instead (shaded on screen),
+    else None;
     ``legend``: its rows in the legend where it draws more than one thing (each colour it
     draws in one of them), else one row of its label is made (:meth:`rows`; ``translucent``:
     its surface is seen through).
