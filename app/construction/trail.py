@@ -138,7 +138,7 @@ class Trail:
         self._retired.clear()
         self._spare.clear()
         self._frozen.clear()
-        self._frozen_segments, self._head, self._layer, self._n = 0, None, None, 0
+        self._frozen_segments, self._head, self._layer, self._n, self._last = 0, None, None, 0, None
 
     def restyle(self, color: tuple[int, int, int], width_px: float) -> None:
         """New colour and width, for the pieces drawn already and those to come."""

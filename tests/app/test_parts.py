@@ -204,12 +204,11 @@ class FakeApi:
         return FakeHandle(self, name, points)
 
     def shown(self) -> set[str]:
-        """The chunks alive whose frames are all visible."""
-        parents = lambda name: [name[:i] for i in range(len(name)) if name[i] == "/" and i]  # noqa: E731
+        """The chunks alive whose frames (every prefix of their name) are all visible."""
         return {
             c
             for c in self.live
-            if all(self.frames[p].visible for p in parents(c) if p in self.frames)
+            if all(f.visible for name, f in self.frames.items() if c.startswith(name + "/"))
         }
 
 

@@ -84,11 +84,14 @@ class FrameWork:
         with outbox.quiet_if_left():
             self._drain()
             if self.build.dirty:
-                self.build.rebuild(self.choice.showcase)
-                # A lead's new body or scene goes to its followers now, not after its next
-                # frame (up to a frame interval later, every follower's rebuild waiting).
-                self.publish.on_frame(time.monotonic())
+                self._rebuild()
         self.shared.update(self._shared_source())
+
+    def _rebuild(self) -> None:
+        """Rebuild; a lead's new body or scene then goes to its followers at once, not after
+        its next frame (up to a frame interval later, every follower's rebuild waiting)."""
+        self.build.rebuild(self.choice.showcase)
+        self.publish.on_frame(time.monotonic())
 
     def _shared_source(self) -> Source | None:
         """What the cast poses this follower from, if its frame is the lead's (a body, not a
@@ -128,7 +131,7 @@ class FrameWork:
         refused = self.queue.run(self.status.report)
         if refused:  # said after the rebuild they ask for (which clears the status line)
             if self.build.dirty:
-                self.build.rebuild(self.choice.showcase)
+                self._rebuild()
             self.status.say(f"Too many changes at once: {refused} were ignored; please redo them.")
 
     def _advance(self) -> None:
