@@ -150,8 +150,14 @@ def set_theme(page, session, theme: str) -> None:
 
 
 def pause(page, session) -> None:
+    """Pause from the page's button, once the page has applied all the server sent it (a
+    preset just chosen rebuilds the panel around the button)."""
+    assert not session.clock.paused, "already paused"
+    page.drawn_after(session.client)
     page.click_button("Pause")
-    assert wait_until(lambda: session.clock.paused, 30)
+    if not wait_until(lambda: session.clock.paused, 30):
+        shown = page.page.get_by_role("button", name="Play", exact=True).count()
+        raise AssertionError(f"not paused ({shown} Play buttons, {session.stats.errors} errors)")
     # The traces are sent in chunks: paused, the last one goes out at the next frame. Until
     # then a picture could change between two screenshots for a reason of its own.
     assert wait_until(lambda: session.scene.traces_complete, 10)
