@@ -77,6 +77,7 @@ def _add_goals(parser: argparse.ArgumentParser, bounds: Bounds) -> None:
     """The goals' bounds (:class:`Bounds`), each an option."""
     goals = parser.add_argument_group("goals")
     goals.add_argument("--min-fps", type=non_negative_float, default=bounds.min_fps)
+    goals.add_argument("--min-hall-fps", type=non_negative_float, default=bounds.min_hall_fps)
     goals.add_argument("--max-redraw-ms", type=positive_float, default=bounds.max_redraw_ms)
     goals.add_argument("--max-rss-growth", type=non_negative_float, default=bounds.max_rss_growth)
     goals.add_argument("--storm-tolerance", type=non_negative_float, default=bounds.storm_tolerance)

@@ -17,9 +17,15 @@ windows of ``follow_seconds``:
 The server's CPU time (its worker processes) over each still window, divided by the frames the
 clients received, gives the CPU per follower-frame against the CPU per session-frame of the
 same clients, in the same run, on the same (shared) machine. The server's cores and the client
-processes' are stated for each size (:class:`Load`): where the clients, or the server and the
-clients together, fill this machine, the frame rates are said to measure them, not the server,
-and are not judged.
+processes' are stated for each size (:class:`Load`): where a client process is near a whole
+core, the frame rates are said to measure the clients, not the server, and are not judged.
+Each follower is held to ``Bounds.min_fps``, or ``Bounds.min_hall_fps`` in a hall (more than
+``HALL`` followers). The clients share this machine with the server: from the CPU each took
+per frame while the lead moved (the server's: all that the machine used but the clients'),
+the phase states the rate the server could give the slowest follower with the machine to
+itself and beside the clients (:meth:`Load.rates`); a rate below its goal that the server
+alone could give, and not beside the clients, is the clients' limit, not the server's
+(``Goal.clients_limit``).
 """
 
 from __future__ import annotations
@@ -32,7 +38,14 @@ import time
 
 from poinsot.app.devtools.load import procfs
 from poinsot.app.devtools.load.config import Config, Report, Say, fps_text, warmup
-from poinsot.app.devtools.load.figures import Figure, at_least, at_most, info, percentile
+from poinsot.app.devtools.load.figures import (
+    HALL,
+    Figure,
+    at_least,
+    at_most,
+    info,
+    percentile,
+)
 from poinsot.app.devtools.load.server_process import ServerProcess
 from poinsot.app.devtools.load.workloads.follow_fleet import FollowFleet, chunks
 
@@ -53,9 +66,11 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         ) as fleet:
             time.sleep(warmup(cfg.follow_seconds))
             pids = server.worker_pids or [server.pid]
+            machine = procfs.Machine.now()
             following = fleet.window(
                 cfg.follow_seconds, cfg.slider_period, cfg.follow_redraw_timeout
             )
+            busy = procfs.Machine.now().busy_since(machine) * (os.cpu_count() or 1)
             cpu0 = _cpu(pids)
             still = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu1 = _cpu(pids)
@@ -64,34 +79,75 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
             own = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu3 = _cpu(pids)
         costs = (_ms_per_frame(cpu1 - cpu0, still), _ms_per_frame(cpu3 - cpu2, own))
-        load = Load((cpu1 - cpu0) / still["seconds"], following["clients"], processes)
+        load = Load(
+            (cpu1 - cpu0) / still["seconds"],
+            following["clients"],
+            processes,
+            Moving(busy, sum(following["fps"]), count, len(pids)),
+        )
         report.add(*_figures(count, following, still, own, costs, explored, load))
         report.notes.append(f"follow, {count} followers: {load.text()}")
 
 
-#: A client process this busy [cores] limits the frame rates it counts, not the server.
+#: A client process this busy [cores] limits the frame rates it counts, not the server; the
+#: share of the machine's cores the server and the clients can use (:meth:`Load.rates`).
 CLIENTS_LIMIT = 0.9
+#: The fps figure's detail keys of :meth:`Load.rates` (the slowest follower's share): its goal
+#: is the clients' when the server alone could meet it, and not beside them.
+RATES = ("server_alone_fps", "beside_clients_fps")
+
+
+@dataclasses.dataclass(frozen=True)
+class Moving:
+    """While the lead moved: the machine's busy cores (all of its processes and its kernel),
+    the follower-frames the clients received a second, the followers and the server's
+    processes."""
+
+    busy: float
+    frames: float
+    followers: int
+    workers: int
 
 
 @dataclasses.dataclass(frozen=True)
 class Load:
     """The machine's cores while following: the server's (its workers, nothing moving), the
-    client processes' (all of them, while the lead moved), and how many processes those are."""
+    client processes' (all of them, while the lead moved), how many processes those are, and
+    (``moving``) the machine while the lead moved, for :meth:`rates`."""
 
     server: float
     clients: float
     processes: int
+    moving: Moving | None = None
 
     @property
     def limit(self) -> str:
         """Who limits the followers' frame rates on this machine: "clients" (a client process
-        near a whole core), "machine" (the server and the clients fill its cores) or
-        "server"."""
+        near a whole core), "machine" (the server and the clients fill its cores, where
+        :meth:`rates` cannot tell which) or "server"."""
         if self.clients / self.processes >= CLIENTS_LIMIT:
             return "clients"
-        if self.server + self.clients >= CLIENTS_LIMIT * (os.cpu_count() or 1):
+        if self.rates() is None and self.server + self.clients >= CLIENTS_LIMIT * (
+            os.cpu_count() or 1
+        ):
             return "machine"
         return "server"
+
+    def rates(self) -> tuple[float, float] | None:
+        """(alone, beside): the mean frame rate each follower could get with the machine to
+        the server (CLIENTS_LIMIT of as many cores as it has processes, at most the machine's)
+        and beside these clients (of all the cores, for both), at the CPU each took per frame
+        received while the lead moved. Everything the machine used but the clients, its kernel
+        included, counts as the server's. None: not measured."""
+        moving = self.moving
+        if moving is None or moving.frames <= 0 or moving.followers <= 0:
+            return None
+        cores = os.cpu_count() or 1
+        server = max(moving.busy - self.clients, 1e-9) / moving.frames  # core-s per frame
+        clients = self.clients / moving.frames
+        alone = CLIENTS_LIMIT * min(cores, moving.workers) / (server * moving.followers)
+        beside = CLIENTS_LIMIT * cores / ((server + clients) * moving.followers)
+        return alone, beside
 
     def figure(self, name: str) -> Figure:
         """The figure "``name``: the machine's cores" of the follow phase."""
@@ -110,6 +166,13 @@ class Load:
             f"the server used {self.server:.2f} of {cores} cores (followers still), the "
             f"clients' {self.processes} process(es) {self.clients:.2f}"
         )
+        rates, moving = self.rates(), self.moving
+        if rates is not None and moving is not None:
+            said += (
+                f"; while the lead moved the machine used {moving.busy:.2f} cores, the clients "
+                f"{self.clients:.2f}: the server could give each follower {rates[0]:.1f} fps "
+                f"with the machine to itself, {rates[1]:.1f} beside the clients (means)"
+            )
         if self.limit == "clients":
             return said + ": the clients, not the server, limit the frame rates"
         if self.limit == "machine":
@@ -141,17 +204,25 @@ def _figures(
     follow_ms, own_ms = costs
     name = f"{count} followers"
     text = f"{fps_text(fps)} (nothing moving: {fps_text(still['fps'])})"
+    detail = {"clients": count, "p50": statistics.median(fps) if fps else 0.0}
+    rates = load.rates()
+    if rates is not None and fps and statistics.mean(fps) > 0:
+        spread = min(fps) / statistics.mean(fps)  # the slowest follower's share of the mean
+        alone, beside = (rate * spread for rate in rates)
+        detail |= {"server_alone_fps": alone, "beside_clients_fps": beside}
+        text += f"; the slowest could get {alone:.1f} from the server alone, {beside:.1f} beside"
     judged = load.limit == "server"
     if not judged:
         text += f"; limited by the {load.limit}, not the server: not judged"
+    bound = "min_hall_fps" if count > HALL else "min_fps"
     return [
         Figure(
             "follow",
             f"{name}: fps each",
             min(fps) if fps else 0.0,
             text,
-            at_least("min_fps", ">= {:g} fps") if judged else None,
-            {"clients": count, "p50": statistics.median(fps) if fps else 0.0},
+            at_least(bound, ">= {:g} fps", rates=RATES) if judged else None,
+            detail,
         ),
         Figure(
             "follow",
