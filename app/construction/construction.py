@@ -77,6 +77,11 @@ MARKER_RADIUS_PX = 9.0
 ARROW_HALF_WIDTH_PX = 3.0
 
 
+def no_fitting(motion: Motion) -> AbstractContextManager[None]:
+    """A scene's :attr:`~PoinsotScene.fitting` by default: nothing bracketed."""
+    return contextlib.nullcontext()
+
+
 class PoinsotScene:
     """The scene nodes of one view. Create with the elements to draw; then :meth:`load` a body
     and call :meth:`advance` every frame. Not thread-safe: one thread drives a scene."""
@@ -118,6 +123,10 @@ class PoinsotScene:
         self._look: Look = palette.DARK
         #: Called with each drawing made (a pointer binds its callbacks to the ellipsoid's).
         self.on_create: Callable[[Element, Drawing], None] | None = None
+        #: Brackets the drawings' fit to a new body in :meth:`load`, given its motion (a
+        #: follower's new body is handed to the followers that still show the old one:
+        #: live/classroom/cast.py).
+        self.fitting: Callable[[Motion], AbstractContextManager[None]] = no_fitting
         self.space = api.add_frame(root, show_axes=False)
         self.body_frame = api.add_frame(f"{root}/body", show_axes=False)
         self.tip = api.add_frame(f"{root}/tip", show_axes=False)
@@ -269,9 +278,10 @@ class PoinsotScene:
             self._body, self._geometry = motion.body, geometry
             self._label_epoch += 1
             self._motion, self._batch = motion, batch
-            for element in sorted(self._elements):
-                drawing = self._drawings.get(element) or self._create(element)
-                drawing.fit(geometry)
+            with self.fitting(motion):
+                for element in sorted(self._elements):
+                    drawing = self._drawings.get(element) or self._create(element)
+                    drawing.fit(geometry)
             self._index()
             self._k_last = None
             self._frame = None

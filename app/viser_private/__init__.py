@@ -70,6 +70,10 @@ Inventory (section, private name, what it is used for):
   - ``ClientHandle._viser_server._websock_server`` with ``_live_connections`` and
     ``_background_event_loop``: a client's socket and its loop (the pacer's unacknowledged
     bytes, the backlog watch).
+  - ``ClientHandle._websock_connection.queue_message`` (through which a client's scene API
+    queues), shadowed on the connection within a block: what one thread queues is held back
+    (:func:`held_back`, :func:`queue_held`: a follower's new body, sent through the
+    followers' shared windows instead).
 
 *Window* (:mod:`poinsot.app.viser_private.window`)
   - ``viser.infra._infra._message_producer``'s wire format (its ``_append_aligned_buffers``,
@@ -147,10 +151,12 @@ from poinsot.app.viser_private.transport import (
     broadcasts_woken_on_their_loop,
     closed,
     connection_of,
+    held_back,
     last_queued,
     last_taken,
     message_buffer,
     pending,
+    queue_held,
     quiet_if_closed,
     senders_woken_on_their_loop,
     set_on_its_loop_only,
@@ -185,6 +191,8 @@ __all__ = [
     "quiet_if_closed",
     "senders_woken_on_their_loop",
     "set_on_its_loop_only",
+    "held_back",
+    "queue_held",
     "connection_count",
     "infra",
     "live_connection_ids",

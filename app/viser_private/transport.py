@@ -11,6 +11,9 @@ private names (:mod:`poinsot.app.viser_private`, whose docstring has the invento
 - :func:`set_on_its_loop_only`: a buffer's ``message_event`` (an ``asyncio.Event``) and
   ``event_loop``, the event made one that only its loop sets (:class:`SetOnItsLoop`: viser
   also sets it from the pushing thread, which races with the sender's wait);
+- :func:`held_back`: ``ClientHandle._websock_connection.queue_message`` (the one method
+  through which a client's scene API queues), shadowed on the connection within a block so
+  that what one thread queues is held back, not sent (the handles keep the values it set);
 
 Both answer None rather than raise when a name has moved (the pacer then never skips, and the
 backlog watch sees nothing: the behaviour before either); the test of each pins the names.
@@ -19,6 +22,9 @@ backlog watch sees nothing: the behaviour before either); the test of each pins 
 from __future__ import annotations
 
 import asyncio
+import contextlib
+import threading
+from collections.abc import Iterator
 from contextlib import AbstractContextManager
 from typing import Any
 
@@ -125,3 +131,36 @@ def broadcasts_woken_on_their_loop(server: viser.ViserServer) -> bool:
     ``ViserServer._websock_server.get_message_buffer()``."""
     getter = getattr(getattr(server, "_websock_server", None), "get_message_buffer", None)
     return getter is not None and set_on_its_loop_only(getter())
+
+
+@contextlib.contextmanager
+def held_back(client: viser.ClientHandle) -> Iterator[list[Any] | None]:
+    """Within the block, what this thread queues to ``client`` is held back, not sent: yields
+    the list it is gathered in (:func:`queue_held` sends it after all). Its node handles keep
+    the values it sets; other threads' messages go as ever. Yields None, and everything goes
+    as ever, if viser's names moved or the queue is shadowed already."""
+    connection = getattr(client, "_websock_connection", None)
+    queue = getattr(connection, "queue_message", None)
+    if connection is None or queue is None or "queue_message" in vars(connection):
+        yield None
+        return
+    thread = threading.get_ident()
+    held: list[Any] = []
+
+    def queue_message(message: Any) -> None:
+        if threading.get_ident() == thread:
+            held.append(message)
+        else:
+            queue(message)
+
+    connection.queue_message = queue_message
+    try:
+        yield held
+    finally:
+        del connection.queue_message
+
+
+def queue_held(client: viser.ClientHandle, messages: list[Any]) -> None:
+    """Queue ``messages`` held back by :func:`held_back` to ``client`` after all."""
+    for message in messages:
+        client._websock_connection.queue_message(message)

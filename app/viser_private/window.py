@@ -134,11 +134,28 @@ class WindowSocket:
         self.busy = False
         self.sent = 0
         self.failed = 0
+        self.handed = 0  # windows handed to it (:func:`send_each`), written or not
+        self._written = threading.Condition()
 
     @property
     def usable(self) -> bool:
         """False if viser's names moved, or the client left before it was reached."""
         return self.connection is not None and isinstance(self.loop, asyncio.AbstractEventLoop)
+
+    def wait_written(self, timeout: float) -> bool:
+        """Wait (a thread other than its loop's) until every window handed to it has been
+        written or has failed, at most ``timeout`` seconds: False if some were not."""
+        with self._written:
+            return self._written.wait_for(lambda: self.sent + self.failed >= self.handed, timeout)
+
+    def _done(self, written: bool) -> None:
+        """A window handed to it was written (or failed): counted, its waiters told."""
+        with self._written:
+            if written:
+                self.sent += 1
+            else:
+                self.failed += 1
+            self._written.notify_all()
 
     def write(self, data: bytes) -> None:
         """On its loop: ``data`` written as ``ServerConnection.send`` writes a message, then
@@ -151,11 +168,10 @@ class WindowSocket:
                 connection.send_data()
             except Exception:  # the client left meanwhile
                 written = False
+        self._done(written)
         if not written:
             self.busy = False
-            self.failed += 1
             return
-        self.sent += 1
         if connection.paused:
             self.loop.create_task(connection.drain()).add_done_callback(self._drained)
         else:
@@ -173,6 +189,7 @@ def send_each(sends: Sequence[tuple[WindowSocket, bytes]]) -> int:
     by_loop: dict[Any, list[tuple[WindowSocket, bytes]]] = {}
     for socket, data in sends:
         socket.busy = True
+        socket.handed += 1
         by_loop.setdefault(socket.loop, []).append((socket, data))
     handed = 0
     for loop, group in by_loop.items():
@@ -182,6 +199,7 @@ def send_each(sends: Sequence[tuple[WindowSocket, bytes]]) -> int:
         except RuntimeError:  # the server stopped: its loop is closed
             for socket, _ in group:
                 socket.busy = False
+                socket._done(False)
     return handed
 
 

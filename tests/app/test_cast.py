@@ -8,11 +8,23 @@ from __future__ import annotations
 
 import asyncio
 import threading
+from types import SimpleNamespace
 
 import numpy as np
 
 from poinsot.app.devtools.probe import Probe, decode_frame
-from poinsot.app.live.classroom.cast import OWN_FPS, OWN_MIN_FPS, OWN_PROCESS_FRAMES, own_fps
+from poinsot.app.live.classroom import cast as cast_module
+from poinsot.app.live.classroom.cast import (
+    OWN_FPS,
+    OWN_MIN_FPS,
+    OWN_PROCESS_FRAMES,
+    FollowCast,
+    Member,
+    Source,
+    own_fps,
+)
+from poinsot.app.model.elements import Element
+from poinsot.app.viser_private import props_message, wire_message
 from tests.app.test_follow import _follow, _lead, _ready, _says, _set
 from tests.conftest import wait_until
 
@@ -291,3 +303,132 @@ def test_a_move_holds_the_cast_s_frames_until_its_followers_rebuilt_at_most_a_bo
     assert wait_until(lambda: cast.handed >= handed + 2 * len(sessions), 30)
     starts = [len(f) for f in frames]
     assert wait_until(lambda: all(len(f) >= s + 2 for f, s in zip(frames, starts, strict=True)), 30)
+
+
+ELLIPSOID = "/space/body/ellipsoid"
+
+
+class Sizes:
+    """The ellipsoid's sizes a probe is sent (each update of its scale), and their windows."""
+
+    def __init__(self, probe: Probe) -> None:
+        self.scales: list[tuple[float, ...]] = []
+        self.windows: list[bytes] = []
+        self._lock = threading.Lock()
+        probe.add_raw_listener(self._on_frame)
+
+    def _on_frame(self, frame: bytes) -> None:
+        for m in decode_frame(frame):
+            if m.get("name") == ELLIPSOID and "scale" in m.get("updates", {}):
+                with self._lock:
+                    self.scales.append(tuple(m["updates"]["scale"]))
+                    self.windows.append(frame)
+
+
+def _fitted_content(frame: bytes) -> tuple[tuple[object, ...], ...]:
+    """A fit's window, its owner aside."""
+    return tuple(
+        (m["type"], m["name"], repr(m.get("updates")), repr(m.get("position")))
+        for m in decode_frame(frame)
+    )
+
+
+def test_a_lead_s_move_is_fitted_once_and_handed_to_every_follower(
+    poinsot_app, make_probe, monkeypatch
+):
+    """The lead's new body: the first follower of the process to open it makes it (the others
+    wait for it: a bound long enough here that none stops waiting), and what its drawings'
+    fit queued goes, encoded once, to it and to every other follower; their own fits to the
+    same body send nothing. Each browser is sent the new size once, the session's own."""
+    monkeypatch.setattr(cast_module, "MAKER_WAIT", 60.0)
+    lead, probes, _, sessions = _class(poinsot_app, make_probe, followers=4)
+    cast = poinsot_app.follow.cast
+    sizes = [Sizes(p) for p in probes]
+    fits, copies = cast.fits, cast.fit_copies
+    generations = [s.generation for s in sessions]
+    _set(lead, "I₂", 1.7)
+    for session, generation in zip(sessions, generations, strict=True):
+        assert wait_until(lambda s=session, g=generation: s.generation > g, 30)
+    assert cast.fits == fits + 1 and cast.fit_copies == copies + len(sessions) - 1
+    meshes = [s.scene.drawing(Element.ELLIPSOID).mesh for s in sessions]
+    assert wait_until(lambda: all(len(z.scales) >= 1 for z in sizes), 30)
+    for size, mesh in zip(sizes, meshes, strict=True):
+        assert len(size.scales) == 1, size.scales  # the cast's copy alone, not its own too
+        assert np.allclose(size.scales[0], mesh.scale)
+    # The same window for all, each stamped with its own follower's owner.
+    assert len({_fitted_content(z.windows[0]) for z in sizes}) == 1
+    owners = [set().union(*map(_owners, z.windows)) for z in sizes]
+    assert all(len(o) == 1 for o in owners) and len(set.union(*owners)) == len(sessions)
+    assert all(s.stats.errors == 0 for s in sessions)
+
+
+def test_followers_that_wait_no_longer_send_their_own_fit_and_still_show_the_new_body(
+    poinsot_app, make_probe, monkeypatch
+):
+    """A maker slower than the others' wait (none here): each follower makes the body itself,
+    sent through the cast as the maker's is, and every browser still ends with the new size."""
+    monkeypatch.setattr(cast_module, "MAKER_WAIT", 0.0)
+    lead, probes, _, sessions = _class(poinsot_app, make_probe, followers=3)
+    sizes = [Sizes(p) for p in probes]
+    generations = [s.generation for s in sessions]
+    _set(lead, "I₂", 1.9)
+    for session, generation in zip(sessions, generations, strict=True):
+        assert wait_until(lambda s=session, g=generation: s.generation > g, 30)
+    meshes = [s.scene.drawing(Element.ELLIPSOID).mesh for s in sessions]
+    shown = list(zip(sizes, meshes, strict=True))
+    assert wait_until(
+        lambda: all(z.scales and np.allclose(z.scales[-1], m.scale) for z, m in shown), 30
+    )
+    assert all(1 <= len(z.scales) <= len(sessions) for z in sizes)
+
+
+class _Socket:
+    """A follower's socket, as :func:`send_each` hands it windows (nothing written)."""
+
+    def __init__(self, loop) -> None:
+        self.loop, self.busy, self.handed, self.sent, self.failed = loop, False, 0, 0, 0
+
+
+class _Loop:
+    def __init__(self) -> None:
+        self.calls: list[object] = []
+
+    def call_soon_threadsafe(self, callback, *args) -> None:
+        self.calls.append(args)
+
+
+def _member(socket: _Socket, source: Source, geometry: object) -> Member:
+    member = Member.__new__(Member)
+    member.socket, member.owner, member.source = socket, f"owner-{id(socket)}", source
+    member.geometry, member.shown = geometry, None
+    return member
+
+
+def test_a_new_body_goes_only_to_followers_showing_the_body_its_maker_showed():
+    """A share takes a follower from the body its maker showed to the new one: a follower
+    sent another body since (a newer move it made itself, or no known body) is not sent it,
+    nor one that draws on other nodes; those sent it pose the new motion from then on."""
+    geometry = [object(), object(), object()]  # what three motions' bodies would be
+    motions = [SimpleNamespace(geometry=g) for g in geometry]
+    loop = _Loop()
+    cast = FollowCast(lambda: None)
+    source = Source(motions[0], "/space/body", "/space/tip", None, frozenset({Element.ELLIPSOID}))
+    other_nodes = Source(motions[0], "/views/body", "/views/tip", None, source.elements)
+    sender = _member(_Socket(loop), source, geometry[0])
+    behind = _member(_Socket(loop), source, geometry[0])
+    newer = _member(_Socket(loop), source, geometry[2])
+    unknown = _member(_Socket(loop), source, None)
+    elsewhere = _member(_Socket(loop), other_nodes, geometry[0])
+    for key, member in enumerate((sender, behind, newer, unknown, elsewhere)):
+        cast._members[key] = member
+    update = props_message("/space/body/ellipsoid", {"scale": (1.0, 0.8, 0.6)})
+    assert cast.share_fit(sender, geometry[0], motions[1], [update])
+    assert behind.geometry is geometry[1] and behind.source.motion is motions[1]
+    assert newer.geometry is geometry[2] and unknown.geometry is None
+    assert elsewhere.geometry is geometry[0] and elsewhere.source.motion is motions[0]
+    handed = [socket for call in loop.calls for socket, _ in call[0]]
+    assert handed == [sender.socket, behind.socket] and cast.fit_copies == 1
+    # Not only node updates (a node removed): nothing is handed, the follower sends its own.
+    removed = wire_message("RemoveSceneNodeMessage", "/space/body/solid")
+    assert not cast.share_fit(sender, geometry[1], motions[2], [update, removed])
+    assert behind.geometry is geometry[1] and len(loop.calls) == 1

@@ -11,6 +11,7 @@ import collections
 import dataclasses
 import inspect
 import threading
+from typing import Any
 
 import pytest
 import viser
@@ -165,6 +166,37 @@ def test_a_client_s_queue_and_socket_are_where_viser_put_them(poinsot_app, probe
     assert isinstance(connection, websockets.asyncio.server.ServerConnection), WRITTEN_FOR
     assert isinstance(loop, asyncio.AbstractEventLoop) and loop.is_running(), WRITTEN_FOR
     assert connection is viser_private.live_connection(poinsot_app.server, client.client_id)
+
+
+def test_what_a_thread_queues_to_a_client_can_be_held_back_and_sent_after_all(poinsot_app, probe):
+    """A client's scene queues through its connection's ``queue_message``: within
+    :func:`held_back` what this thread queues is held (its browser is not sent it, the node's
+    handle keeps the value), another thread's goes as ever, and the queue is viser's own
+    again after the block; :func:`queue_held` sends what was held. A client's messages
+    arrive in the order queued, so the other thread's, queued after, arriving first shows the
+    first held."""
+    client = session_of(poinsot_app).client
+    node = client.scene.add_frame("/held", show_axes=False)
+    assert probe.wait_for(lambda p: "/held" in p.snapshot()[0], 30)
+
+    def shown() -> Any:
+        return probe.snapshot()[0]["/held"]
+
+    with viser_private.held_back(client) as held:
+        assert held is not None, WRITTEN_FOR
+        node.position = (1.0, 2.0, 3.0)
+        other = threading.Thread(target=lambda: setattr(node, "wxyz", (0.0, 1.0, 0.0, 0.0)))
+        other.start()
+        other.join()
+    assert [type(m).__name__ for m in held] == ["SetPositionMessage"], WRITTEN_FOR
+    assert tuple(node.position) == (1.0, 2.0, 3.0)
+    assert "queue_message" not in vars(client._websock_connection)
+    assert probe.wait_for(lambda p: shown().wxyz == (0.0, 1.0, 0.0, 0.0), 30)
+    assert shown().position == (0.0, 0.0, 0.0)
+    viser_private.queue_held(client, held)
+    assert probe.wait_for(lambda p: shown().position == (1.0, 2.0, 3.0), 30)
+    with viser_private.held_back(client) as outer, viser_private.held_back(client) as inner:
+        assert outer is not None and inner is None  # one holder at a time: the inner sends
 
 
 class _Walked(collections.deque):

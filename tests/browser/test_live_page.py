@@ -20,7 +20,7 @@ from poinsot.app.devtools.probe import Probe
 from poinsot.app.live.classroom import links
 from poinsot.app.model.elements import Element
 from poinsot.app.model.presets import DEFAULT_PRESET, preset_by_key
-from tests.app.test_follow import _lead, _ready
+from tests.app.test_follow import _lead, _ready, _set
 
 pytestmark = pytest.mark.browser
 
@@ -38,6 +38,13 @@ def amber_fraction(rgb: np.ndarray) -> float:
     hue = hsv[:, 0] * 360.0
     amber = (hue > 22) & (hue < 45) & (hsv[:, 1] > 0.3) & (hsv[:, 2] > 0.18)
     return float(np.sum(amber)) / len(small)
+
+
+#: The ellipsoid's scale in viser's client (its scene tree, as the page holds it).
+ELLIPSOID_SCALE_JS = """() => {
+  const node = window.__viserSceneTree.getState()['/space/body/ellipsoid'];
+  return node ? node.message.props.scale : null;
+}"""
 
 
 def canvas_pixels(page) -> np.ndarray:
@@ -262,6 +269,18 @@ def test_a_follower_s_body_turns_in_the_browser(shared):
         after = canvas_pixels(page)
         changed = np.mean(np.any(np.abs(after.astype(int) - before) > 24, axis=2))
         assert changed > 0.01, f"only {changed:.4f} of the view changed"
+        # The lecturer's move: the follower's new body goes to its browser through the cast
+        # (held back from its own queue, encoded once for the process's followers): the page's
+        # ellipsoid takes the size the session gave it.
+        mesh = session.scene.drawing(Element.ELLIPSOID).mesh
+        old_scale, fits = tuple(mesh.scale), cast.fits
+        _set(lead, "I₂", 1.7)
+        assert wait_until(lambda: cast.fits > fits and tuple(mesh.scale) != old_scale, 30)
+        new_scale = np.array(mesh.scale)
+        shown = lambda: page.page.evaluate(ELLIPSOID_SCALE_JS)  # noqa: E731
+        assert wait_until(lambda: np.allclose(shown() or (0, 0, 0), new_scale, atol=1e-6), 30), (
+            f"the page shows {shown()}, the session {new_scale} (was {old_scale})"
+        )
         assert page.errors == [] and session.stats.errors == 0, session.stats.last_error
     finally:
         lead.close()

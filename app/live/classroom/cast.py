@@ -19,6 +19,19 @@ node of that id only; a copy is the one msgpack with the id spliced in, then com
   :func:`own_fps`: the traces (its own history of the motion), the labels laid out for its own
   camera, the ω plot and the time readout (widgets of its own page). The pose is then left out
   of its frames (``PoinsotScene.send_pose``).
+- The lead's new body is made once per process too. Every follower rebuilds it, but the first
+  of the cast to open it makes it (:meth:`FollowCast.claim_move`: the others wait for it, at
+  most :data:`MAKER_WAIT`), and what its drawings' fit queues (the body's sizes and static
+  curves: about a dozen node updates) is held back from its own queue and handed, encoded
+  once, to it and to every follower whose browser still shows the body it showed
+  (:meth:`FollowCast.share_fit`); those are posed from the new motion at once, and their own
+  fits to the same body send nothing. The hall sees the lead's move once one follower has
+  made it, not once the last has; each follower's own rebuild then sends only what is its own
+  (its sliders, traces, readouts). A member's :attr:`Member.geometry` says which body its
+  browser was last sent (by the cast or its session), so that a share never takes a follower
+  back to an older body, and every fit of a follower's goes through the cast's path, in the
+  order handed. Only node updates are shared, to followers drawing the same elements on the
+  same nodes; a fit that makes or removes a node is its follower's own, sent as ever.
 - The lead's new body or scene is a rebuild in every follower: the cast then holds its frames
   (:meth:`FollowCast.hold`) until every follower it poses has rebuilt (poses another motion)
   or :data:`MOVE_HOLD` has passed, so that the rebuilds have the interpreter to themselves
@@ -32,26 +45,30 @@ node of that id only; a copy is the one msgpack with the id spliced in, then com
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import logging
 import threading
 import time
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Iterator
 from typing import Any
 
 import numpy as np
 import viser
 
-from poinsot.app.construction.construction import PoinsotScene
+from poinsot.app.construction.construction import PoinsotScene, no_fitting
 from poinsot.app.construction.sampled.motion import Motion
 from poinsot.app.live.hardening.pacing import MAX_UNACKED, Outbox, Pacer, next_due
+from poinsot.app.model.elements import Element
 from poinsot.app.viser_private import (
     OwnedWindow,
     WindowSocket,
     client_owner,
+    held_back,
     orientation_message,
     position_message,
     props_message,
+    queue_held,
     send_each,
 )
 
@@ -72,6 +89,21 @@ CHECK_TICKS = 8
 #: The longest the cast holds its frames after the lead's new body or scene [s]
 #: (:meth:`FollowCast.hold`).
 MOVE_HOLD = 1.0
+#: The messages a follower's fit to a new body may hand to the others (node updates).
+FIT_MESSAGES = frozenset({"SceneNodeUpdateMessage", "SetPositionMessage", "SetOrientationMessage"})
+#: The longest a follower's own fit waits for the windows already handed to its socket [s].
+FIT_WAIT = 0.5
+#: The longest a follower waits for another to make the new body it is about to fit [s].
+MAKER_WAIT = 0.25
+
+
+def _nothing() -> None:
+    pass
+
+
+def updates_only(messages: list[Any]) -> bool:
+    """Whether ``messages`` only update existing nodes (no node made or removed)."""
+    return all(type(m).__name__ in FIT_MESSAGES for m in messages)
 
 
 def own_fps(members: int) -> float:
@@ -82,12 +114,13 @@ def own_fps(members: int) -> float:
 @dataclasses.dataclass(frozen=True)
 class Source:
     """What a follower's frame is drawn from: ``motion``, posing the nodes ``body``, ``tip``
-    and ``arrow`` (None: no ω arrow drawn)."""
+    and ``arrow`` (None: no ω arrow drawn), in a scene that draws ``elements``."""
 
     motion: Motion
     body: str
     tip: str
     arrow: str | None
+    elements: frozenset[Element] = frozenset()
 
     @classmethod
     def of(cls, scene: PoinsotScene) -> Source | None:
@@ -95,7 +128,13 @@ class Source:
         motion = scene.motion
         if motion is None:
             return None
-        return cls(motion, *scene.pose_nodes())
+        body, tip, arrow = scene.pose_nodes()
+        return cls(motion, body, tip, arrow, scene.elements)
+
+    @property
+    def layout(self) -> Hashable:
+        """Followers with the same layout fit a body to the same nodes."""
+        return (self.body, self.tip, self.arrow, self.elements)
 
     @property
     def key(self) -> Hashable:
@@ -128,6 +167,9 @@ class Member:
         self.outbox = Outbox(client)
         self.source: Source | None = None
         self.shown: tuple[Hashable, int] | None = None
+        #: The body (its motion's geometry) its browser was last sent, by its session or the
+        #: cast (None: not known; it is then sent no other follower's).
+        self.geometry: Any = None
         self.skipped = 0
         self._behind, self._looked = False, -CHECK_TICKS  # its socket's backlog, as last read
 
@@ -161,6 +203,12 @@ class FollowCast:
         self.ticks = 0
         #: Frames not sent while a move was held (:meth:`hold`).
         self.held = 0
+        #: New bodies handed from one follower to others, and the copies handed.
+        self.fits = 0
+        self.fit_copies = 0
+        #: The lead's last move: set once its maker has rebuilt, and its maker.
+        self._move: tuple[threading.Event, Member | None] = (threading.Event(), None)
+        self._move[0].set()
         self._hold: tuple[float, list[Motion]] | None = None  # until when, the old motions
         self._error = ""
 
@@ -196,6 +244,7 @@ class FollowCast:
         motion it poses now (each has rebuilt, or left), or :data:`MOVE_HOLD` has passed."""
         with self._lock:
             old = {id(m.source.motion): m.source.motion for m in self._members.values() if m.source}
+            self._move = (threading.Event(), None)  # its maker: the first member to rebuild
         if old:
             self._hold = (time.monotonic() + MOVE_HOLD, list(old.values()))
 
@@ -236,11 +285,75 @@ class FollowCast:
             if ready:
                 window = OwnedWindow(source.messages(k))
                 encoded += 1
-                self.handed += send_each([(m.socket, window.bytes_for(m.owner)) for m in ready])
+                sends = [(m.socket, window.bytes_for(m.owner)) for m in ready]
+                with self._lock:  # a socket's windows are counted as a fit waits for them
+                    self.handed += send_each(sends)
                 for member in ready:
                     member.shown = (key, k)
         self.encoded += encoded
         return encoded
+
+    # -- a new body, handed from the first follower to fit it ------------------------------
+    def claim_move(self, member: Member) -> Callable[[], None]:
+        """``member``'s session is about to open the lead's new body or scene (its thread).
+        The first member to do so after the lead's move (:meth:`hold`) *makes* it: the others
+        wait for it here (at most :data:`MAKER_WAIT`), so that it has the interpreter to
+        itself and the new body it hands them (:meth:`share_fit`) reaches them before they
+        make their own. Returns what to call once its work is over."""
+        with self._lock:
+            made, maker = self._move
+            if maker is None:
+                self._move = (made, member)
+                return made.set
+        if maker is not member:
+            made.wait(MAKER_WAIT)
+        return _nothing
+
+    def fitting(self, member: Member, geometry: Any) -> Any:
+        """``member``'s session begins to fit its drawings to ``geometry`` (its thread):
+        returns the body its browser was sent before (None: not known)."""
+        with self._lock:
+            before, member.geometry = member.geometry, geometry
+        return before
+
+    def forget_geometry(self, member: Member) -> None:
+        """Its fit failed half-way: which body its browser shows is not known."""
+        with self._lock:
+            member.geometry = None
+
+    def share_fit(self, sender: Member, before: Any, motion: Motion, messages: list[Any]) -> bool:
+        """``sender`` fitted its drawings to ``motion``'s body, holding back ``messages``: hand
+        them as one window, encoded once, each its copy, to ``sender`` and to every other
+        member whose browser was last sent ``before`` too (the same updates take it to the
+        same body) on the same nodes, and pose those from ``motion`` from now on (their
+        sessions' rebuilds follow). One path for all of them: every window a socket is handed
+        is written in the order handed. False (nothing handed) if ``messages`` are not all
+        node updates."""
+        source = sender.source
+        if source is None or not messages or not updates_only(messages):
+            return False
+        geometry, layout = motion.geometry, source.layout
+        with self._lock:  # handed in the order the members' geometries change
+            targets = [
+                m
+                for m in self._members.values()
+                if m is not sender
+                and before is not None
+                and before is not geometry
+                and m.geometry is before
+                and m.source is not None
+                and m.source.layout == layout
+            ]
+            for member in targets:
+                member.geometry = geometry
+                if member.source is not None:
+                    member.source = dataclasses.replace(member.source, motion=motion)
+            window = OwnedWindow(messages)
+            members = [sender, *targets]
+            send_each([(m.socket, window.bytes_for(m.owner)) for m in members])
+            self.fits += 1
+            self.fit_copies += len(targets)
+        return True
 
     def _ready(self, member: Member) -> bool:
         if member.ready(self.ticks):
@@ -284,6 +397,7 @@ class SharedFrames:
         #: Makes its frame loop's next frame due at once (set once the loop exists).
         self.draw_now: Callable[[], None] = lambda: None
         self.member: Member | None = None
+        self._made: Callable[[], None] | None = None  # called once its move is made
 
     @property
     def shared(self) -> bool:
@@ -299,7 +413,9 @@ class SharedFrames:
             member = self.member = self.cast.join(id(self), self.client)
             if member is None:  # its socket cannot be reached: its own frames, as ever
                 return
+            member.geometry = source.motion.geometry  # what its browser shows now
             self.scene.send_pose = False
+            self.scene.fitting = self._fitting
         self.pacer.cap = own_fps(self.cast.members)
         member.source = source
 
@@ -310,5 +426,49 @@ class SharedFrames:
         self.cast.leave(id(self))
         self.member = None
         self.scene.send_pose = True
+        self.scene.fitting = no_fitting
         self.pacer.cap = None
         self.draw_now()
+
+    @contextlib.contextmanager
+    def _fitting(self, motion: Motion) -> Iterator[None]:
+        """The scene's fit to ``motion``'s body (its :attr:`~PoinsotScene.fitting`): what it
+        queues is held back, and sent through the cast, to this follower and to the followers
+        still showing the body this one showed (:meth:`FollowCast.share_fit`); dropped if the
+        cast has sent it this body already."""
+        member = self.member
+        if member is None:
+            yield
+            return
+        geometry = motion.geometry
+        before = self.cast.fitting(member, geometry)
+        with held_back(self.client) as messages:
+            try:
+                yield
+            except BaseException:
+                self.cast.forget_geometry(member)
+                raise
+        if messages is None:  # sent as ever
+            return
+        if before is geometry and updates_only(messages) and not member.socket.failed:
+            return  # its browser has this body: the messages would only repeat it
+        if not self.cast.share_fit(member, before, motion, messages):
+            # Sent as ever, after every window handed to it, so that no share older than
+            # its own fit is written after it.
+            member.socket.wait_written(FIT_WAIT)
+            queue_held(self.client, messages)
+
+    def moving(self) -> None:
+        """The lead's new body or scene is about to be opened (its frame thread): the first
+        follower of the cast to open it makes it, the others wait for it here
+        (:meth:`FollowCast.claim_move`); :meth:`worked` after its work."""
+        member = self.member
+        if member is not None and self._made is None:
+            self._made = self.cast.claim_move(member)
+
+    def worked(self) -> None:
+        """The session's work before its frame is done (its rebuild included): if it made the
+        lead's new body, the followers waiting for it go on."""
+        made, self._made = self._made, None
+        if made is not None:
+            made()

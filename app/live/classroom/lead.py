@@ -82,13 +82,16 @@ class LeadSession(links.LinkState, Protocol):
 
 class Mirror(Protocol):
     """What a follower changes on its frame thread to show the lead's state: its playback's
-    speed range and trail, the panel's playback and show/hide rows, the motion's grid."""
+    speed range and trail, the panel's playback and show/hide rows, the motion's grid; and
+    :meth:`moving` before it opens the lead's new body or scene (the first follower of the
+    process makes it, the others wait for it: :mod:`.cast`)."""
 
     @property
     def speed_range(self) -> tuple[float, float]: ...
     def set_trail(self, points: int) -> None: ...
     def show_playback(self, speed: float, paused: bool, trail: int) -> None: ...
     def show_visibility(self, visible: Callable[[Element], bool]) -> None: ...
+    def moving(self) -> None: ...
     def regrid(self) -> None: ...
 
 
@@ -221,6 +224,7 @@ class LeadControls:
             return
         if state.query != self._applied_query:
             self._applied_query = state.query
+            self.mirror.moving()
             self._open(state.query)
         clock = session.clock
         if clock.paused != state.paused:

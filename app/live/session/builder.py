@@ -184,6 +184,7 @@ def _frame_thread(
         report=front.status.report,
     )
     front.wake, frames.shared.draw_now = loop.wake, loop.draw_now
+    front.moving = frames.shared.moving
     return Core(
         client=client,
         front=front,

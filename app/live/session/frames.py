@@ -79,12 +79,15 @@ class FrameWork:
         """Before each frame: the queued actions, then a rebuild if they asked for one (none
         once the client has left: what they would send goes to nobody)."""
         outbox = self.pacer.outbox
-        if outbox.closed():
-            return
-        with outbox.quiet_if_left():
-            self._drain()
-            if self.build.dirty:
-                self._rebuild()
+        try:
+            if outbox.closed():
+                return
+            with outbox.quiet_if_left():
+                self._drain()
+                if self.build.dirty:
+                    self._rebuild()
+        finally:
+            self.shared.worked()  # a follower that made the lead's new body: the others go on
         self.shared.update(self._shared_source())
 
     def _rebuild(self) -> None:

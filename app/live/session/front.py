@@ -79,6 +79,9 @@ class Front:
         self.queue = queue
         #: Wakes the frame thread (set once the session's frame loop exists).
         self.wake: Callable[[], None] = lambda: None
+        #: A follower is about to open the lead's new body or scene (set by the builder:
+        #: :meth:`~..classroom.cast.SharedFrames.moving`).
+        self.moving: Callable[[], None] = lambda: None
         #: The camera view chosen (the lecture tools', once mounted).
         self.camera_of: Callable[[], str] = lambda: "default"
         #: Run on the frame thread after a preset, or a scene, is shown (the layout reframes
@@ -251,6 +254,10 @@ class FollowerMirror:
 
     def show_visibility(self, visible: Callable[[Element], bool]) -> None:
         self._front._parts()[1].show_visibility(visible)
+
+    def moving(self) -> None:
+        """The lead's new body or scene is about to be opened."""
+        self._front.moving()
 
     def regrid(self) -> None:
         """The clock's speed changed: the motion on the new grid."""
