@@ -273,18 +273,21 @@ class FollowFleet:
         return self._each("told", (words, timeout), which, timeout + 60.0, f"{words!r} told")
 
     def window(self, seconds: float, period: float, timeout: float) -> dict:
-        """Frames over ``seconds``; every ``period`` (0: never) a lead's move, lost if not
-        redrawn on a follower within ``timeout``. ``clients``: the client processes' CPU
+        """Frames over ``seconds``; every ``period`` from the start (0: never) a lead's move,
+        lost if not redrawn on a follower within ``timeout`` (the next move waits for it, and
+        is made at once if it is due). ``clients``: the client processes' CPU
         [cores]; ``redraws``: per move, each follower's seconds to its redraw (None: lost)."""
         first = self._all(("count",), 60.0, "the poses counted")
         start = time.perf_counter()
+        end = due = start + seconds
         redraws: list[list[float | None]] = []
-        while time.perf_counter() < start + seconds:
-            if period > 0:
+        while time.perf_counter() < end:
+            if period > 0:  # a move every period from the start (at once if one was late)
                 self.arm()
                 sent = self.move(SLIDER_VALUES[(len(redraws) + 1) % 2])
                 redraws.append(self.redraws(sent, timeout))
-            time.sleep(max(0.0, min(period or seconds, start + seconds - time.perf_counter())))
+                due = start + len(redraws) * period
+            time.sleep(max(0.0, min(due, end) - time.perf_counter()))
         last = self._all(("count",), 60.0, "the poses counted")
         fps: list[float] = []
         cpu = 0.0
