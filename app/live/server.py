@@ -30,7 +30,9 @@ from poinsot.app.model import docs_site
 from poinsot.app.model.presets import DEFAULT_PRESET, Preset
 from poinsot.app.viser_private import (
     handshake_origin,
+    message_buffer,
     page_address,
+    quiet_if_closed,
     senders_woken_on_their_loop,
 )
 
@@ -38,6 +40,20 @@ log = logging.getLogger(__name__)
 
 #: Seconds a new page has to say its address (its link) before it opens the default scene.
 PAGE_TIMEOUT = 10.0
+
+
+def built_session(
+    client: viser.ClientHandle, link: links.Opening, options: SessionOptions
+) -> Session:
+    """The session of ``client`` showing ``link`` (not started). A browser may leave while its
+    session is built (30-300 ms): what the build sends it then goes to nobody, and is dropped
+    without viser's warning of a write to a closed connection (the session is then closed,
+    never started: :meth:`PoinsotApp._connect`)."""
+    buffer = message_buffer(client)
+    with quiet_if_closed(buffer) if buffer is not None else contextlib.nullcontext():
+        session = Session(client, link.preset, options)
+        links.apply(session, link)
+    return session
 
 
 def guide_page(path: str) -> Response | None:
@@ -197,8 +213,7 @@ class PoinsotApp:
             user_agent=self.guard.user_agent(client.client_id),
             follow=self.follow,
         )
-        session = Session(client, link.preset, options)
-        links.apply(session, link)
+        session = built_session(client, link, options)
         with self._connected:
             if self._stopping.is_set():
                 left = True

@@ -7,16 +7,20 @@ from __future__ import annotations
 import random
 import re
 import time
+import warnings
 
 import numpy as np
 import pytest
 from conftest import after_frames, record_frame_times, session_of, wait_until
 from test_scene_geometry import check_finite
 
+from poinsot.app import viser_private
 from poinsot.app.construction.trail import CHUNK_SEGMENTS
+from poinsot.app.live.classroom import links
 from poinsot.app.live.lecture.display import LABEL_MIN_FRAMES
 from poinsot.app.live.panel.panel import ELEMENT_LABELS
-from poinsot.app.live.session.session import MAX_FPS, STEP_SECONDS
+from poinsot.app.live.server import built_session
+from poinsot.app.live.session.session import MAX_FPS, STEP_SECONDS, Session, SessionOptions
 from poinsot.app.model.elements import Control, Element, Plot
 from poinsot.app.model.parameters import Parameters
 from poinsot.app.model.presets import CUSTOM, DEFAULT_PRESET, PRESETS, preset_by_key
@@ -542,3 +546,24 @@ def test_a_session_still_being_built_when_the_server_stops_logs_no_error(
     errors = [r for r in caplog.records if r.levelno >= logging.ERROR]
     assert errors == [], [r.getMessage() for r in errors]
     assert app.sessions() == {}
+
+
+def _closed_connection(caught: list[warnings.WarningMessage]) -> list[str]:
+    return [str(w.message) for w in caught if "closed connection" in str(w.message)]
+
+
+def test_a_session_built_for_a_browser_that_left_meanwhile_warns_of_nothing(poinsot_app, probe):
+    """A browser may leave while its session is built: what the build sends then goes to
+    nobody, silently. Built as viser's own, it would warn (once a connection) of a write to a
+    closed connection: the test's own check that the client had left."""
+    client = session_of(poinsot_app).client
+    buffer = viser_private.message_buffer(client)
+    probe.close()
+    assert wait_until(lambda: viser_private.closed(buffer) and not poinsot_app.sessions(), 30)
+    link = links.opening(None, DEFAULT_PRESET, None)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        built_session(client, link, SessionOptions(follow=poinsot_app.follow)).close()
+        assert _closed_connection(caught) == []
+        Session(client, link.preset, SessionOptions(follow=poinsot_app.follow)).close()
+        assert len(_closed_connection(caught)) == 1
