@@ -35,6 +35,9 @@ Inventory (section, private name, what it is used for):
   - ``handle._impl.uuid``: a widget's wire id (:func:`handle_id`).
   - ``GuiApi._current_file_upload_states`` (transfer id -> state dict): the uploads in
     progress, which the upload cap drops early (:func:`upload_states`).
+  - ``GuiApi._websock_interface``'s queue: writes to a departed client's widgets dropped
+    without viser's warning (:func:`gui_quiet_if_closed`: the sliders a session mirrored,
+    written on viser's loop after its browser left).
   - ``GuiApi._event_loop``: the loop a client's GUI runs its callbacks on, for a caller that
     holds the GUI and not the server (:func:`gui_event_loop`; it is the loop of the public
     :meth:`viser.ViserServer.get_event_loop`).
@@ -307,6 +310,17 @@ def upload_states(gui: viser.GuiApi) -> dict[str, Any]:
     ``client_id``, ``total_bytes``, ``transferred_bytes`` and ``parts``)."""
     states: dict[str, Any] = gui._current_file_upload_states
     return states
+
+
+def gui_quiet_if_closed(gui: viser.GuiApi) -> contextlib.AbstractContextManager[None]:
+    """Writes to the GUI's widgets within this block, if its client has left meanwhile, are
+    dropped without viser's warning (``GuiApi._websock_interface``'s queue:
+    :func:`quiet_if_closed`); nothing changes if viser's names moved."""
+    getter = getattr(getattr(gui, "_websock_interface", None), "get_message_buffer", None)
+    buffer = getter() if getter is not None else None
+    if not hasattr(buffer, "sanctioned_dead_writes"):
+        return contextlib.nullcontext()
+    return quiet_if_closed(buffer)
 
 
 def gui_event_loop(gui: viser.GuiApi) -> asyncio.AbstractEventLoop:

@@ -21,6 +21,7 @@ from poinsot.app.live.classroom import links
 from poinsot.app.live.classroom.follow import ENDED, MAX_WRONG_CODES, FollowHub, LeadState
 from poinsot.app.live.classroom.lead import HELD
 from poinsot.app.live.panel.body_controls import run_writes
+from poinsot.app.live.panel.widgets import on_loop
 from poinsot.app.live.relay import Relay
 from poinsot.app.model.elements import Element
 from poinsot.app.viser_private import wire_message
@@ -321,6 +322,21 @@ def test_a_follower_mirrors_a_move_into_its_sliders_in_one_wake_of_its_loop(
         assert 2 <= len(mirrors) <= rebuilds, (name, rebuilds, calls[name])
         alone = [c for c in calls[name] if "_mirror" in getattr(c, "__qualname__", "")]
         assert alone == [], alone  # never a slider on its own
+
+
+def test_a_write_for_a_stopped_server_s_loop_goes_to_nobody():
+    """A session's frame thread may still rebuild while its server stops (a test's teardown,
+    Ctrl-C): the writes it hands viser's loop (its sliders mirrored, a value shown) go to
+    nobody once the loop is closed, instead of raising into the frame thread, which reported
+    "Event loop is closed" as an internal error, with its traceback in the server's log."""
+    loop = asyncio.new_event_loop()
+    ran: list[int] = []
+    assert on_loop(loop, ran.append, 1)
+    loop.run_until_complete(asyncio.sleep(0))
+    assert ran == [1]
+    loop.close()
+    assert not on_loop(loop, ran.append, 2)
+    assert ran == [1]
 
 
 def test_followers_share_one_build_of_the_lead_s_scene(poinsot_app, make_probe):

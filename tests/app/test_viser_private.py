@@ -11,6 +11,7 @@ import collections
 import dataclasses
 import inspect
 import threading
+import warnings
 from typing import Any
 
 import pytest
@@ -197,6 +198,23 @@ def test_what_a_thread_queues_to_a_client_can_be_held_back_and_sent_after_all(po
     assert probe.wait_for(lambda p: shown().position == (1.0, 2.0, 3.0), 30)
     with viser_private.held_back(client) as outer, viser_private.held_back(client) as inner:
         assert outer is not None and inner is None  # one holder at a time: the inner sends
+
+
+def test_a_departed_client_s_widgets_are_written_quietly_within_the_gui_s_scope(poinsot_app, probe):
+    """Within :func:`gui_quiet_if_closed` a write to the widget of a client that has left is
+    dropped without viser's warning; outside it, viser warns (once a connection)."""
+    client = session_of(poinsot_app).client
+    slider = client.gui.add_slider("pinned", 0.0, 1.0, 0.1, 0.5)
+    buffer = viser_private.message_buffer(client)
+    probe.close()
+    assert wait_until(lambda: viser_private.closed(buffer) and not poinsot_app.sessions(), 30)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with viser_private.gui_quiet_if_closed(client.gui):
+            slider.value = 0.25
+        assert [w for w in caught if "closed connection" in str(w.message)] == [], WRITTEN_FOR
+        slider.value = 0.75
+        assert [w for w in caught if "closed connection" in str(w.message)], WRITTEN_FOR
 
 
 class _Walked(collections.deque):

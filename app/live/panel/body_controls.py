@@ -18,11 +18,13 @@ from typing import Any
 
 import viser
 
+from poinsot.app import viser_private as private
 from poinsot.app.live.panel.widgets import (
     Pressed,
     Removable,
     Sent,
     Widgets,
+    on_loop,
     set_marks,
     set_value,
 )
@@ -186,7 +188,7 @@ class BodyControls:
                 w.omega_norm.min, w.omega_norm.max = lo, hi
             writes.append(self._mirror("omega", w.omega_norm, float(params.omega_norm)))
         if writes:
-            self._loop.call_soon_threadsafe(run_writes, writes)
+            on_loop(self._loop, run_writes, writes, self.gui)
 
     # -- a slider moved in the browser, and the body shown ----------------------------------
     def _edit(self, key: str, sent: Sent, change: Callable[[Parameters], Parameters]) -> None:
@@ -232,7 +234,9 @@ class BodyControls:
         return write
 
 
-def run_writes(writes: list[Callable[[], None]]) -> None:
-    """On viser's event loop: the sliders' writes of one :meth:`BodyControls.show`, in order."""
-    for write in writes:
-        write()
+def run_writes(writes: list[Callable[[], None]], gui: viser.GuiApi) -> None:
+    """On viser's event loop: the sliders' writes of one :meth:`BodyControls.show`, in order
+    (to nobody, silently, if ``gui``'s browser left since they were handed over)."""
+    with private.gui_quiet_if_closed(gui):
+        for write in writes:
+            write()

@@ -187,7 +187,20 @@ def write_unless_newer(
         set_value(handle, value)
         sent.value = value
 
-    loop.call_soon_threadsafe(write)
+    on_loop(loop, write)
+
+
+def on_loop(loop: asyncio.AbstractEventLoop, callback: Callable[..., None], *args: Any) -> bool:
+    """Run ``callback(*args)`` on viser's event loop ``loop`` (from any thread); False, and
+    nothing run, if the loop is closed: the server stopped while a session's frame thread was
+    still at work (what the writes would send goes to nobody)."""
+    try:
+        loop.call_soon_threadsafe(callback, *args)
+    except RuntimeError:
+        if not loop.is_closed():
+            raise
+        return False
+    return True
 
 
 class Refused(ValueError):
