@@ -20,7 +20,7 @@ from poinsot.app.live.classroom import links
 from poinsot.app.live.lecture.display import LABEL_MIN_FRAMES
 from poinsot.app.live.panel.panel import ELEMENT_LABELS
 from poinsot.app.live.server import built_session
-from poinsot.app.live.session.session import MAX_FPS, STEP_SECONDS, Session, SessionOptions
+from poinsot.app.live.session.session import MAX_FPS, STEP_SECONDS, SessionOptions
 from poinsot.app.model.elements import Control, Element, Plot
 from poinsot.app.model.parameters import Parameters
 from poinsot.app.model.presets import CUSTOM, DEFAULT_PRESET, PRESETS, preset_by_key
@@ -554,8 +554,7 @@ def _closed_connection(caught: list[warnings.WarningMessage]) -> list[str]:
 
 def test_a_session_built_for_a_browser_that_left_meanwhile_warns_of_nothing(poinsot_app, probe):
     """A browser may leave while its session is built: what the build sends then goes to
-    nobody, silently. Built as viser's own, it would warn (once a connection) of a write to a
-    closed connection: the test's own check that the client had left."""
+    nobody, silently (viser would warn of a write to a closed connection)."""
     client = session_of(poinsot_app).client
     buffer = viser_private.message_buffer(client)
     probe.close()
@@ -564,6 +563,4 @@ def test_a_session_built_for_a_browser_that_left_meanwhile_warns_of_nothing(poin
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         built_session(client, link, SessionOptions(follow=poinsot_app.follow)).close()
-        assert _closed_connection(caught) == []
-        Session(client, link.preset, SessionOptions(follow=poinsot_app.follow)).close()
-        assert len(_closed_connection(caught)) == 1
+    assert _closed_connection(caught) == []
