@@ -241,7 +241,8 @@ class FollowCast:
 
     def hold(self) -> None:
         """The lead's body or scene changed (any thread): no frame until no member poses a
-        motion it poses now (each has rebuilt, or left), or :data:`MOVE_HOLD` has passed."""
+        motion it poses now (each has rebuilt, or left), or :data:`MOVE_HOLD` has passed; and
+        a new move begins, whose maker is the first member to open it (:meth:`claim_move`)."""
         with self._lock:
             old = {id(m.source.motion): m.source.motion for m in self._members.values() if m.source}
             self._move = (threading.Event(), None)  # its maker: the first member to rebuild
@@ -334,12 +335,12 @@ class FollowCast:
             return False
         geometry, layout = motion.geometry, source.layout
         with self._lock:  # handed in the order the members' geometries change
+            behind = before is not None and before is not geometry  # else only the sender's
             targets = [
                 m
                 for m in self._members.values()
-                if m is not sender
-                and before is not None
-                and before is not geometry
+                if behind
+                and m is not sender
                 and m.geometry is before
                 and m.source is not None
                 and m.source.layout == layout
