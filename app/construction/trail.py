@@ -5,7 +5,10 @@ cost O(trail length) bytes per frame. Instead the trail is a ring of small line-
 ("chunks"): each append only resends the head chunk (at most ``chunk`` segments), in one
 message unless the head fills; a full head is frozen and a new one started; the oldest chunks
 are dropped once the trail is longer than its length. Bytes per append are bounded by the chunk
-size; the length stays within one chunk below ``max_points``.
+size, or by the append's own size when it brings more than a chunk: what overflows the head is
+then sent as one chunk of its own, frozen at once (a follower of a lecture draws its traces a
+few times a second, a hundred points an append: one node, not four). The length stays within
+one chunk (or one such append) below ``max_points``.
 
 A dropped chunk is not removed but kept as a spare, shrunk to one point of the trail (hidden
 under it), and reused as the next head: a chunk's node is made once, and in the steady state
@@ -173,6 +176,9 @@ class Trail:
             if room == 0:
                 self._freeze_head()
                 continue
+            if self._n == 0 and total - start > self._chunk:  # more than a chunk: one node
+                self._add_frozen(np.stack([chain[start:total], chain[start + 1 :]], axis=1))
+                break
             take = min(room, total - start)
             rows = self._buffer[self._n : self._n + take]
             rows[:, 0] = chain[start : start + take]
@@ -185,21 +191,32 @@ class Trail:
 
     # -- internals -----------------------------------------------------------------------
     def _send_head(self) -> None:
-        if self._head is None and self._spare:
-            self._head = self._spare.pop()
-            self._head.points = self._buffer[: self._n]
-        elif self._head is None:
-            self._counter += 1
-            self._head = self._api.add_line_segments(
-                f"{self._current_layer().name}/c{self._counter}",
-                self._buffer[: self._n].copy(),  # the creation message keeps its array
-                self._color,
-                thickness=self._width,
-                thickness_units="screen",
-                scale=self._scale,
-            )
+        if self._head is None:  # the creation message keeps its array: a copy
+            self._head = self._chunk_showing(self._buffer[: self._n].copy())
         else:
             self._head.points = self._buffer[: self._n]  # a points update casts (copies)
+
+    def _add_frozen(self, segments: np.ndarray) -> None:
+        """A chunk of ``segments`` (K, 2, 3), K above the chunk size, sent and frozen at once."""
+        self._frozen.append((self._chunk_showing(segments), len(segments)))
+        self._frozen_segments += len(segments)
+
+    def _chunk_showing(self, segments: np.ndarray) -> viser.LineSegmentsHandle:
+        """A chunk's node drawing ``segments``: a spare's points updated if there is one (a
+        node is made once), else a node made."""
+        if self._spare:
+            handle = self._spare.pop()
+            handle.points = segments
+            return handle
+        self._counter += 1
+        return self._api.add_line_segments(
+            f"{self._current_layer().name}/c{self._counter}",
+            segments,
+            self._color,
+            thickness=self._width,
+            thickness_units="screen",
+            scale=self._scale,
+        )
 
     def _freeze_head(self) -> None:
         if self._head is not None:

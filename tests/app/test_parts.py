@@ -194,6 +194,7 @@ class FakeApi:
         self.frames: dict[str, FakeHandle] = {}
         self.sent_bytes = 0
         self.removed = 0
+        self.made = 0
 
     def add_frame(self, name, **kwargs):
         self.frames[name] = FakeHandle(self, name, np.zeros((0, 3)))
@@ -201,6 +202,7 @@ class FakeApi:
 
     def add_line_segments(self, name, points, color, **kwargs):
         self.live.add(name)
+        self.made += 1
         return FakeHandle(self, name, points)
 
     def shown(self) -> set[str]:
@@ -241,7 +243,9 @@ def test_a_cleared_trail_is_hidden_at_once_and_removed_a_few_chunks_an_append():
     api = FakeApi()
     trail = Trail(api, "/t", (255, 0, 0), 2.0, max_points=10_000, chunk=8)
     points = np.cumsum(np.ones((801, 3)), axis=0).astype(np.float32)
-    trail.append(points)
+    trail.append(points[:1])
+    for k in range(100):  # a chunk an append, as a live session's frames draw it
+        trail.append(points[1 + 8 * k : 9 + 8 * k])
     chunks = len(api.live)
     assert chunks == 100 and api.shown() == api.live
     removed = api.removed
@@ -264,6 +268,28 @@ def test_a_cleared_trail_is_hidden_at_once_and_removed_a_few_chunks_an_append():
     assert len(hidden) <= MAX_RETIRED and api.shown() == set()
     trail.remove()
     assert api.live == set()
+
+
+def test_a_follower_s_long_appends_make_one_node_each_then_none():
+    """A follower's few own frames a second append a hundred points each: what overflows the
+    head is one chunk (one node, not one per chunk size), and once the trail is full the
+    chunks it drops are reused: no node made, and the length within an append of its bound."""
+    api = FakeApi()
+    trail = Trail(api, "/t", (255, 0, 0), 2.0, max_points=1200, chunk=24)
+    points = np.cumsum(np.ones((1 + 90 * 60, 3)), axis=0).astype(np.float32)
+    trail.append(points[:1])
+    made = []
+    for k in range(60):
+        before = api.made
+        trail.append(points[1 + 90 * k : 91 + 90 * k])
+        made.append(api.made - before)
+        assert 1200 - 90 - 24 <= trail.segment_count <= 1200 or k < 14
+    assert max(made) == 1 and sum(made[30:]) == 0, made
+    assert api.removed == 0
+    drawn = trail.points()
+    assert np.array_equal(drawn, points[-len(drawn) :])  # contiguous, oldest first
+    segments = np.concatenate([h.points for h, _ in trail._frozen])
+    assert np.array_equal(segments[1:, 0], segments[:-1, 1])  # chunks join end to end
 
 
 def test_trail_appends_of_any_size_draw_one_unbroken_polyline():
