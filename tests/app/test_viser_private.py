@@ -209,13 +209,15 @@ def test_a_departed_client_s_widgets_are_written_quietly_within_the_gui_s_scope(
     buffer = viser_private.message_buffer(client)
     probe.close()
     assert wait_until(lambda: viser_private.closed(buffer) and not poinsot_app.sessions(), 30)
+    # The departed session's own last writes, in the same scope, may still be under way.
+    assert wait_until(lambda: buffer._sanctioned_dead_writes == 0, 30), WRITTEN_FOR
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         with viser_private.gui_quiet_if_closed(client.gui):
-            assert buffer._sanctioned_dead_writes == 1, WRITTEN_FOR
+            assert buffer._sanctioned_dead_writes >= 1, WRITTEN_FOR
             slider.value = 0.25
-        assert buffer._sanctioned_dead_writes == 0, WRITTEN_FOR
         assert [w for w in caught if "closed connection" in str(w.message)] == [], WRITTEN_FOR
+    assert wait_until(lambda: buffer._sanctioned_dead_writes == 0, 30), WRITTEN_FOR
 
 
 class _Walked(collections.deque):
