@@ -28,12 +28,7 @@ that queued it (``SceneApi._queue_scene_message``), and its client drops an upda
 a variant it does not show (``routeShadowedUpdate``). A client's own nodes are its id's, so a
 window for several clients differs in that id alone: :class:`OwnedWindow` serialises the
 messages once, with a marker for the owner, and makes each client's copy by splicing its id
-into that msgpack. A copy is framed as zstd without being compressed (:func:`zstd_stored`:
-stored blocks, which viser's client's decoder reads as any zstd frame): a compressor gives up
-the interpreter for each call, and the cast's thread, making 75 copies a frame while the
-followers' sessions rebuild after the lead's move, waited for it back each time (32 ticks a
-second where 40 were due, against 25 to 29 when each copy was compressed; a pose window is a few
-hundred bytes, which compression hardly shrinks).
+into that msgpack and compressing it (about 2 microseconds a copy against 20 for the window).
 
 ``tests/app/test_viser_private.py`` checks that a window encoded here decodes to what viser's own
 producer sends for the same messages, each client's copy with its own id.
@@ -83,36 +78,9 @@ def _inner(messages: Sequence[Any]) -> tuple[bytes, list[memoryview]]:
     return inner, binary_buffers
 
 
-#: A zstd frame's magic number, and the largest block a frame may hold [bytes].
-ZSTD_MAGIC = (0xFD2FB528).to_bytes(4, "little")
-ZSTD_MAX_BLOCK = 128 * 1024
-
-
-def zstd_stored(data: bytes) -> bytes:
-    """``data`` as one zstd frame of raw blocks (RFC 8878: a single-segment frame whose blocks
-    are stored, not compressed): what any zstd decoder reads back as ``data``, made without
-    compressing, and so without giving up the interpreter to a compressor."""
-    n = len(data)
-    if n < 256:  # Frame_Content_Size_flag 0 (one byte) with Single_Segment_flag
-        header = b"\x20" + n.to_bytes(1, "little")
-    elif n < 65536 + 256:
-        header = b"\x60" + (n - 256).to_bytes(2, "little")
-    elif n < 1 << 32:
-        header = b"\xa0" + n.to_bytes(4, "little")
-    else:
-        header = b"\xe0" + n.to_bytes(8, "little")
-    parts = [ZSTD_MAGIC, header]
-    for start in range(0, max(n, 1), ZSTD_MAX_BLOCK):
-        block = data[start : start + ZSTD_MAX_BLOCK]
-        last = start + ZSTD_MAX_BLOCK >= n
-        parts += [(len(block) << 3 | last).to_bytes(3, "little"), block]  # Block_Type 0: raw
-    return b"".join(parts)
-
-
-def _framed(inner: bytes, binary_buffers: Sequence[memoryview], stored: bool = False) -> bytes:
-    """The bytes of a window: its msgpack's sizes, the msgpack compressed (or ``stored``: framed
-    as zstd, not compressed), its buffers."""
-    compressed = zstd_stored(inner) if stored else _compressor().compress(inner)
+def _framed(inner: bytes, binary_buffers: Sequence[memoryview]) -> bytes:
+    """The bytes of a window: its msgpack's sizes, the msgpack compressed, its buffers."""
+    compressed = _compressor().compress(inner)
     parts: list[bytes | memoryview] = [
         len(inner).to_bytes(8, "little"),
         len(compressed).to_bytes(8, "little"),
@@ -153,7 +121,7 @@ class OwnedWindow:
             for message in self._messages:
                 message.owner = owner
             return encode_window(self._messages)
-        return _framed(msgspec.msgpack.encode(owner).join(self._pieces), self._buffers, True)
+        return _framed(msgspec.msgpack.encode(owner).join(self._pieces), self._buffers)
 
 
 class WindowSocket:

@@ -452,26 +452,6 @@ def test_a_window_for_many_clients_is_each_one_s_window_of_its_own_nodes():
         assert ours[-points.nbytes :] == points.tobytes()
 
 
-@pytest.mark.parametrize("size", [0, 1, 255, 256, 65791, 65792, 128 * 1024, 300_001])
-def test_a_stored_zstd_frame_reads_back_as_its_data_in_a_zstd_decoder(size):
-    """Each follower's copy of a window is framed as zstd without compressing (the copy is
-    made on the cast's thread 75 times a frame; a compressor gives up the interpreter each
-    time): a frame any decoder reads, for every size of its header's content-size field and
-    past one block."""
-    import numpy as np
-    import zstandard
-
-    from poinsot.app.viser_private.window import ZSTD_MAX_BLOCK, zstd_stored
-
-    data = np.random.default_rng(size).integers(0, 256, size, dtype=np.uint8).tobytes()
-    frame = zstd_stored(data)
-    assert zstandard.ZstdDecompressor().decompress(frame) == data
-    params = zstandard.get_frame_parameters(frame)
-    assert params.content_size == size and not params.has_checksum
-    blocks = max(1, -(-size // ZSTD_MAX_BLOCK))
-    assert len(frame) - size <= 4 + 9 + 3 * blocks
-
-
 def test_the_cast_of_a_property_is_viser_s_own_for_every_hint_of_its_nodes_and_widgets():
     """The patched cast (its array hints made once) gives what viser's own gives, for each
     property hint of viser's scene nodes and widgets and values of every kind a caller sets."""
