@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 import viser
-from conftest import record_messages, session_of, wait_until
+from conftest import after_frames, record_messages, session_of, wait_until
 
 from poinsot.app.construction.construction import TRAIL_EVERY, PoinsotScene
 from poinsot.app.construction.labels import layout as labels
@@ -149,6 +149,9 @@ def test_a_frame_carries_at_most_one_of_traces_plot_and_a_layout_step(make_app, 
     app = make_app(max_fps=MAX_FPS)
     make_probe(app)
     session = session_of(app)
+    # Counted from its 30th frame on: its first frames restart the traces (sent at once, out of
+    # their cadence) while its first layout is taken, and a plot could wait a frame more.
+    after_frames(session, 30)
     display, motion = session.lecture.display, session.panel.motion
     frames: list[set[str]] = []
     current: set[str] = set()
