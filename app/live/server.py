@@ -49,8 +49,7 @@ def built_session(
     session is built (30-300 ms): what the build sends it then goes to nobody, and is dropped
     without viser's warning of a write to a closed connection (the session is then closed,
     never started: :meth:`PoinsotApp._connect`)."""
-    buffer = message_buffer(client)
-    with quiet_if_closed(buffer) if buffer is not None else contextlib.nullcontext():
+    with quiet_if_closed(message_buffer(client)):
         session = Session(client, link.preset, options)
         links.apply(session, link)
     return session

@@ -154,6 +154,7 @@ from poinsot.app.viser_private.transport import (
     broadcasts_woken_on_their_loop,
     closed,
     connection_of,
+    gui_message_buffer,
     held_back,
     last_queued,
     last_taken,
@@ -314,13 +315,8 @@ def upload_states(gui: viser.GuiApi) -> dict[str, Any]:
 
 def gui_quiet_if_closed(gui: viser.GuiApi) -> contextlib.AbstractContextManager[None]:
     """Writes to the GUI's widgets within this block, if its client has left meanwhile, are
-    dropped without viser's warning (``GuiApi._websock_interface``'s queue:
-    :func:`quiet_if_closed`); nothing changes if viser's names moved."""
-    getter = getattr(getattr(gui, "_websock_interface", None), "get_message_buffer", None)
-    buffer = getter() if getter is not None else None
-    if not hasattr(buffer, "sanctioned_dead_writes"):
-        return contextlib.nullcontext()
-    return quiet_if_closed(buffer)
+    dropped without viser's warning (:func:`quiet_if_closed` on its client's queue)."""
+    return quiet_if_closed(gui_message_buffer(gui))
 
 
 def gui_event_loop(gui: viser.GuiApi) -> asyncio.AbstractEventLoop:

@@ -1,7 +1,8 @@
 """One client's send queue and socket in viser 1.1.x: part of the one adapter to viser's
 private names (:mod:`poinsot.app.viser_private`, whose docstring has the inventory).
 
-- :func:`message_buffer`: ``ClientHandle._websock_connection.get_message_buffer()``, the
+- :func:`message_buffer`: ``ClientHandle._websock_connection.get_message_buffer()`` (and
+  :func:`gui_message_buffer`: ``GuiApi._websock_interface``'s, the same connection), the
   client's queue, with its ``message_counter`` (next id), ``generator_cursors`` (client id ->
   the last id its sender took), ``message_from_id`` (the messages still queued), ``done``
   (set once the client has left: a message pushed then is never sent, and viser warns) and
@@ -42,7 +43,16 @@ BUFFER_FIELDS = (
 
 def message_buffer(client: viser.ClientHandle) -> Any:
     """viser 1.1 keeps the queue on the client's connection; None if that ever changes."""
-    connection = getattr(client, "_websock_connection", None)
+    return _buffer_of(getattr(client, "_websock_connection", None))
+
+
+def gui_message_buffer(gui: viser.GuiApi) -> Any:
+    """The queue of the client whose GUI is ``gui`` (``GuiApi._websock_interface``, the same
+    connection), or None."""
+    return _buffer_of(getattr(gui, "_websock_interface", None))
+
+
+def _buffer_of(connection: Any) -> Any:
     getter = getattr(connection, "get_message_buffer", None)
     if getter is None:
         return None
@@ -83,8 +93,9 @@ def closed(buffer: Any) -> bool:
 
 def quiet_if_closed(buffer: Any) -> AbstractContextManager[None]:
     """Pushes to ``buffer`` within this block, if its client has left meanwhile, are dropped
-    without viser's warning (a frame begun just before the client left)."""
-    return buffer.sanctioned_dead_writes()
+    without viser's warning (a frame begun just before the client left); nothing changes for
+    a buffer of None (viser's names moved: :func:`message_buffer`)."""
+    return contextlib.nullcontext() if buffer is None else buffer.sanctioned_dead_writes()
 
 
 class SetOnItsLoop(asyncio.Event):

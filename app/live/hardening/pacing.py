@@ -102,8 +102,6 @@ class Outbox:
         """A frame's or an action's messages within this block, if the client leaves while it
         runs, are dropped without viser's warning (the session is closing: the next pass of
         its frame thread sees :meth:`closed`)."""
-        if self._buffer is None:
-            return contextlib.nullcontext()
         return private.quiet_if_closed(self._buffer)
 
     def pending(self) -> int:
