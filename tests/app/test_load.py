@@ -30,6 +30,8 @@ from poinsot.app.devtools.load.server_process import error_lines, thread_kind
 from poinsot.app.devtools.load.workloads import follow_fleet, following
 from poinsot.app.devtools.load.workloads import hosts as hosts_workload
 from poinsot.app.devtools.load.workloads.storm import KINDS
+from poinsot.app.live.classroom.cast import CAST_FPS
+from poinsot.app.live.server import MAX_FPS
 from tests.app.test_nginx import service_or_skip
 
 TINY = Config(
@@ -215,6 +217,12 @@ def test_follow_phase_measures_followers_and_their_cost(follow_report):
     fps = report.figure("follow", "3 followers: fps each").detail
     assert fps["server_alone_fps"] > fps["beside_clients_fps"] > 0
     assert any(n.startswith("follow, 3 followers: the server used") for n in report.notes)
+    # The followers' shared poses: their ticks while the lead moved and while nothing moved
+    # (each worker's cast ticks while it has followers), the frames held and skipped counted.
+    cast = report.figure("follow", "3 followers: the cast").detail
+    assert cast["ticks_moving"] > 0 and cast["ticks_still"] > 0
+    assert cast["due"] == 2 * min(CAST_FPS, MAX_FPS)  # two workers' casts
+    assert {"held", "skipped"} <= cast.keys()
 
 
 def test_the_followers_are_spread_evenly_over_as_few_processes_as_hold_them():

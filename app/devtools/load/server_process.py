@@ -53,7 +53,22 @@ def _status(app: Any) -> dict[str, Any]:
         "connections": viser_private.connection_count(app.server),
         "disconnected": app.guard.disconnected,  # cut off for exceeding the message budget
         "threads": dict(kinds),
+        **cast_counts(app.follow.cast),
     }
+
+
+#: The followers' cast's counters in a status (its
+#: :class:`~poinsot.app.live.classroom.cast.FollowCast`): its thread's ticks, the frames it held
+#: while a move was rebuilt, the followers it skipped (a socket busy or behind), the windows it
+#: encoded and the copies it handed to sockets.
+CAST_COUNTS = ("ticks", "held", "skipped", "encoded", "handed")
+
+
+def cast_counts(cast: Any) -> dict[str, float]:
+    """``cast``'s counters, named ``cast_<counter>`` (:data:`CAST_COUNTS`), and its ticks due a
+    second (``cast_due``: summed over a classroom's workers, each worker's cast ticks)."""
+    counts: dict[str, float] = {f"cast_{name}": getattr(cast, name) for name in CAST_COUNTS}
+    return counts | {"cast_due": cast.fps}
 
 
 class _Classroom:

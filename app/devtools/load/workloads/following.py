@@ -66,14 +66,16 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         ) as fleet:
             time.sleep(warmup(cfg.follow_seconds))
             pids = server.worker_pids or [server.pid]
-            machine = procfs.Machine.now()
+            machine, casts = procfs.Machine.now(), [server.status()]
             following = fleet.window(
                 cfg.follow_seconds, cfg.slider_period, cfg.follow_redraw_timeout
             )
             busy = procfs.Machine.now().busy_since(machine) * (os.cpu_count() or 1)
+            casts.append(server.status())
             cpu0 = _cpu(pids)
             still = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu1 = _cpu(pids)
+            casts.append(server.status())
             explored = fleet.explore()
             cpu2 = _cpu(pids)
             own = fleet.window(cfg.follow_seconds, 0.0, 0.0)
@@ -86,6 +88,7 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
             Moving(busy, sum(following["fps"]), count, len(pids)),
         )
         report.add(*_figures(count, following, still, own, costs, explored, load))
+        report.add(cast_figure(f"{count} followers", casts, following, still))
         report.notes.append(f"follow, {count} followers: {load.text()}")
 
 
@@ -248,3 +251,36 @@ def _figures(
 
 def own_fps_text(own: dict) -> str:
     return f"sessions {fps_text(own['fps'])}"
+
+
+def cast_figure(name: str, casts: list[dict], moving: dict, still: dict) -> Figure:
+    """The figure "``name``: the cast" from the server's status before the moving window,
+    after it and after the still one (:func:`~..server_process.cast_counts`): the followers'
+    shared poses (:mod:`poinsot.app.live.classroom.cast`), how many of their ticks came while
+    the lead moved and while nothing moved, and where the moving window's frames went."""
+    before, after, last = casts
+    seconds = moving["seconds"]
+
+    def rate(a: dict, b: dict, window: dict) -> float:
+        return (b["cast_ticks"] - a["cast_ticks"]) / window["seconds"]
+
+    due = after["cast_due"]
+    diff = {key: after[key] - before[key] for key in after if key.startswith("cast_")}
+    text = (
+        f"{rate(before, after, moving):.1f} ticks a second of {due:g} due (its workers "
+        f"together) while the lead moved, {rate(after, last, still):.1f} with nothing moving; "
+        f"while it moved: {diff['cast_held']:.0f} frames held for the followers' rebuilds, "
+        f"{diff['cast_skipped']:.0f} followers skipped (a socket busy or behind), "
+        f"{diff['cast_encoded'] / seconds:.1f} windows encoded and "
+        f"{diff['cast_handed'] / seconds:.0f} copies handed a second"
+    )
+    return info(
+        "follow",
+        f"{name}: the cast",
+        text,
+        ticks_moving=rate(before, after, moving),
+        ticks_still=rate(after, last, still),
+        due=due,
+        held=diff["cast_held"],
+        skipped=diff["cast_skipped"],
+    )
