@@ -80,9 +80,10 @@ CAST_FPS = 40.0
 #: A shared follower's own frames a second (its traces, labels, plot and time readout), at most,
 #: and at least; a process's followers share OWN_PROCESS_FRAMES of them a second between them
 #: (:func:`own_fps`): each own frame costs about a session's frame, so their sum must not grow
-#: with the hall.
+#: with the hall, up to 240 followers a process (OWN_MIN_FPS: a follower's traces and clock
+#: then move every 2 s; its body, posed by the cast, still turns at the cast's rate).
 OWN_FPS = 6.0
-OWN_MIN_FPS = 2.0
+OWN_MIN_FPS = 0.5
 OWN_PROCESS_FRAMES = 120.0
 #: A follower's unacknowledged bytes are read every this many of the cast's frames.
 CHECK_TICKS = 8
