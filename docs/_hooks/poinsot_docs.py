@@ -111,7 +111,7 @@ def _figures() -> dict[str, Callable[[], str]]:
     from poinsot.app.exports import html as html_export
     from poinsot.app.exports import video
     from poinsot.app.live.hardening import backlog, pacing
-    from poinsot.app.live.classroom import follow, links
+    from poinsot.app.live.classroom import cast, follow, links
     from poinsot.app.live.session import session
 
     return {
@@ -123,6 +123,9 @@ def _figures() -> dict[str, Callable[[], str]]:
         "recording_mb": lambda: _mb(recordings.MAX_BYTES),
         "link_max_time": lambda: f"{links.MAX_TIME:g}",
         "wrong_codes": lambda: str(follow.MAX_WRONG_CODES),
+        "own_fps": lambda: f"{cast.OWN_FPS:g}",
+        "own_process_frames": lambda: f"{cast.OWN_PROCESS_FRAMES:g}",
+        "own_min_every": lambda: f"{1 / cast.OWN_MIN_FPS:g}",
         "video_browser_seconds": lambda: f"{video.BROWSER_MAX_SECONDS:g}",
         "video_browser_size": lambda: "{}×{}".format(*video.BROWSER_MAX_SIZE),
         "video_max_seconds": lambda: f"{video.MAX_SECONDS:g}",
