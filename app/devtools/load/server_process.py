@@ -60,8 +60,9 @@ def _status(app: Any) -> dict[str, Any]:
 #: The followers' cast's counters in a status (its
 #: :class:`~poinsot.app.live.classroom.cast.FollowCast`): its thread's ticks, the frames it held
 #: while a move was rebuilt, the followers it skipped (a socket busy or behind), the windows it
-#: encoded and the copies it handed to sockets.
-CAST_COUNTS = ("ticks", "held", "skipped", "encoded", "handed")
+#: encoded and the copies it handed to sockets, the lead's new bodies one follower handed to
+#: others and the copies of those.
+CAST_COUNTS = ("ticks", "held", "skipped", "encoded", "handed", "fits", "fit_copies")
 
 
 def cast_counts(cast: Any) -> dict[str, float]:

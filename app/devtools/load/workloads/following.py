@@ -272,7 +272,9 @@ def cast_figure(name: str, casts: list[dict], moving: dict, still: dict) -> Figu
         f"while it moved: {diff['cast_held']:.0f} frames held for the followers' rebuilds, "
         f"{diff['cast_skipped']:.0f} followers skipped (a socket busy or behind), "
         f"{diff['cast_encoded'] / seconds:.1f} windows encoded and "
-        f"{diff['cast_handed'] / seconds:.0f} copies handed a second"
+        f"{diff['cast_handed'] / seconds:.0f} copies handed a second, the lead's new body "
+        f"handed {diff['cast_fits']:.0f} times by one follower to {diff['cast_fit_copies']:.0f} "
+        f"others ({moving['moves']} moves)"
     )
     return info(
         "follow",
@@ -283,4 +285,5 @@ def cast_figure(name: str, casts: list[dict], moving: dict, still: dict) -> Figu
         due=due,
         held=diff["cast_held"],
         skipped=diff["cast_skipped"],
+        fit_copies=diff["cast_fit_copies"],
     )
