@@ -210,6 +210,7 @@ def test_follow_phase_measures_followers_and_their_cost(follow_report):
     assert moves["moves"] >= 2 and moves["lost"] == 0 and moves["redraws"] == 3 * moves["moves"]
     cost = report.figure("follow", "3 followers: server CPU per frame").detail
     assert cost["explored"] == 1.0 and cost["follower_ms"] > 0 and cost["session_ms"] > 0
+    assert math.isfinite(cost["move_ms"])  # (beyond the still window: a difference, any sign)
     cores = report.figure("follow", "3 followers: the machine's cores").detail
     # The clients' two processes, measured beside the server; its own cores while still.
     assert cores["processes"] == 2 and cores["clients_cpu"] > 0 and cores["server_cores"] > 0
@@ -223,6 +224,14 @@ def test_follow_phase_measures_followers_and_their_cost(follow_report):
     assert cast["ticks_moving"] > 0 and cast["ticks_still"] > 0
     assert cast["due"] == 2 * min(CAST_FPS, MAX_FPS)  # two workers' casts
     assert {"held", "skipped", "fit_copies"} <= cast.keys()
+
+
+def test_a_lead_s_move_costs_each_follower_the_moving_window_s_cpu_beyond_the_still_one():
+    # 3 s of the server's CPU over 10 s with the lead moving, where the same 10 s nothing moving
+    # take 2 s: 1 s for 5 moves of 100 followers, 2 ms a follower a move.
+    moving = {"seconds": 10.0, "moves": 5}
+    assert following._ms_per_move(3.0, 0.2, moving, 100) == pytest.approx(2.0)
+    assert math.isnan(following._ms_per_move(3.0, 0.2, {"seconds": 10.0, "moves": 0}, 100))
 
 
 def test_the_followers_are_spread_evenly_over_as_few_processes_as_hold_them():
@@ -248,7 +257,7 @@ def _hall_fps(count: int, fps: list[float], moving: following.Moving) -> Figure:
     moved, the machine as ``moving`` says, its clients' two processes at 0.7 cores."""
     window = {"fps": fps, "latencies": [0.05] * count, "redraws": [[0.05] * count], "moves": 1}
     load = following.Load(0.5, 0.7, 2, moving)
-    figures = following._figures(count, window, window, window, (0.1, 0.5), True, load)
+    figures = following._figures(count, window, window, window, (0.1, 0.5, 1.0), True, load)
     return next(f for f in figures if f.name == f"{count} followers: fps each")
 
 
@@ -303,7 +312,7 @@ def test_the_follow_figures_are_the_95th_percentile_of_the_redraws_not_the_slowe
     redraws = [[0.001 * (10 * m + f + 1) for f in range(10)] for m in range(10)]
     moving = {"fps": [30.0] * 10, "latencies": sum(redraws, []), "redraws": redraws, "moves": 10}
     load = following.Load(0.5, 0.5, 1)
-    one = following._figures(10, moving, moving, moving, (0.1, 0.5), True, load)
+    one = following._figures(10, moving, moving, moving, (0.1, 0.5, 1.0), True, load)
     move = next(f for f in one if f.name == "10 followers: lead's slider move on every follower")
     assert move.value == pytest.approx(95.0) and move.text.startswith("p95 95 ms over 100")
     outage = {"recovery": [1.0], "lost": 0, "early": 0, "told": 1, "others": 1, "refused": 0}

@@ -66,7 +66,7 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
         ) as fleet:
             time.sleep(warmup(cfg.follow_seconds))
             pids = server.worker_pids or [server.pid]
-            machine, casts = procfs.Machine.now(), [server.status()]
+            machine, casts, cpu_moving = procfs.Machine.now(), [server.status()], _cpu(pids)
             following = fleet.window(
                 cfg.follow_seconds, cfg.slider_period, cfg.follow_redraw_timeout
             )
@@ -80,7 +80,11 @@ def phase(server: ServerProcess, cfg: Config, report: Report, say: Say) -> None:
             cpu2 = _cpu(pids)
             own = fleet.window(cfg.follow_seconds, 0.0, 0.0)
             cpu3 = _cpu(pids)
-        costs = (_ms_per_frame(cpu1 - cpu0, still), _ms_per_frame(cpu3 - cpu2, own))
+        costs = (
+            _ms_per_frame(cpu1 - cpu0, still),
+            _ms_per_frame(cpu3 - cpu2, own),
+            _ms_per_move(cpu0 - cpu_moving, (cpu1 - cpu0) / still["seconds"], following, count),
+        )
         load = Load(
             (cpu1 - cpu0) / still["seconds"],
             following["clients"],
@@ -188,12 +192,21 @@ def _ms_per_frame(cpu: float, window: dict) -> float:
     return 1e3 * cpu / frames if frames else math.nan
 
 
+def _ms_per_move(cpu: float, still_cores: float, moving: dict, followers: int) -> float:
+    """The server's CPU [ms] a lead's move cost each follower: what the window with the lead
+    moving took (``cpu`` [s]) beyond the same seconds with nothing moving (``still_cores``),
+    over its moves and the followers."""
+    moves = moving["moves"] * followers
+    extra = cpu - still_cores * moving["seconds"]
+    return 1e3 * extra / moves if moves else math.nan
+
+
 def _figures(
     count: int,
     following: dict,
     still: dict,
     own: dict,
-    costs: tuple[float, float],
+    costs: tuple[float, float, float],
     explored: bool,
     load: Load,
 ) -> list[Figure]:
@@ -204,7 +217,7 @@ def _figures(
     fps, latencies = following["fps"], following["latencies"]
     lost = following["moves"] * count - len(latencies)
     p95 = 1e3 * percentile(latencies, 0.95) if latencies else math.nan
-    follow_ms, own_ms = costs
+    follow_ms, own_ms, move_ms = costs
     name = f"{count} followers"
     text = f"{fps_text(fps)} (nothing moving: {fps_text(still['fps'])})"
     detail = {"clients": count, "p50": statistics.median(fps) if fps else 0.0}
@@ -240,9 +253,11 @@ def _figures(
             "follow",
             f"{name}: server CPU per frame",
             f"{follow_ms:.2f} ms per follower-frame, {own_ms:.2f} ms per session-frame "
-            f"(the same clients after Explore from here, {own_fps_text(own)}; nothing moved)",
+            f"(the same clients after Explore from here, {own_fps_text(own)}; nothing moved); "
+            f"a lead's move {move_ms:.2f} ms per follower (the moving window beyond the still)",
             follower_ms=follow_ms,
             session_ms=own_ms,
+            move_ms=move_ms,
             explored=float(explored),
         ),
         load.figure(name),
