@@ -333,7 +333,12 @@ def test_a_write_for_a_stopped_server_s_loop_goes_to_nobody():
     ran: list[int] = []
     assert on_loop(loop, ran.append, 1)
     loop.call_soon(loop.stop)  # runs what is ready, then stops
-    loop.run_forever()
+    # On a thread of its own, as viser's loop runs (this thread may hold the event loop of a
+    # real-browser test that ran before, in this process: ``python -m pytest`` without workers).
+    thread = threading.Thread(target=loop.run_forever)
+    thread.start()
+    thread.join(30)
+    assert not thread.is_alive(), "the loop did not stop"
     assert ran == [1]
     loop.close()
     assert not on_loop(loop, ran.append, 2)
