@@ -217,7 +217,6 @@ def _figures(
     fps, latencies = following["fps"], following["latencies"]
     lost = following["moves"] * count - len(latencies)
     p95 = 1e3 * percentile(latencies, 0.95) if latencies else math.nan
-    follow_ms, own_ms, move_ms = costs
     name = f"{count} followers"
     text = f"{fps_text(fps)} (nothing moving: {fps_text(still['fps'])})"
     detail = {"clients": count, "p50": statistics.median(fps) if fps else 0.0}
@@ -249,19 +248,25 @@ def _figures(
             at_most("max_follow_ms", "p95 <= {:g} ms"),
             {"redraws": len(latencies), "moves": following["moves"], "lost": lost},
         ),
-        info(
-            "follow",
-            f"{name}: server CPU per frame",
-            f"{follow_ms:.2f} ms per follower-frame, {own_ms:.2f} ms per session-frame "
-            f"(the same clients after Explore from here, {own_fps_text(own)}; nothing moved); "
-            f"a lead's move {move_ms:.2f} ms per follower (the moving window beyond the still)",
-            follower_ms=follow_ms,
-            session_ms=own_ms,
-            move_ms=move_ms,
-            explored=float(explored),
-        ),
+        _cost_figure(name, costs, own, explored),
         load.figure(name),
     ]
+
+
+def _cost_figure(name: str, costs: tuple[float, float, float], own: dict, explored: bool) -> Figure:
+    """The figure "``name``: server CPU per frame" (and per follower a lead's move)."""
+    follow_ms, own_ms, move_ms = costs
+    return info(
+        "follow",
+        f"{name}: server CPU per frame",
+        f"{follow_ms:.2f} ms per follower-frame, {own_ms:.2f} ms per session-frame "
+        f"(the same clients after Explore from here, {own_fps_text(own)}; nothing moved); "
+        f"a lead's move {move_ms:.2f} ms per follower (the moving window beyond the still)",
+        follower_ms=follow_ms,
+        session_ms=own_ms,
+        move_ms=move_ms,
+        explored=float(explored),
+    )
 
 
 def own_fps_text(own: dict) -> str:
