@@ -149,6 +149,49 @@ def test_a_detached_follower_encodes_its_own_frames_again(poinsot_app, make_prob
     assert cast.handed - handed <= len(frames[1]) - start1 + 2
 
 
+class _OwnedGate:
+    """The cast's draw gate, saying which thread holds it."""
+
+    def __init__(self, lock: threading.Lock) -> None:
+        self.lock, self.holder = lock, 0
+
+    def __enter__(self) -> None:
+        self.lock.acquire()
+        self.holder = threading.get_ident()
+
+    def __exit__(self, *exc: object) -> None:
+        self.holder = 0
+        self.lock.release()
+
+
+def test_a_process_s_followers_draw_their_own_frames_one_at_a_time(poinsot_app, make_probe):
+    """A hall's followers would all want the interpreter at once, the cast's thread behind
+    them: each shared follower draws its own frame holding the process's one gate; a detached
+    one, its own again, draws without it."""
+    _, probes, _, sessions = _class(poinsot_app, make_probe)
+    cast = poinsot_app.follow.cast
+    gate = cast.draw_gate = _OwnedGate(cast.draw_gate)  # type: ignore[assignment]
+    held: dict[int, list[tuple[bool, bool]]] = {id(s): [] for s in sessions}
+    for session in sessions:
+        advance = session.scene.advance
+
+        def recording(t, s=session, advance=advance):
+            held[id(s)].append((s.shared.shared, gate.holder == threading.get_ident()))
+            return advance(t)
+
+        session.scene.advance = recording
+    assert wait_until(lambda: all(len(v) >= 5 for v in held.values()), 30)
+    detached = sessions[0]
+    _set(probes[0], "Explore from here")
+    assert wait_until(lambda: not detached.shared.shared, 30)
+    count = len(held[id(detached)])
+    assert wait_until(lambda: len(held[id(detached)]) >= count + 10, 30)
+    for session in sessions:
+        # Shared: drawn inside the gate, by its own thread; its own again: outside it.
+        assert all(shared == inside for shared, inside in held[id(session)]), held[id(session)]
+    assert any(not shared for shared, _ in held[id(detached)])
+
+
 class _Stuck:
     """A follower's connection whose transport has paused writing until released (a socket that
     does not drain: its browser reads nothing, or the network to it is gone). Its writes reach

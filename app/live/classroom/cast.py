@@ -212,6 +212,8 @@ class FollowCast:
         self._move[0].set()
         self._hold: tuple[float, list[Motion]] | None = None  # until when, the old motions
         self._error = ""
+        #: The members' own frames, one at a time in the process (:meth:`SharedFrames.drawing`).
+        self.draw_gate = threading.Lock()
 
     def join(self, key: int, client: viser.ClientHandle) -> Member | None:
         """``client`` is sent the shared frames from now on (None if its socket cannot be
@@ -404,6 +406,13 @@ class SharedFrames:
     @property
     def shared(self) -> bool:
         return self.member is not None
+
+    def drawing(self) -> contextlib.AbstractContextManager[Any]:
+        """Around an own frame of a member: the process's followers draw theirs one at a time
+        (:attr:`FollowCast.draw_gate`). A hall's hundred frame threads would otherwise all
+        want the interpreter at once, and the cast's thread, which poses them all, waits
+        behind them; one at a time, it waits for one."""
+        return self.cast.draw_gate if self.member is not None else contextlib.nullcontext()
 
     def update(self, source: Source | None) -> None:
         """Join the cast with ``source``, or leave it at once (None)."""

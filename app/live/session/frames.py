@@ -111,7 +111,7 @@ class FrameWork:
         skipped, the rate lowered). A frame's messages go out at once, in one atomic window."""
         if not self.pacer.may_draw():
             return False
-        with self.pacer.outbox.quiet_if_left(), self.client.atomic():
+        with self.shared.drawing(), self.pacer.outbox.quiet_if_left(), self.client.atomic():
             self._advance()
             self._after(now)
         self.client.flush()  # out now, not at viser's next 1/60 s window
