@@ -180,15 +180,17 @@ def test_a_process_s_followers_draw_their_own_frames_one_at_a_time(poinsot_app, 
             return advance(t)
 
         session.scene.advance = recording
-    assert wait_until(lambda: all(len(v) >= 5 for v in held.values()), 30)
+    assert wait_until(lambda: all(len(v) >= 6 for v in held.values()), 30)
     detached = sessions[0]
     _set(probes[0], "Explore from here")
     assert wait_until(lambda: not detached.shared.shared, 30)
     count = len(held[id(detached)])
     assert wait_until(lambda: len(held[id(detached)]) >= count + 10, 30)
     for session in sessions:
-        # Shared: drawn inside the gate, by its own thread; its own again: outside it.
-        assert all(shared == inside for shared, inside in held[id(session)]), held[id(session)]
+        # Shared: drawn inside the gate, by its own thread; its own again: outside it. (Its
+        # first frame recorded may have taken the gate before the gate was watched.)
+        drawn = held[id(session)][1:]
+        assert all(shared == inside for shared, inside in drawn), drawn
     assert any(not shared for shared, _ in held[id(detached)])
 
 

@@ -17,8 +17,9 @@ node of that id only; a copy is the one msgpack with the id spliced in, then com
   never holds the others (each socket's write is a task of its own on viser's loop).
 - What differs between followers stays each one's own, drawn by its own session at
   :func:`own_fps`: the traces (its own history of the motion), the labels laid out for its own
-  camera, the ω plot and the time readout (widgets of its own page). The pose is then left out
-  of its frames (``PoinsotScene.send_pose``).
+  camera, the ω plot and the time readout (widgets of its own page), one follower's at a time
+  in the process (:meth:`SharedFrames.drawing`). The pose is then left out of its frames
+  (``PoinsotScene.send_pose``).
 - The lead's new body is made once per process too. Every follower rebuilds it, but the first
   of the cast to open it makes it (:meth:`FollowCast.claim_move`: the others wait for it, at
   most :data:`MAKER_WAIT`), and what its drawings' fit queues (the body's sizes and static
