@@ -49,7 +49,7 @@ from poinsot.app.construction.cameras import (
 )
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.geometry import L_OVERSHOOT
-from poinsot.app.construction.view import DEFAULT_VIEW
+from poinsot.app.construction.view import DEFAULT_VIEW, View
 from poinsot.app.live.panel.motion_window import MotionWindow
 from poinsot.app.live.panel.readouts import REGIME_TEXT
 from poinsot.app.live.panel.showcase import LiveShowcase
@@ -155,6 +155,9 @@ class Layout:
         self.size: tuple[int, int] | None = None  # the canvas last reported [px]
         self.mirror: viser.GuiHtmlHandle | None = None
         self.framings = 0  # camera framings sent (tests)
+        #: The canvas size [px] and the camera of the last framing (sent to the browser);
+        #: ``client.camera`` mirrors what the browser reports, which can lag a framing.
+        self.framed: tuple[tuple[int, int] | None, View] | None = None
         self.header = ""  # the sheet's header last sent
         self._header_at = -1.0  # monotonic time it was
         session.client.camera.on_update(self._on_camera)
@@ -233,6 +236,7 @@ class Layout:
         else:
             chosen = framed(view, aspect, every)
         chosen.apply(self.session.client.camera)
+        self.framed = (self.size, chosen)
         self.framings += 1
 
     def show_header(self, now: float, t: float) -> None:
