@@ -25,7 +25,7 @@ from poinsot.app.live.classroom.cast import (
 )
 from poinsot.app.model.elements import Element
 from poinsot.app.viser_private import props_message, wire_message
-from tests.app.test_follow import _follow, _lead, _ready, _says, _set
+from tests.app.test_follow import D, _follow, _lead, _ready, _says, _set
 from tests.conftest import wait_until
 
 POSE = "/space/body"
@@ -192,6 +192,30 @@ def test_a_process_s_followers_draw_their_own_frames_one_at_a_time(poinsot_app, 
         drawn = held[id(session)][1:]
         assert all(shared == inside for shared, inside in drawn), drawn
     assert any(not shared for shared, _ in held[id(detached)])
+
+
+def test_a_process_s_followers_rebuild_the_lead_s_move_one_at_a_time(poinsot_app, make_probe):
+    """After the lead's move every follower of the process rebuilds: each holds the gate its
+    own frames pass (the cast's thread then waits for one, not for all); the lead, no
+    follower, rebuilds without it."""
+    lead, _, _, sessions = _class(poinsot_app, make_probe, followers=3)
+    cast = poinsot_app.follow.cast
+    gate = cast.draw_gate = _OwnedGate(cast.draw_gate)  # type: ignore[assignment]
+    everyone = list(poinsot_app.sessions().values())
+    held: dict[int, list[bool]] = {id(s): [] for s in everyone}
+    for session in everyone:
+        rebuild = session.build.rebuild
+
+        def recording(showcase, s=session, rebuild=rebuild):
+            held[id(s)].append(gate.holder == threading.get_ident())
+            return rebuild(showcase)
+
+        session.build.rebuild = recording
+    _set(lead, D, 2.3)
+    assert wait_until(lambda: all(held[id(s)] for s in everyone), 30), held
+    assert all(all(held[id(s)]) for s in sessions), held  # the followers': inside
+    (leader,) = [s for s in everyone if s not in sessions]
+    assert not any(held[id(leader)]), held[id(leader)]  # the lead's: outside
 
 
 class _Stuck:

@@ -18,8 +18,8 @@ node of that id only; a copy is the one msgpack with the id spliced in, then com
 - What differs between followers stays each one's own, drawn by its own session at
   :func:`own_fps`: the traces (its own history of the motion), the labels laid out for its own
   camera, the ω plot and the time readout (widgets of its own page), one follower's at a time
-  in the process (:meth:`SharedFrames.drawing`). The pose is then left out of its frames
-  (``PoinsotScene.send_pose``).
+  in the process (:meth:`SharedFrames.drawing`), as are their rebuilds. The pose is then left
+  out of its frames (``PoinsotScene.send_pose``).
 - The lead's new body is made once per process too. Every follower rebuilds it, but the first
   of the cast to open it makes it (:meth:`FollowCast.claim_move`: the others wait for it, at
   most :data:`MAKER_WAIT`), and what its drawings' fit queues (the body's sizes and static
@@ -409,10 +409,11 @@ class SharedFrames:
         return self.member is not None
 
     def drawing(self) -> contextlib.AbstractContextManager[Any]:
-        """Around an own frame of a member: the process's followers draw theirs one at a time
-        (:attr:`FollowCast.draw_gate`). A hall's hundred frame threads would otherwise all
-        want the interpreter at once, and the cast's thread, which poses them all, waits
-        behind them; one at a time, it waits for one."""
+        """Around an own frame or a rebuild of a member: the process's followers draw and
+        rebuild one at a time (:attr:`FollowCast.draw_gate`). A hall's hundred frame threads
+        would otherwise all want the interpreter at once (after the lead's move, all
+        rebuilding), and the cast's thread, which poses them all, waits behind them; one at a
+        time, it waits for one."""
         return self.cast.draw_gate if self.member is not None else contextlib.nullcontext()
 
     def update(self, source: Source | None) -> None:

@@ -92,8 +92,12 @@ class FrameWork:
 
     def _rebuild(self) -> None:
         """Rebuild; a lead's new body or scene then goes to its followers at once, not after
-        its next frame (up to a frame interval later, every follower's rebuild waiting)."""
-        self.build.rebuild(self.choice.showcase)
+        its next frame (up to a frame interval later, every follower's rebuild waiting). A
+        follower in the cast rebuilds through the gate its own frames pass (one at a time in
+        the process, :meth:`~poinsot.app.live.classroom.cast.SharedFrames.drawing`): a hall's
+        rebuilds after the lead's move would otherwise all want the interpreter at once."""
+        with self.shared.drawing():
+            self.build.rebuild(self.choice.showcase)
         self.publish.on_frame(time.monotonic())
 
     def _shared_source(self) -> Source | None:
