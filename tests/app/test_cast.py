@@ -350,7 +350,7 @@ def test_a_move_holds_the_cast_s_frames_until_its_followers_rebuilt_at_most_a_bo
     # A hold with nothing to end it: the frames stop (one tick's may still be in flight), then
     # come again once its bound has passed.
     held, handed = cast.held, cast.handed
-    cast.hold()
+    cast.hold("held by the test")
     assert wait_until(lambda: cast.held >= held + 3, 30)
     assert cast.handed <= handed + len(sessions)
     assert wait_until(lambda: cast.handed > handed + 2 * len(sessions), 30)
@@ -493,7 +493,7 @@ def test_a_new_body_goes_only_to_followers_showing_the_body_its_maker_showed():
     for key, member in enumerate((sender, behind, newer, unknown, elsewhere)):
         cast._members[key] = member
     update = props_message("/space/body/ellipsoid", {"scale": (1.0, 0.8, 0.6)})
-    assert cast.share_fit(sender, geometry[0], motions[1], [update])
+    assert cast.share_fit(sender, geometry[0], motions[1], [update], cast.query)
     assert behind.geometry is geometry[1] and behind.source.motion is motions[1]
     assert newer.geometry is geometry[2] and unknown.geometry is None
     assert elsewhere.geometry is geometry[0] and elsewhere.source.motion is motions[0]
@@ -501,5 +501,35 @@ def test_a_new_body_goes_only_to_followers_showing_the_body_its_maker_showed():
     assert handed == [sender.socket, behind.socket] and cast.fit_copies == 1
     # Not only node updates (a node removed): nothing is handed, the follower sends its own.
     removed = wire_message("RemoveSceneNodeMessage", "/space/body/solid")
-    assert not cast.share_fit(sender, geometry[1], motions[2], [update, removed])
+    assert not cast.share_fit(sender, geometry[1], motions[2], [update, removed], cast.query)
     assert behind.geometry is geometry[1] and len(loop.calls) == 1
+
+
+def test_a_fit_of_a_state_the_lead_has_left_goes_to_nobody():
+    """A lead going back and forth between two bodies (A, B, A: the process keeps their
+    motions, so A's geometry comes back). A follower whose session took the state of the move
+    to B, and fits B after the move back to A was handed round, sends nothing: its browser
+    shows A, as every other (a fit handed round would take them all back to B, each of their
+    own fits then all the others forth again); its next rebuild is of A."""
+    a, b = SimpleNamespace(geometry=object()), SimpleNamespace(geometry=object())
+    loop = _Loop()
+    cast = FollowCast(lambda: None)
+    source = Source(a, "/space/body", "/space/tip", None, frozenset({Element.ELLIPSOID}))
+    late, maker, other = (_member(_Socket(loop), source, a.geometry) for _ in range(3))
+    cast._members.update(enumerate((late, maker, other)))
+    update = props_message("/space/body/ellipsoid", {"scale": (1.0, 0.8, 0.6)})
+    for query, motion in (("I=1,1.9,3", b), ("I=1,1.7,3", a)):  # to B, and back to A
+        cast.hold(query)
+        before = cast.fitting(maker, motion.geometry)
+        assert not cast.left_behind(maker, before, motion.geometry, query)
+        assert cast.share_fit(maker, before, motion, [update], query)
+        assert late.geometry is motion.geometry and other.geometry is motion.geometry
+    calls = len(loop.calls)
+    before = cast.fitting(late, b.geometry)  # its fit of the move to B, late
+    assert cast.left_behind(late, before, b.geometry, "I=1,1.9,3")
+    assert late.geometry is a.geometry and other.geometry is a.geometry
+    assert len(loop.calls) == calls
+    # Handed in that state all the same (the lead moved between the two): its own only.
+    before = cast.fitting(late, b.geometry)
+    assert cast.share_fit(late, before, b, [update], "I=1,1.9,3")
+    assert other.geometry is a.geometry and [s for s, _ in loop.calls[calls][0]] == [late.socket]

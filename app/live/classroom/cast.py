@@ -18,8 +18,8 @@ node of that id only; a copy is the one msgpack with the id spliced in, then com
 - What differs between followers stays each one's own, drawn by its own session at
   :func:`own_fps`: the traces (its own history of the motion), the labels laid out for its own
   camera, the ω plot and the time readout (widgets of its own page), one follower's at a time
-  in the process (:meth:`SharedFrames.drawing`), as are their rebuilds. The pose is then left
-  out of its frames (``PoinsotScene.send_pose``).
+  in the process (:meth:`.shared_frames.SharedFrames.drawing`), as are their rebuilds. The pose
+  is then left out of its frames (``PoinsotScene.send_pose``).
 - The lead's new body is made once per process too. Every follower rebuilds it, but the first
   of the cast to open it makes it (:meth:`FollowCast.claim_move`: the others wait for it, at
   most :data:`MAKER_WAIT`), and what its drawings' fit queues (the body's sizes and static
@@ -30,46 +30,46 @@ node of that id only; a copy is the one msgpack with the id spliced in, then com
   made it, not once the last has; each follower's own rebuild then sends only what is its own
   (its sliders, traces, readouts). A member's :attr:`Member.geometry` says which body its
   browser was last sent (by the cast or its session), so that a share never takes a follower
-  back to an older body, and every fit of a follower's goes through the cast's path, in the
-  order handed. Only node updates are shared, to followers drawing the same elements on the
-  same nodes; a fit that makes or removes a node is its follower's own, sent as ever.
+  back to an older body; a fit of a lead's state left since its session took it is not sent
+  (:meth:`FollowCast.left_behind`); and every fit of a follower's goes through the cast's
+  path, in the order handed. Only node updates are shared, to followers drawing the same
+  elements on the same nodes; a fit that makes or removes a node is its follower's own, sent
+  as ever.
 - The lead's new body or scene is a rebuild in every follower: the cast then holds its frames
   (:meth:`FollowCast.hold`) until every follower it poses has rebuilt (poses another motion)
   or :data:`MOVE_HOLD` has passed, so that the rebuilds have the interpreter to themselves
   and the move reaches the last follower of a hall sooner (the poses of the old body would be
   outdated by then anyway).
 - A follower whose frame is not the lead's falls back to its own frames at its own rate at once
-  (its session calls :meth:`SharedFrames.update` with None): the lead shows a lecture scene (its
-  frame is the scene's own drawing), the follower's ghost is on, its camera rides along with the
-  body, or its rebuild is pending. "Explore from here" leaves the cast the same way.
+  (its session calls :meth:`.shared_frames.SharedFrames.update` with None): the lead shows a
+  lecture scene (its frame is the scene's own drawing), the follower's ghost is on, its camera
+  rides along with the body, or its rebuild is pending. "Explore from here" leaves the cast the
+  same way.
 """
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import logging
 import threading
 import time
-from collections.abc import Callable, Hashable, Iterator
+from collections.abc import Callable, Hashable
 from typing import Any
 
 import numpy as np
 import viser
 
-from poinsot.app.construction.construction import PoinsotScene, no_fitting
+from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.sampled.motion import Motion
-from poinsot.app.live.hardening.pacing import MAX_UNACKED, Outbox, Pacer, next_due
+from poinsot.app.live.hardening.pacing import MAX_UNACKED, Outbox, next_due
 from poinsot.app.model.elements import Element
 from poinsot.app.viser_private import (
     OwnedWindow,
     WindowSocket,
     client_owner,
-    held_back,
     orientation_message,
     position_message,
     props_message,
-    queue_held,
     send_each,
 )
 
@@ -208,12 +208,15 @@ class FollowCast:
         #: New bodies handed from one follower to others, and the copies handed.
         self.fits = 0
         self.fit_copies = 0
+        #: The query of the lead's state last moved to (:meth:`hold`).
+        self.query: str | None = None
         #: The lead's last move: set once its maker has rebuilt, and its maker.
         self._move: tuple[threading.Event, Member | None] = (threading.Event(), None)
         self._move[0].set()
         self._hold: tuple[float, list[Motion]] | None = None  # until when, the old motions
         self._error = ""
-        #: The members' own frames, one at a time in the process (:meth:`SharedFrames.drawing`).
+        #: The members' own frames and rebuilds, one at a time in the process
+        #: (:meth:`.shared_frames.SharedFrames.drawing`).
         self.draw_gate = threading.Lock()
 
     def join(self, key: int, client: viser.ClientHandle) -> Member | None:
@@ -243,11 +246,13 @@ class FollowCast:
         self._stop.set()
         self._wake.set()
 
-    def hold(self) -> None:
-        """The lead's body or scene changed (any thread): no frame until no member poses a
-        motion it poses now (each has rebuilt, or left), or :data:`MOVE_HOLD` has passed; and
-        a new move begins, whose maker is the first member to open it (:meth:`claim_move`)."""
+    def hold(self, query: str) -> None:
+        """The lead's body or scene changed (any thread), to its state of ``query``: no frame
+        until no member poses a motion it poses now (each has rebuilt, or left), or
+        :data:`MOVE_HOLD` has passed; and a new move begins, whose maker is the first member
+        to open it (:meth:`claim_move`)."""
         with self._lock:
+            self.query = query
             old = {id(m.source.motion): m.source.motion for m in self._members.values() if m.source}
             self._move = (threading.Event(), None)  # its maker: the first member to rebuild
         if old:
@@ -326,20 +331,37 @@ class FollowCast:
         with self._lock:
             member.geometry = None
 
-    def share_fit(self, sender: Member, before: Any, motion: Motion, messages: list[Any]) -> bool:
+    def left_behind(self, member: Member, before: Any, geometry: Any, query: str | None) -> bool:
+        """Whether ``member``'s fit to ``geometry`` is of a lead's state (``query``) left since
+        its session took it (then waited for the move's maker and the interpreter): not sent,
+        its browser shows ``before`` (or a share's body), and its next rebuild follows. Handed
+        round, it took every browser back a move (a lead going back and forth brings the same
+        geometry back), each of their fits then all the others forth again."""
+        with self._lock:
+            if query == self.query:
+                return False
+            if member.geometry is geometry:  # no share took it elsewhere meanwhile
+                member.geometry = before
+            return True
+
+    def share_fit(
+        self, sender: Member, before: Any, motion: Motion, messages: list[Any], query: str | None
+    ) -> bool:
         """``sender`` fitted its drawings to ``motion``'s body, holding back ``messages``: hand
         them as one window, encoded once, each its copy, to ``sender`` and to every other
         member whose browser was last sent ``before`` too (the same updates take it to the
         same body) on the same nodes, and pose those from ``motion`` from now on (their
-        sessions' rebuilds follow). One path for all of them: every window a socket is handed
-        is written in the order handed. False (nothing handed) if ``messages`` are not all
-        node updates."""
+        sessions' rebuilds follow); only to ``sender`` if its fit is of a state (``query``) the
+        lead has left (:meth:`left_behind`). One path for all of them: every window a socket is
+        handed is written in the order handed. False (nothing handed) if ``messages`` are not
+        all node updates."""
         source = sender.source
         if source is None or not messages or not updates_only(messages):
             return False
         geometry, layout = motion.geometry, source.layout
         with self._lock:  # handed in the order the members' geometries change
-            behind = before is not None and before is not geometry  # else only the sender's
+            # else only the sender's: the same body, or the state of a move since overtaken
+            behind = before is not None and before is not geometry and query == self.query
             targets = [
                 m
                 for m in self._members.values()
@@ -390,98 +412,3 @@ class FollowCast:
                     log.exception("followers' shared frames: %s", message)
             self.cpu_seconds += time.thread_time() - cpu
             due = next_due(due, time.monotonic(), 1.0 / self.fps)
-
-
-class SharedFrames:
-    """A session's side of the cast (its frame thread only): :meth:`update` after its work."""
-
-    def __init__(
-        self, cast: FollowCast, client: viser.ClientHandle, pacer: Pacer, scene: PoinsotScene
-    ) -> None:
-        self.cast, self.client, self.pacer, self.scene = cast, client, pacer, scene
-        #: Makes its frame loop's next frame due at once (set once the loop exists).
-        self.draw_now: Callable[[], None] = lambda: None
-        self.member: Member | None = None
-        self._made: Callable[[], None] | None = None  # called once its move is made
-
-    @property
-    def shared(self) -> bool:
-        return self.member is not None
-
-    def drawing(self) -> contextlib.AbstractContextManager[Any]:
-        """Around an own frame or a rebuild of a member: the process's followers draw and
-        rebuild one at a time (:attr:`FollowCast.draw_gate`). A hall's hundred frame threads
-        would otherwise all want the interpreter at once (after the lead's move, all
-        rebuilding), and the cast's thread, which poses them all, waits behind them; one at a
-        time, it waits for one."""
-        return self.cast.draw_gate if self.member is not None else contextlib.nullcontext()
-
-    def update(self, source: Source | None) -> None:
-        """Join the cast with ``source``, or leave it at once (None)."""
-        if source is None:
-            self.leave()
-            return
-        member = self.member
-        if member is None:
-            member = self.member = self.cast.join(id(self), self.client)
-            if member is None:  # its socket cannot be reached: its own frames, as ever
-                return
-            member.geometry = source.motion.geometry  # what its browser shows now
-            self.scene.send_pose = False
-            self.scene.fitting = self._fitting
-        self.pacer.cap = own_fps(self.cast.members)
-        member.source = source
-
-    def leave(self) -> None:
-        """Its own frames again, the next one at once, pose included."""
-        if self.member is None:
-            return
-        self.cast.leave(id(self))
-        self.member = None
-        self.scene.send_pose = True
-        self.scene.fitting = no_fitting
-        self.pacer.cap = None
-        self.draw_now()
-
-    @contextlib.contextmanager
-    def _fitting(self, motion: Motion) -> Iterator[None]:
-        """The scene's fit to ``motion``'s body (its :attr:`~PoinsotScene.fitting`): what it
-        queues is held back, and sent through the cast, to this follower and to the followers
-        still showing the body this one showed (:meth:`FollowCast.share_fit`); dropped if the
-        cast has sent it this body already."""
-        member = self.member
-        if member is None:
-            yield
-            return
-        geometry = motion.geometry
-        before = self.cast.fitting(member, geometry)
-        with held_back(self.client) as messages:
-            try:
-                yield
-            except BaseException:
-                self.cast.forget_geometry(member)
-                raise
-        if messages is None:  # sent as ever
-            return
-        if before is geometry and updates_only(messages) and not member.socket.failed:
-            return  # its browser has this body: the messages would only repeat it
-        if not self.cast.share_fit(member, before, motion, messages):
-            # Sent as ever, after every window handed to it, so that no share older than
-            # its own fit is written after it.
-            member.socket.wait_written(FIT_WAIT)
-            queue_held(self.client, messages)
-
-    def moving(self) -> None:
-        """The lead's new body or scene is about to be opened (its frame thread): the first
-        follower of the cast to open it makes it, the others wait for it here
-        (:meth:`FollowCast.claim_move`); :meth:`worked` after its work."""
-        member = self.member
-        if member is not None and self._made is None:
-            self._made = self.cast.claim_move(member)
-
-    def worked(self) -> None:
-        """The session's work before its frame is done (its rebuild included): if it made the
-        lead's new body, the followers waiting for it go on."""
-        made, self._made = self._made, None
-        if made is not None:
-            made()

@@ -83,15 +83,15 @@ class LeadSession(links.LinkState, Protocol):
 class Mirror(Protocol):
     """What a follower changes on its frame thread to show the lead's state: its playback's
     speed range and trail, the panel's playback and show/hide rows, the motion's grid; and
-    :meth:`moving` before it opens the lead's new body or scene (the first follower of the
-    process makes it, the others wait for it: :mod:`.cast`)."""
+    :meth:`moving` before it opens the lead's new body or scene, the state's query (the first
+    follower of the process makes it, the others wait for it: :mod:`.cast`)."""
 
     @property
     def speed_range(self) -> tuple[float, float]: ...
     def set_trail(self, points: int) -> None: ...
     def show_playback(self, speed: float, paused: bool, trail: int) -> None: ...
     def show_visibility(self, visible: Callable[[Element], bool]) -> None: ...
-    def moving(self) -> None: ...
+    def moving(self, query: str) -> None: ...
     def regrid(self) -> None: ...
 
 
@@ -179,9 +179,11 @@ class LeadControls:
         set_value(self.follow, False)
 
     def _detach(self) -> None:
-        """Explore from here: the session's own clock goes on from the lead's time."""
+        """Explore from here: the session's own clock goes on from the lead's time, in the
+        lead's state now (a state taken just before the lead moved may still be on its way)."""
         if self.mode != "follow":
             return
+        self._sync()
         lead = self.hub.now()  # the lead's time (None before its first state)
         t = float(self.session.clock.now()) if lead is None else lead
         self._stop_following()
@@ -224,7 +226,7 @@ class LeadControls:
             return
         if state.query != self._applied_query:
             self._applied_query = state.query
-            self.mirror.moving()
+            self.mirror.moving(state.query)
             self._open(state.query)
         clock = session.clock
         if clock.paused != state.paused:

@@ -18,9 +18,9 @@ from poinsot.app.construction.cameras import RIDE_ALONG
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.view import DEFAULT_VIEW, View, apply_theme
 from poinsot.app.lessons.support.spec import SceneSpec
-from poinsot.app.live.classroom.cast import SharedFrames
 from poinsot.app.live.classroom.follow import FollowHub
 from poinsot.app.live.classroom.lead import LeadControls
+from poinsot.app.live.classroom.shared_frames import SharedFrames
 from poinsot.app.live.hardening.budget import RebuildGate
 from poinsot.app.live.hardening.pacing import Outbox, Pacer, SessionStats
 from poinsot.app.live.lecture.layout import Layout

@@ -18,7 +18,8 @@ import viser
 
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.sampled.batch import Frame
-from poinsot.app.live.classroom.cast import SharedFrames, Source
+from poinsot.app.live.classroom.cast import Source
+from poinsot.app.live.classroom.shared_frames import SharedFrames
 from poinsot.app.live.hardening.pacing import Pacer, SessionStats
 from poinsot.app.live.panel.clock import SimClock
 from poinsot.app.live.session.actions import ActionQueue
@@ -93,9 +94,9 @@ class FrameWork:
     def _rebuild(self) -> None:
         """Rebuild; a lead's new body or scene then goes to its followers at once, not after
         its next frame (up to a frame interval later, every follower's rebuild waiting). A
-        follower in the cast rebuilds through the gate its own frames pass (one at a time in
-        the process, :meth:`~poinsot.app.live.classroom.cast.SharedFrames.drawing`): a hall's
-        rebuilds after the lead's move would otherwise all want the interpreter at once."""
+        follower in the cast rebuilds through the gate its own frames pass, one at a time in
+        the process (:meth:`.classroom.shared_frames.SharedFrames.drawing`): a hall's rebuilds
+        after the lead's move would otherwise all want the interpreter at once."""
         with self.shared.drawing():
             self.build.rebuild(self.choice.showcase)
         self.publish.on_frame(time.monotonic())

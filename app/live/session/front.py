@@ -79,9 +79,9 @@ class Front:
         self.queue = queue
         #: Wakes the frame thread (set once the session's frame loop exists).
         self.wake: Callable[[], None] = lambda: None
-        #: A follower is about to open the lead's new body or scene (set by the builder:
-        #: :meth:`~..classroom.cast.SharedFrames.moving`).
-        self.moving: Callable[[], None] = lambda: None
+        #: A follower is about to open the lead's new body or scene, the state of this query
+        #: (set by the builder: :meth:`~..classroom.shared_frames.SharedFrames.moving`).
+        self.moving: Callable[[str], None] = lambda query: None
         #: The camera view chosen (the lecture tools', once mounted).
         self.camera_of: Callable[[], str] = lambda: "default"
         #: Run on the frame thread after a preset, or a scene, is shown (the layout reframes
@@ -255,9 +255,9 @@ class FollowerMirror:
     def show_visibility(self, visible: Callable[[Element], bool]) -> None:
         self._front._parts()[1].show_visibility(visible)
 
-    def moving(self) -> None:
-        """The lead's new body or scene is about to be opened."""
-        self._front.moving()
+    def moving(self, query: str) -> None:
+        """The lead's new body or scene (its state of ``query``) is about to be opened."""
+        self._front.moving(query)
 
     def regrid(self) -> None:
         """The clock's speed changed: the motion on the new grid."""
