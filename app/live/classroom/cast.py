@@ -31,7 +31,7 @@ node of that id only; a copy is the one msgpack with the id spliced in, then com
   (its sliders, traces, readouts). A member's :attr:`Member.geometry` says which body its
   browser was last sent (by the cast or its session), so that a share never takes a follower
   back to an older body; a fit of a lead's state left since its session took it is not sent
-  (:meth:`FollowCast.left_behind`); and every fit of a follower's goes through the cast's
+  (:meth:`FollowCast.share_fit`); and every fit of a follower's goes through the cast's
   path, in the order handed. Only node updates are shared, to followers drawing the same
   elements on the same nodes; a fit that makes or removes a node is its follower's own, sent
   as ever.
@@ -247,8 +247,9 @@ class FollowCast:
         self._wake.set()
 
     def hold(self, query: str) -> None:
-        """The lead's body or scene changed (any thread), to its state of ``query``: no frame
-        until no member poses a motion it poses now (each has rebuilt, or left), or
+        """The lead's state opens another body or scene, or is its first (any thread), of
+        ``query``: no frame until no member poses a motion it poses now (each has rebuilt, or
+        left), or
         :data:`MOVE_HOLD` has passed; and a new move begins, whose maker is the first member
         to open it (:meth:`claim_move`)."""
         with self._lock:
@@ -331,19 +332,6 @@ class FollowCast:
         with self._lock:
             member.geometry = None
 
-    def left_behind(self, member: Member, before: Any, geometry: Any, query: str | None) -> bool:
-        """Whether ``member``'s fit to ``geometry`` is of a lead's state (``query``) left since
-        its session took it (then waited for the move's maker and the interpreter): not sent,
-        its browser shows ``before`` (or a share's body), and its next rebuild follows. Handed
-        round, it took every browser back a move (a lead going back and forth brings the same
-        geometry back), each of their fits then all the others forth again."""
-        with self._lock:
-            if query == self.query:
-                return False
-            if member.geometry is geometry:  # no share took it elsewhere meanwhile
-                member.geometry = before
-            return True
-
     def share_fit(
         self, sender: Member, before: Any, motion: Motion, messages: list[Any], query: str | None
     ) -> bool:
@@ -351,17 +339,26 @@ class FollowCast:
         them as one window, encoded once, each its copy, to ``sender`` and to every other
         member whose browser was last sent ``before`` too (the same updates take it to the
         same body) on the same nodes, and pose those from ``motion`` from now on (their
-        sessions' rebuilds follow); only to ``sender`` if its fit is of a state (``query``) the
-        lead has left (:meth:`left_behind`). One path for all of them: every window a socket is
-        handed is written in the order handed. False (nothing handed) if ``messages`` are not
-        all node updates."""
+        sessions' rebuilds follow). One path for all of them: every window a socket is handed
+        is written in the order handed. False (nothing handed) if ``messages`` are not all
+        node updates.
+
+        Nothing is handed, not even to ``sender``, if its fit is of a lead's state (``query``)
+        left since its session took it (then waited for the move's maker and the interpreter):
+        its browser keeps ``before`` (or a share's body) and its next rebuild follows. Handed
+        round, such a fit took every browser back a move (a lead going back and forth brings
+        the same geometry back: the process keeps its motions), each of their fits then all
+        the others forth again."""
         source = sender.source
         if source is None or not messages or not updates_only(messages):
             return False
         geometry, layout = motion.geometry, source.layout
         with self._lock:  # handed in the order the members' geometries change
-            # else only the sender's: the same body, or the state of a move since overtaken
-            behind = before is not None and before is not geometry and query == self.query
+            if query != self.query:  # left behind: sent to nobody
+                if sender.geometry is geometry:  # no share took it elsewhere meanwhile
+                    sender.geometry = before
+                return True
+            behind = before is not None and before is not geometry  # else only the sender's
             targets = [
                 m
                 for m in self._members.values()

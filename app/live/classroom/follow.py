@@ -202,10 +202,8 @@ class FollowHub:
                     deposed, self._lead, self._lead_token = self._lead, None, ""
             elif kind == "state" and token.leader == self.token:
                 news = token.news(self.state)
-                if self.state is not None and token.query != self.state.query:
+                if self.state is None or token.query != self.state.query:
                     self.cast.hold(token.query)  # every follower rebuilds (:mod:`.cast`)
-                elif self.state is None:  # the first: what the followers' fits are of
-                    self.cast.query = token.query
                 self.state, self.gone = token, ""
                 self.delivered += 1
                 if not news:  # the same state again: the followers' clock is the hub's

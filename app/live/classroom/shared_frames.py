@@ -81,7 +81,7 @@ class SharedFrames:
         """The scene's fit to ``motion``'s body (its :attr:`~PoinsotScene.fitting`): what it
         queues is held back, and sent through the cast, to this follower and to the followers
         still showing the body this one showed (:meth:`FollowCast.share_fit`); dropped if the
-        cast has sent it this body already."""
+        cast has sent it this body already, or if the lead has left the state it is of."""
         member = self.member
         if member is None:
             yield
@@ -98,8 +98,6 @@ class SharedFrames:
             return
         if before is geometry and updates_only(messages) and not member.socket.failed:
             return  # its browser has this body: the messages would only repeat it
-        if updates_only(messages) and self.cast.left_behind(member, before, geometry, self._query):
-            return  # a fit of a state the lead has left: its next rebuild is of the one now
         if not self.cast.share_fit(member, before, motion, messages, self._query):
             # Sent as ever, after every window handed to it, so that no share older than
             # its own fit is written after it.

@@ -157,7 +157,7 @@ class Layout:
         self.framings = 0  # camera framings sent (tests)
         #: The canvas size [px] and the camera of the last framing (sent to the browser);
         #: ``client.camera`` mirrors what the browser reports, which can lag a framing.
-        self.framed: tuple[tuple[int, int] | None, View] | None = None
+        self.framed: tuple[tuple[int, int], View] | None = None
         self.header = ""  # the sheet's header last sent
         self._header_at = -1.0  # monotonic time it was
         session.client.camera.on_update(self._on_camera)
@@ -236,7 +236,7 @@ class Layout:
         else:
             chosen = framed(view, aspect, every)
         chosen.apply(self.session.client.camera)
-        self.framed = (self.size, chosen)
+        self.framed = ((width, height), chosen)
         self.framings += 1
 
     def show_header(self, now: float, t: float) -> None:
