@@ -199,14 +199,16 @@ def plot_waits(kinds: list[set[str]]) -> list[int]:
     """For each sending of the plot, the frames it waited past the first frame that could
     carry its samples (the later of the first sample's frame and PLOT_MIN_FRAMES after the last
     sending). In frames: the samples come by the clock, and how many come a frame is the
-    machine's."""
+    machine's. From the second sending counted on: the first's last sending was before the
+    count (a busy run read a first "wait" of 6 frames, the sending before it unseen)."""
     waits: list[int] = []
-    last_sent, pending = -PLOT_MIN_FRAMES, None
+    last_sent: int | None = None
+    pending: int | None = None
     for i, kind in enumerate(kinds):
         if "sample" in kind and pending is None:
             pending = i
         if "plot" in kind:
-            if pending is not None:  # (the first may carry a sample from before the count)
+            if last_sent is not None and pending is not None:
                 waits.append(i - max(pending, last_sent + PLOT_MIN_FRAMES))
             last_sent, pending = i, None
     return waits
