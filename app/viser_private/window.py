@@ -28,7 +28,13 @@ that queued it (``SceneApi._queue_scene_message``), and its client drops an upda
 a variant it does not show (``routeShadowedUpdate``). A client's own nodes are its id's, so a
 window for several clients differs in that id alone: :class:`OwnedWindow` serialises the
 messages once, with a marker for the owner, and makes each client's copy by splicing its id
-into that msgpack and compressing it (about 2 microseconds a copy against 20 for the window).
+into that msgpack. A copy of up to :data:`STORED_LIMIT` bytes is then *stored* in its zstd frame
+rather than compressed (:func:`stored_zstd`: a frame of raw blocks, which every zstd decoder,
+the client's included, reads as any other): zstd's compressor lets go of the interpreter for
+each call, and a thread that lets go of it while the process's other threads are busy waits a
+switch interval (5 ms) or more to have it back. The cast's thread, making 75 copies a frame
+while a lead's move rebuilds every follower of the process, then made its frames late and
+dropped a quarter of them (a follower's pose window is 440 bytes stored, 344 compressed).
 
 ``tests/app/test_viser_private.py`` checks that a window encoded here decodes to what viser's own
 producer sends for the same messages, each client's copy with its own id.
@@ -52,6 +58,12 @@ from poinsot.app.viser_private.transport import connection_of
 
 #: viser's compression level for a window (``_message_producer``).
 ZSTD_LEVEL = 1
+#: A client's copy of an owned window whose msgpack is at most this long [bytes] is stored in
+#: its zstd frame, not compressed (see the module's docstring).
+STORED_LIMIT = 4096
+#: zstd's frame magic number, and the largest block it allows [bytes].
+ZSTD_MAGIC = b"\x28\xb5\x2f\xfd"
+ZSTD_BLOCK = 128 * 1024
 
 _local = threading.local()
 
@@ -78,9 +90,31 @@ def _inner(messages: Sequence[Any]) -> tuple[bytes, list[memoryview]]:
     return inner, binary_buffers
 
 
-def _framed(inner: bytes, binary_buffers: Sequence[memoryview]) -> bytes:
-    """The bytes of a window: its msgpack's sizes, the msgpack compressed, its buffers."""
-    compressed = _compressor().compress(inner)
+def stored_zstd(data: bytes) -> bytes:
+    """``data`` in a zstd frame of raw (stored) blocks, made without the compressor (RFC 8878:
+    a single-segment frame header with the content size, blocks of at most
+    :data:`ZSTD_BLOCK` bytes, no checksum)."""
+    n = len(data)
+    if n < 256:
+        header = bytes((0x20, n))  # single segment, a 1-byte content size
+    elif n < 256 + 65536:
+        header = b"\x60" + (n - 256).to_bytes(2, "little")  # a 2-byte size, less 256
+    else:
+        header = b"\xa0" + n.to_bytes(4, "little")
+    parts = [ZSTD_MAGIC, header]
+    if n == 0:
+        parts.append(b"\x01\x00\x00")  # one empty raw block, the last
+    for start in range(0, n, ZSTD_BLOCK):
+        block = data[start : start + ZSTD_BLOCK]
+        last = start + ZSTD_BLOCK >= n
+        parts += [(len(block) << 3 | last).to_bytes(3, "little"), block]
+    return b"".join(parts)
+
+
+def _framed(inner: bytes, binary_buffers: Sequence[memoryview], stored: bool = False) -> bytes:
+    """The bytes of a window: its msgpack's sizes, the msgpack compressed (``stored``: in a
+    frame of raw blocks, :func:`stored_zstd`), its buffers."""
+    compressed = stored_zstd(inner) if stored else _compressor().compress(inner)
     parts: list[bytes | memoryview] = [
         len(inner).to_bytes(8, "little"),
         len(compressed).to_bytes(8, "little"),
@@ -121,7 +155,8 @@ class OwnedWindow:
             for message in self._messages:
                 message.owner = owner
             return encode_window(self._messages)
-        return _framed(msgspec.msgpack.encode(owner).join(self._pieces), self._buffers)
+        inner = msgspec.msgpack.encode(owner).join(self._pieces)
+        return _framed(inner, self._buffers, stored=len(inner) <= STORED_LIMIT)
 
 
 class WindowSocket:

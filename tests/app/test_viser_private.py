@@ -14,6 +14,7 @@ import threading
 import warnings
 from typing import Any
 
+import numpy as np
 import pytest
 import viser
 import websockets.asyncio.server
@@ -450,6 +451,47 @@ def test_a_window_for_many_clients_is_each_one_s_window_of_its_own_nodes():
         assert {m["owner"] for m in decoded} == {owner}
         np.testing.assert_array_equal(decoded[2]["updates"]["points"], points.ravel())
         assert ours[-points.nbytes :] == points.tobytes()
+
+
+@pytest.mark.parametrize("size", [0, 1, 255, 256, 65791, 65792, 128 * 1024, 300_001])
+def test_a_stored_zstd_frame_is_read_by_zstd_s_own_decoder(size):
+    """A frame of raw blocks made without the compressor (the followers' small copies) is a zstd
+    frame like any other: zstd's decoder reads it back, every size of its header's content
+    size and a block boundary crossed, and reports the content size it declares."""
+    import zstandard
+
+    data = bytes(np.random.default_rng(size).integers(0, 256, size, dtype=np.uint8))
+    frame = viser_private.window.stored_zstd(data)
+    assert zstandard.ZstdDecompressor().decompress(frame) == data
+    assert zstandard.frame_content_size(frame) == size
+    assert len(frame) - size <= 4 + 5 + 3 * max(1, -(-size // (128 * 1024)))  # no more than headers
+
+
+def test_a_follower_s_small_copy_is_stored_and_a_large_one_compressed():
+    """A client's copy of a small owned window (a pose: the cast's frames) is stored, not
+    compressed (no call that lets go of the interpreter); a large one is compressed as viser
+    compresses it; both decode to the same messages for that client."""
+    from poinsot.app.devtools.probe import decode_frame
+
+    def window(n: int) -> viser_private.OwnedWindow:
+        points = np.zeros((n, 2, 3), dtype=np.float32)
+        return viser_private.OwnedWindow(
+            [
+                viser_private.orientation_message("/space/body", (0.5, 0.5, 0.5, 0.5)),
+                viser_private.props_message("/space/omega", {"colors": points.tolist()}),
+            ]
+        )
+
+    small, large = window(1).bytes_for("42"), window(400).bytes_for("42")
+    for frame, stored in ((small, True), (large, False)):
+        size, compressed = _header(frame)
+        body = frame[16 : 16 + compressed]
+        assert (size <= viser_private.window.STORED_LIMIT) is stored
+        # A stored frame's first block is raw (type 0) and holds the whole msgpack.
+        first_block = int.from_bytes(body[6 if size < 256 else 7 :][:3], "little")
+        assert ((first_block >> 1) & 3 == 0 and compressed > size) is stored
+        assert {m["owner"] for m in decode_frame(frame)} == {"42"}
+        assert _inner(frame)["messages"][0]["name"] == "/space/body"
 
 
 def test_the_cast_of_a_property_is_viser_s_own_for_every_hint_of_its_nodes_and_widgets():
