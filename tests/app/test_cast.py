@@ -495,6 +495,7 @@ def test_a_new_body_goes_only_to_followers_showing_the_body_its_maker_showed():
     update = props_message("/space/body/ellipsoid", {"scale": (1.0, 0.8, 0.6)})
     assert cast.share_fit(sender, geometry[0], motions[1], [update], cast.query)
     assert behind.geometry is geometry[1] and behind.source.motion is motions[1]
+    assert sender.source.motion is motions[1]  # posed from the new body at once, as the others
     assert newer.geometry is geometry[2] and unknown.geometry is None
     assert elsewhere.geometry is geometry[0] and elsewhere.source.motion is motions[0]
     handed = [socket for call in loop.calls for socket, _ in call[0]]
@@ -520,9 +521,13 @@ def test_a_fit_of_a_state_the_lead_has_left_goes_to_nobody():
     update = props_message("/space/body/ellipsoid", {"scale": (1.0, 0.8, 0.6)})
     for query, motion in (("I=1,1.9,3", b), ("I=1,1.7,3", a)):  # to B, and back to A
         cast.hold(query)
+        assert cast._holding(list(cast._members.values()))
         before = cast.fitting(maker, motion.geometry)
         assert cast.share_fit(maker, before, motion, [update], query)
         assert late.geometry is motion.geometry and other.geometry is motion.geometry
+        # Every browser shows the new body, the maker's too: the hold ends with the share
+        # (not with the maker's own rebuild, which the move's latency does not wait for).
+        assert not cast._holding(list(cast._members.values()))
     calls, fits = len(loop.calls), cast.fits
     before = cast.fitting(late, b.geometry)  # its fit of the move to B, late
     assert cast.share_fit(late, before, b, [update], "I=1,1.9,3")  # taken care of: no window

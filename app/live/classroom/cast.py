@@ -338,8 +338,9 @@ class FollowCast:
         """``sender`` fitted its drawings to ``motion``'s body, holding back ``messages``: hand
         them as one window, encoded once, each its copy, to ``sender`` and to every other
         member whose browser was last sent ``before`` too (the same updates take it to the
-        same body) on the same nodes, and pose those from ``motion`` from now on (their
-        sessions' rebuilds follow). One path for all of them: every window a socket is handed
+        same body) on the same nodes, and pose all of them from ``motion`` from now on (their
+        sessions' rebuilds follow; a move's hold, :meth:`hold`, ends once the maker's share
+        has taken every member to the new body, not once its own rebuild is over). One path for all of them: every window a socket is handed
         is written in the order handed. False (nothing handed) if ``messages`` are not all
         node updates.
 
@@ -370,10 +371,11 @@ class FollowCast:
             ]
             for member in targets:
                 member.geometry = geometry
+            members = [sender, *targets]
+            for member in members:  # the sender too: its rebuild's own part may take a while
                 if member.source is not None:
                     member.source = dataclasses.replace(member.source, motion=motion)
             window = OwnedWindow(messages)
-            members = [sender, *targets]
             send_each([(m.socket, window.bytes_for(m.owner)) for m in members])
             self.fits += 1
             self.fit_copies += len(targets)
