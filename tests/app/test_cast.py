@@ -7,6 +7,7 @@ keeps, never on wall-clock time.
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import threading
 from types import SimpleNamespace
 
@@ -23,6 +24,7 @@ from poinsot.app.live.classroom.cast import (
     Source,
     own_fps,
 )
+from poinsot.app.live.classroom.shared_frames import SharedFrames
 from poinsot.app.model.elements import Element
 from poinsot.app.viser_private import props_message, wire_message
 from tests.app.test_follow import D, _follow, _lead, _ready, _says, _set
@@ -533,3 +535,34 @@ def test_a_fit_of_a_state_the_lead_has_left_goes_to_nobody():
     assert cast.share_fit(late, before, b, [update], "I=1,1.9,3")  # taken care of: no window
     assert late.geometry is a.geometry and other.geometry is a.geometry
     assert len(loop.calls) == calls and cast.fits == fits
+
+
+def test_a_late_rebuild_of_a_left_state_keeps_its_follower_posed_from_the_body_it_shows():
+    """The follower whose fit of a left state went to nobody (above) ends its rebuild of that
+    state: the cast goes on posing it from the body its browser shows, not from the left
+    state's (its body would turn as the other one does; and the next move to that state would
+    find a member posing the new motion already, and hold every frame for its whole bound)."""
+    a, b = SimpleNamespace(geometry=object()), SimpleNamespace(geometry=object())
+    loop = _Loop()
+    cast = FollowCast(lambda: None)
+    source = Source(a, "/space/body", "/space/tip", None, frozenset({Element.ELLIPSOID}))
+    late, maker, other = (_member(_Socket(loop), source, a.geometry) for _ in range(3))
+    cast._members.update(enumerate((late, maker, other)))
+    update = props_message("/space/body/ellipsoid", {"scale": (1.0, 0.8, 0.6)})
+    for query, motion in (("I=1,1.9,3", b), ("I=1,1.7,3", a)):  # to B, and back to A
+        cast.hold(query)
+        assert cast.share_fit(maker, cast.fitting(maker, motion.geometry), motion, [update], query)
+    assert cast.share_fit(late, cast.fitting(late, b.geometry), b, [update], "I=1,1.9,3")
+    frames = SharedFrames.__new__(SharedFrames)  # its session's side, its rebuild of B over
+    frames.cast, frames.member, frames.pacer = cast, late, SimpleNamespace(cap=None)
+    frames.update(dataclasses.replace(source, motion=b))
+    assert late.source.motion is a and late.geometry is a.geometry
+    # The lead to B again: the cast holds its frames until B's maker has handed B round.
+    cast.hold("I=1,1.9,3b")
+    assert cast._holding(list(cast._members.values()))
+    before = cast.fitting(maker, b.geometry)
+    assert cast.share_fit(maker, before, b, [update], "I=1,1.9,3b")
+    assert not cast._holding(list(cast._members.values()))
+    # A rebuild whose body its browser was sent (its own fit, or a share's): posed from it.
+    frames.update(dataclasses.replace(source, motion=b))
+    assert late.source.motion is b

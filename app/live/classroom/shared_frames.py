@@ -63,6 +63,18 @@ class SharedFrames:
             self.scene.send_pose = False
             self.scene.fitting = self._fitting
         self.pacer.cap = own_fps(self.cast.members)
+        shown = member.source
+        if (
+            shown is not None
+            and member.geometry is not source.motion.geometry
+            and shown.motion.geometry is member.geometry
+            and shown.layout == source.layout
+        ):
+            # Its rebuild was of a lead's state left since, whose fit the cast did not send:
+            # its browser shows the body a share took it to, posed from that body's motion
+            # (posed from this one, it would turn wrongly, and hold the next move's frames:
+            # :meth:`FollowCast.hold`), until its next rebuild.
+            return
         member.source = source
 
     def leave(self) -> None:
