@@ -340,9 +340,9 @@ class FollowCast:
         member whose browser was last sent ``before`` too (the same updates take it to the
         same body) on the same nodes, and pose all of them from ``motion`` from now on (their
         sessions' rebuilds follow; a move's hold, :meth:`hold`, ends once the maker's share
-        has taken every member to the new body, not once its own rebuild is over). One path for all of them: every window a socket is handed
-        is written in the order handed. False (nothing handed) if ``messages`` are not all
-        node updates.
+        has taken every member to the new body, not once its own rebuild is over). One path
+        for all of them: every window a socket is handed is written in the order handed.
+        False (nothing handed) if ``messages`` are not all node updates.
 
         Nothing is handed, not even to ``sender``, if its fit is of a lead's state (``query``)
         left since its session took it (then waited for the move's maker and the interpreter):
