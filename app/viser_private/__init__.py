@@ -83,7 +83,8 @@ Inventory (section, private name, what it is used for):
     ``Message.as_serializable_dict``, zstd level 1): a window of messages encoded once and
     written to many clients' connections (the followers' shared frames), each client's copy
     with the owner id viser stamps on its own scene's messages (``SceneApi._owner_id``, the
-    ``owner`` field its client routes a node's updates by), in one call on their
+    ``owner`` field its client routes a node's updates by; a small copy stored in its zstd
+    frame, raw blocks, rather than compressed), in one call on their
     loop, each as websockets' ``ServerConnection.send`` writes a message, without its task: the
     connection's Sans-I/O ``protocol.send_binary`` and its ``send_data``, ``paused`` (flow
     control), ``drain`` and ``send_in_progress`` (:func:`encode_window`, :class:`OwnedWindow`,
