@@ -508,12 +508,23 @@ def test_a_new_body_goes_only_to_followers_showing_the_body_its_maker_showed():
     assert behind.geometry is geometry[1] and len(loop.calls) == 1
 
 
-def test_a_fit_of_a_state_the_lead_has_left_goes_to_nobody():
-    """A lead going back and forth between two bodies (A, B, A: the process keeps their
-    motions, so A's geometry comes back). A follower whose session took the state of the move
-    to B, and fits B after the move back to A was handed round, sends nothing: its browser
-    shows A, as every other (a fit handed round would take them all back to B, each of their
-    own fits then all the others forth again); its next rebuild is of A."""
+@dataclasses.dataclass
+class _Hall:
+    """A cast of three followers showing body A (``late``, ``maker``, ``other``), a lead's
+    two bodies' motions ``a`` and ``b``, and a fit's node update."""
+
+    a: SimpleNamespace
+    b: SimpleNamespace
+    loop: _Loop
+    cast: FollowCast
+    source: Source
+    late: Member
+    maker: Member
+    other: Member
+    update: object
+
+
+def _hall_on_a() -> _Hall:
     a, b = SimpleNamespace(geometry=object()), SimpleNamespace(geometry=object())
     loop = _Loop()
     cast = FollowCast(lambda: None)
@@ -521,6 +532,18 @@ def test_a_fit_of_a_state_the_lead_has_left_goes_to_nobody():
     late, maker, other = (_member(_Socket(loop), source, a.geometry) for _ in range(3))
     cast._members.update(enumerate((late, maker, other)))
     update = props_message("/space/body/ellipsoid", {"scale": (1.0, 0.8, 0.6)})
+    return _Hall(a, b, loop, cast, source, late, maker, other, update)
+
+
+def test_a_fit_of_a_state_the_lead_has_left_goes_to_nobody():
+    """A lead going back and forth between two bodies (A, B, A: the process keeps their
+    motions, so A's geometry comes back). A follower whose session took the state of the move
+    to B, and fits B after the move back to A was handed round, sends nothing: its browser
+    shows A, as every other (a fit handed round would take them all back to B, each of their
+    own fits then all the others forth again); its next rebuild is of A."""
+    hall = _hall_on_a()
+    a, b, loop, cast = hall.a, hall.b, hall.loop, hall.cast
+    late, maker, other, update = hall.late, hall.maker, hall.other, hall.update
     for query, motion in (("I=1,1.9,3", b), ("I=1,1.7,3", a)):  # to B, and back to A
         cast.hold(query)
         assert cast._holding(list(cast._members.values()))
@@ -542,13 +565,9 @@ def test_a_late_rebuild_of_a_left_state_keeps_its_follower_posed_from_the_body_i
     state: the cast goes on posing it from the body its browser shows, not from the left
     state's (its body would turn as the other one does; and the next move to that state would
     find a member posing the new motion already, and hold every frame for its whole bound)."""
-    a, b = SimpleNamespace(geometry=object()), SimpleNamespace(geometry=object())
-    loop = _Loop()
-    cast = FollowCast(lambda: None)
-    source = Source(a, "/space/body", "/space/tip", None, frozenset({Element.ELLIPSOID}))
-    late, maker, other = (_member(_Socket(loop), source, a.geometry) for _ in range(3))
-    cast._members.update(enumerate((late, maker, other)))
-    update = props_message("/space/body/ellipsoid", {"scale": (1.0, 0.8, 0.6)})
+    hall = _hall_on_a()
+    a, b, cast, source = hall.a, hall.b, hall.cast, hall.source
+    late, maker, update = hall.late, hall.maker, hall.update
     for query, motion in (("I=1,1.9,3", b), ("I=1,1.7,3", a)):  # to B, and back to A
         cast.hold(query)
         assert cast.share_fit(maker, cast.fitting(maker, motion.geometry), motion, [update], query)
