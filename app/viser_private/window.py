@@ -61,7 +61,8 @@ ZSTD_LEVEL = 1
 #: A client's copy of an owned window whose msgpack is at most this long [bytes] is stored in
 #: its zstd frame, not compressed (see the module's docstring).
 STORED_LIMIT = 4096
-#: zstd's frame magic number, and the largest block it allows [bytes].
+#: zstd's frame magic number, and the largest block it allows [bytes] (more than
+#: :data:`STORED_LIMIT`: a stored copy is one block).
 ZSTD_MAGIC = b"\x28\xb5\x2f\xfd"
 ZSTD_BLOCK = 128 * 1024
 
@@ -91,24 +92,20 @@ def _inner(messages: Sequence[Any]) -> tuple[bytes, list[memoryview]]:
 
 
 def stored_zstd(data: bytes) -> bytes:
-    """``data`` in a zstd frame of raw (stored) blocks, made without the compressor (RFC 8878:
-    a single-segment frame header with the content size, blocks of at most
-    :data:`ZSTD_BLOCK` bytes, no checksum)."""
+    """``data`` (at most :data:`ZSTD_BLOCK` bytes) in a zstd frame of one raw (stored) block,
+    made without the compressor (RFC 8878: a single-segment frame header with the content
+    size, no checksum)."""
     n = len(data)
+    if n > ZSTD_BLOCK:
+        raise ValueError(f"{n} bytes do not fit one zstd block ({ZSTD_BLOCK})")
     if n < 256:
         header = bytes((0x20, n))  # single segment, a 1-byte content size
     elif n < 256 + 65536:
         header = b"\x60" + (n - 256).to_bytes(2, "little")  # a 2-byte size, less 256
     else:
         header = b"\xa0" + n.to_bytes(4, "little")
-    parts = [ZSTD_MAGIC, header]
-    if n == 0:
-        parts.append(b"\x01\x00\x00")  # one empty raw block, the last
-    for start in range(0, n, ZSTD_BLOCK):
-        block = data[start : start + ZSTD_BLOCK]
-        last = start + ZSTD_BLOCK >= n
-        parts += [(len(block) << 3 | last).to_bytes(3, "little"), block]
-    return b"".join(parts)
+    block = (n << 3 | 1).to_bytes(3, "little")  # raw (type 0), the last
+    return b"".join((ZSTD_MAGIC, header, block, data))
 
 
 def _framed(inner: bytes, binary_buffers: Sequence[memoryview], stored: bool = False) -> bytes:

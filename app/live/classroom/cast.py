@@ -36,10 +36,10 @@ node of that id only; a copy is the one msgpack with the id spliced in, then com
   elements on the same nodes; a fit that makes or removes a node is its follower's own, sent
   as ever.
 - The lead's new body or scene is a rebuild in every follower: the cast then holds its frames
-  (:meth:`FollowCast.hold`) until every follower it poses has rebuilt (poses another motion)
-  or :data:`MOVE_HOLD` has passed, so that the rebuilds have the interpreter to themselves
-  and the move reaches the last follower of a hall sooner (the poses of the old body would be
-  outdated by then anyway).
+  (:meth:`FollowCast.hold`) until every follower it poses poses another motion (the maker's
+  share took it to the new body, or it rebuilt) or :data:`MOVE_HOLD` has passed, so that the
+  rebuilds have the interpreter to themselves and the move reaches the last follower of a hall
+  sooner (the poses of the old body would be outdated by then anyway).
 - A follower whose frame is not the lead's falls back to its own frames at its own rate at once
   (its session calls :meth:`.shared_frames.SharedFrames.update` with None): the lead shows a
   lecture scene (its frame is the scene's own drawing), the follower's ghost is on, its camera
@@ -248,10 +248,9 @@ class FollowCast:
 
     def hold(self, query: str) -> None:
         """The lead's state opens another body or scene, or is its first (any thread), of
-        ``query``: no frame until no member poses a motion it poses now (each has rebuilt, or
-        left), or
-        :data:`MOVE_HOLD` has passed; and a new move begins, whose maker is the first member
-        to open it (:meth:`claim_move`)."""
+        ``query``: no frame until no member poses a motion it poses now (a share took it to
+        the new body, it rebuilt, or it left), or :data:`MOVE_HOLD` has passed; and a new move
+        begins, whose maker is the first member to open it (:meth:`claim_move`)."""
         with self._lock:
             self.query = query
             old = {id(m.source.motion): m.source.motion for m in self._members.values() if m.source}
