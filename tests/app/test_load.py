@@ -322,6 +322,23 @@ def test_the_follow_figures_are_the_95th_percentile_of_the_redraws_not_the_slowe
     assert other.value == pytest.approx(95.0)
 
 
+def test_a_hall_on_two_hosts_is_held_to_the_hall_s_rate():
+    """The two-host phase holds its rows as the one-host phase does: 300 followers at 25 fps
+    each meet a hall's 24; 150 at 25 miss a class's 30."""
+    outage = {"recovery": [1.0], "lost": 0, "early": 0, "told": 1, "others": 1, "refused": 0}
+    outage |= {"links_lost": 1, "told_s": 0.5}
+    load = following.Load(0.5, 0.5, 1)
+    bounds = Bounds()
+    for count, verdict, goal in ((300, "met", ">= 24 fps"), (150, "MISSED", ">= 30 fps")):
+        moving = {"fps": [25.0] * count, "latencies": [0.05] * count, "moves": 1}
+        moving["redraws"] = [[0.05] * count]
+        name = f"2 hosts, {count} followers"
+        figures = hosts_workload._figures(name, [1] * count, moving, moving, 0.1, outage, load)
+        fps = next(f for f in figures if f.name == f"{name}: fps each")
+        assert fps.goal is not None and fps.goal.describe(bounds) == goal
+        assert fps.verdict(bounds) == verdict
+
+
 @pytest.mark.slow
 def test_the_follow_phase_on_two_hosts_follows_through_redis_and_recovers(hosts_report):
     """Half the followers are on the other host: every lead's move reaches them through Redis,

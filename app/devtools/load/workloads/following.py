@@ -201,6 +201,12 @@ def _ms_per_move(cpu: float, still_cores: float, moving: dict, followers: int) -
     return 1e3 * extra / moves if moves else math.nan
 
 
+def fps_bound(count: int) -> str:
+    """The bound a row of ``count`` followers' frame rates is held to: ``Bounds.min_fps``, or
+    ``Bounds.min_hall_fps`` in a hall (more than ``HALL`` followers), on one host or several."""
+    return "min_hall_fps" if count > HALL else "min_fps"
+
+
 def _figures(
     count: int,
     following: dict,
@@ -229,7 +235,7 @@ def _figures(
     judged = load.limit == "server"
     if not judged:
         text += f"; limited by the {load.limit}, not the server: not judged"
-    bound = "min_hall_fps" if count > HALL else "min_fps"
+    bound = fps_bound(count)
     return [
         Figure(
             "follow",
