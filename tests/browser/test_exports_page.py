@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import io
 import re
+import threading
 
 import numpy as np
 import pytest
@@ -187,7 +188,9 @@ def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_p
 
 
 def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
-    page = open_page(poinsot_app.url, width=960, height=540)
+    # A laptop's page: with large text its docked columns still leave the picture between them
+    # wide enough (at 960 x 540 they leave 135 px, and the page is laid out compact).
+    page = open_page(poinsot_app.url, width=1280, height=720)
     session = started_session(poinsot_app)
     lecture = lecture_of(session)
     camera = session.client.camera
@@ -257,11 +260,20 @@ def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     # Large text: the root font size (all panel text is in rem) grows.
     root = "parseFloat(getComputedStyle(document.documentElement).fontSize)"
     before = page.page.evaluate(root)
+    layout = session.layout
+    assert layout is not None and layout.size is not None and not layout.compact
+    picture = layout.size  # the canvas between the docked columns, as the browser reports it
     page.set_checkbox("Large text", True)
     grown = before * LARGE_TEXT_PERCENT / 100
     assert wait_until(lambda: page.page.evaluate(root) >= grown - 0.5, 10), before
-    # The panel's labels follow (in one reading: while the panel is laid out again for the
-    # larger text, a label can be absent for a moment; 0 then).
+    # The columns widen with the text: the browser reports the narrower picture, and once the
+    # session has taken that report (an action posted after it runs after it), the page is
+    # still docked, not folded compact.
+    assert wait_until(lambda: layout.size is not None and layout.size[0] < picture[0], 10)
+    taken = threading.Event()
+    session.post(taken.set)
+    assert taken.wait(10) and not layout.compact, (picture, layout.size)
+    # The panel's labels follow.
     label = (
         "(() => { const l = [...document.querySelectorAll('label')].find("
         "l => l.textContent === 'Dark theme');"
