@@ -189,7 +189,7 @@ def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_p
 
 def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     # A laptop's page: with large text its docked columns still leave the picture between them
-    # wide enough (at 960 x 540 they leave 135 px, and the page is laid out compact).
+    # wide enough (at 960 x 540 they leave 127 px, and the page is laid out compact).
     page = open_page(poinsot_app.url, width=1280, height=720)
     session = started_session(poinsot_app)
     lecture = lecture_of(session)
