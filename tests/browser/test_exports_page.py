@@ -189,8 +189,11 @@ def test_screenshot_button_downloads_pngs_of_the_chosen_size(poinsot_app, open_p
 
 def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     # A laptop's page: with large text its docked columns still leave the picture between them
-    # wide enough (at 960 x 540 they leave 127 px, and the page is laid out compact).
-    page = open_page(poinsot_app.url, width=1280, height=720)
+    # wide enough (at 960 x 540 they leave 127 px, and the page is laid out compact). Its pixel
+    # ratio held: the theme's pixels are read from two pictures (viser otherwise lowers the
+    # ratio of a page that draws few frames, and a canvas resized shows nothing until its next
+    # frame: once, its whole bottom row read grey 49 where the background reads 20).
+    page = open_page(poinsot_app.url + "?fixedDpr=1", width=1280, height=720)
     session = started_session(poinsot_app)
     lecture = lecture_of(session)
     camera = session.client.camera
@@ -247,6 +250,8 @@ def test_keys_cameras_theme_and_text_size(poinsot_app, open_page):
     assert wait_until(near(side.position), 10), ("side view", camera.position, side.position)
     # Theme: the page's background turns light.
     page.page.keyboard.press("Space")
+    assert wait_until(lambda: session.clock.paused, 30), "space did not pause"
+    page.drawn_after(session.client)  # the side view's picture, drawn
     # The darkest pixel of the 3D view's bottom row is its background (the side view may
     # frame the plane down to the edge; the panels may have docked since the first box).
     box = page.canvas_box()
