@@ -196,10 +196,12 @@ def test_a_process_s_followers_draw_their_own_frames_one_at_a_time(poinsot_app, 
     assert any(not shared for shared, _ in held[id(detached)])
 
 
-def test_a_process_s_followers_rebuild_the_lead_s_move_one_at_a_time(poinsot_app, make_probe):
+def test_a_process_s_followers_rebuild_the_lead_s_move_one_at_a_time_but_its_maker(
+    poinsot_app, make_probe
+):
     """After the lead's move every follower of the process rebuilds: each holds the gate its
-    own frames pass (the cast's thread then waits for one, not for all); the lead, no
-    follower, rebuilds without it."""
+    own frames pass (the cast's thread then waits for one, not for all), but for the move's
+    maker, whom the others wait for; the lead, no follower, rebuilds without it."""
     lead, _, _, sessions = _class(poinsot_app, make_probe, followers=3)
     cast = poinsot_app.follow.cast
     gate = cast.draw_gate = _OwnedGate(cast.draw_gate)  # type: ignore[assignment]
@@ -215,9 +217,46 @@ def test_a_process_s_followers_rebuild_the_lead_s_move_one_at_a_time(poinsot_app
         session.build.rebuild = recording
     _set(lead, D, 2.3)
     assert wait_until(lambda: all(held[id(s)] for s in everyone), 30), held
-    assert all(all(held[id(s)]) for s in sessions), held  # the followers': inside
+    # Each follower's rebuild of the move: the maker's outside, the two others' inside.
+    assert sorted(held[id(s)][0] for s in sessions) == [False, True, True], held
     (leader,) = [s for s in everyone if s not in sessions]
     assert not any(held[id(leader)]), held[id(leader)]  # the lead's: outside
+
+
+def test_the_lead_s_move_reaches_every_follower_while_their_gate_is_taken(
+    poinsot_app, make_probe, monkeypatch
+):
+    """The gate the followers' own frames pass is no queue: in a hall, the move's maker waited
+    there behind the others' frames (up to 2 s in a worker of 150) while the others waited for
+    it. With the gate taken for the whole move (here by the test), the maker still makes the
+    new body and hands it to every follower."""
+    monkeypatch.setattr(cast_module, "MAKER_WAIT", 60.0)  # none makes its own meanwhile
+    lead, probes, _, sessions = _class(poinsot_app, make_probe, followers=3)
+    cast = poinsot_app.follow.cast
+    sizes = [Sizes(p) for p in probes]
+    fits = cast.fits
+    with cast.draw_gate:
+        _set(lead, "I₂", 1.8)
+        assert wait_until(lambda: all(z.scales for z in sizes), 30), [z.scales for z in sizes]
+        assert cast.fits == fits + 1
+    meshes = [s.scene.drawing(Element.ELLIPSOID).mesh for s in sessions]
+    assert wait_until(lambda: all(s.build.body is not None for s in sessions), 30)
+    for size, mesh in zip(sizes, meshes, strict=True):
+        assert wait_until(lambda z=size, m=mesh: np.allclose(z.scales[-1], m.scale), 30)
+
+
+def test_the_cast_draws_nothing_while_a_session_of_its_process_rebuilds(poinsot_app, make_probe):
+    """A session's own rebuild (the lead's move among them) holds the other sessions' frames
+    (:class:`~poinsot.app.live.hardening.budget.RebuildGate`), the followers' shared ones
+    too: they come again once it ends."""
+    _, _, frames, sessions = _class(poinsot_app, make_probe)
+    cast = poinsot_app.follow.cast
+    with poinsot_app.budget.rebuild():
+        held, handed = cast.held, cast.handed
+        assert wait_until(lambda: cast.held >= held + 3, 30)
+        assert cast.handed <= handed + len(sessions)  # one tick's may have been under way
+    starts = [len(f) for f in frames]
+    assert wait_until(lambda: all(len(f) >= s + 2 for f, s in zip(frames, starts, strict=True)), 30)
 
 
 class _Stuck:

@@ -34,7 +34,8 @@ class SharedFrames:
         #: Makes its frame loop's next frame due at once (set once the loop exists).
         self.draw_now: Callable[[], None] = lambda: None
         self.member: Member | None = None
-        self._made: Callable[[], None] | None = None  # called once its move is made
+        self._claimed = False  # it has asked for the lead's move since its last work
+        self._made: Callable[[], None] | None = None  # its maker's: called once it is made
         self._query: str | None = None  # the lead's state it last opened
 
     @property
@@ -46,8 +47,14 @@ class SharedFrames:
         rebuild one at a time (:attr:`FollowCast.draw_gate`). A hall's hundred frame threads
         would otherwise all want the interpreter at once (after the lead's move, all
         rebuilding), and the cast's thread, which poses them all, waits behind them; one at a
-        time, it waits for one."""
-        return self.cast.draw_gate if self.member is not None else contextlib.nullcontext()
+        time, it waits for one. The maker of the lead's move (:meth:`FollowCast.claim_move`)
+        passes: every other follower waits for its new body, and the gate is no queue (a
+        lock's next holder is whichever thread the system wakes first): in a hall of 150 a
+        worker, wanted by the others' own frames and by the rebuilds of those that had waited
+        long enough, it kept the maker from the new body 0.2 to 2 s after the move."""
+        if self.member is None or self._made is not None:
+            return contextlib.nullcontext()
+        return self.cast.draw_gate
 
     def update(self, source: Source | None) -> None:
         """Join the cast with ``source``, or leave it at once (None)."""
@@ -121,12 +128,13 @@ class SharedFrames:
         frame thread): the first follower of the cast to open it makes it, the others wait for
         it here (:meth:`FollowCast.claim_move`); :meth:`worked` after its work."""
         member, self._query = self.member, query
-        if member is not None and self._made is None:
+        if member is not None and not self._claimed:
+            self._claimed = True
             self._made = self.cast.claim_move(member)
 
     def worked(self) -> None:
         """The session's work before its frame is done (its rebuild included): if it made the
         lead's new body, the followers waiting for it go on."""
-        made, self._made = self._made, None
+        made, self._made, self._claimed = self._made, None, False
         if made is not None:
             made()
