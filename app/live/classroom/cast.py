@@ -82,8 +82,11 @@ CAST_FPS = 40.0
 #: and at least; a process's followers share OWN_PROCESS_FRAMES of them a second between them
 #: (:func:`own_fps`): each own frame costs about a session's frame, so their sum must not grow
 #: with the hall, up to 240 followers a process (OWN_MIN_FPS: a follower's traces and clock
-#: then move every 2 s; its body, posed by the cast, still turns at the cast's rate).
-OWN_FPS = 6.0
+#: then move every 2 s; its body, posed by the cast, still turns at the cast's rate). At 6 a
+#: second, a worker's own frames were most of its followers' cost in a class of 30 on two
+#: workers (0.17 to 0.19 ms of the server's CPU per follower-frame, 3.2 to 3.5 times below a
+#: session-frame); at 3, 0.14 to 0.15 ms, 4.1 to 4.4 times below (four runs).
+OWN_FPS = 3.0
 OWN_MIN_FPS = 0.5
 OWN_PROCESS_FRAMES = 120.0
 #: A follower's unacknowledged bytes are read every this many of the cast's frames.

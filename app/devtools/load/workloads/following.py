@@ -262,11 +262,13 @@ def _figures(
 def _cost_figure(name: str, costs: tuple[float, float, float], own: dict, explored: bool) -> Figure:
     """The figure "``name``: server CPU per frame" (and per follower a lead's move)."""
     follow_ms, own_ms, move_ms = costs
+    ratio = own_ms / follow_ms if follow_ms > 0 else math.nan
     return info(
         "follow",
         f"{name}: server CPU per frame",
         f"{follow_ms:.2f} ms per follower-frame, {own_ms:.2f} ms per session-frame "
-        f"(the same clients after Explore from here, {own_fps_text(own)}; nothing moved); "
+        f"({ratio:.1f} times as much; the same clients after Explore from here, "
+        f"{own_fps_text(own)}; nothing moved); "
         f"a lead's move {move_ms:.2f} ms per follower (the moving window beyond the still)",
         follower_ms=follow_ms,
         session_ms=own_ms,
