@@ -252,13 +252,38 @@ def test_the_phase_says_who_limits_the_frame_rates(monkeypatch, server, clients,
     assert ("not the server" in load.text()) == (limit != "server")
 
 
-def _hall_fps(count: int, fps: list[float], moving: following.Moving) -> Figure:
-    """The "fps each" figure of a row of ``count`` followers that drew ``fps`` while the lead
-    moved, the machine as ``moving`` says, its clients' two processes at 0.7 cores."""
-    window = {"fps": fps, "latencies": [0.05] * count, "redraws": [[0.05] * count], "moves": 1}
+def _row(
+    count: int, fps: list[float], moving: following.Moving, latency: float = 0.05
+) -> list[Figure]:
+    """The figures of a row of ``count`` followers that drew ``fps`` while the lead moved (each
+    redrew its move after ``latency`` seconds), the machine as ``moving`` says, its clients' two
+    processes at 0.7 cores."""
+    window = {"fps": fps, "latencies": [latency] * count, "moves": 1}
+    window["redraws"] = [[latency] * count]
     load = following.Load(0.5, 0.7, 2, moving)
-    figures = following._figures(count, window, window, window, (0.1, 0.5, 1.0), True, load)
-    return next(f for f in figures if f.name == f"{count} followers: fps each")
+    return following._figures(count, window, window, window, (0.1, 0.5, 1.0), True, load)
+
+
+def _hall_fps(count: int, fps: list[float], moving: following.Moving) -> Figure:
+    """The "fps each" figure of :func:`_row`."""
+    return next(f for f in _row(count, fps, moving) if f.name == f"{count} followers: fps each")
+
+
+def test_a_hall_s_move_is_held_to_the_hall_s_bound():
+    """The lead's move on every follower, p95: a class of 150 within 150 ms, a hall of 300
+    within 250 (the issue holds only 150 followers to 150 ms; a hall of 300 fills this 2-core
+    machine, its clients half of it)."""
+    bounds = Bounds()
+    moving = following.Moving(1.8, 30.0 * 300, 300, 2)
+    for count, latency, goal, verdict in (
+        (150, 0.2, "p95 <= 150 ms", "MISSED"),
+        (300, 0.2, "p95 <= 250 ms", "met"),
+        (300, 0.3, "p95 <= 250 ms", "MISSED"),
+    ):
+        figures = _row(count, [30.0] * count, moving, latency)
+        move = next(f for f in figures if f.name.endswith("lead's slider move on every follower"))
+        assert move.goal is not None and move.goal.describe(bounds) == goal
+        assert move.verdict(bounds) == verdict, (count, latency)
 
 
 def test_a_hall_below_its_rate_is_the_clients_limit_only_where_the_server_alone_would_not_be(
@@ -385,8 +410,8 @@ def test_met_bounds_give_zero_and_each_impossible_bound_gives_one(
 ):
     # The tiny follow run has no hall: a row of 300 followers at 25 fps, its server in one
     # process (it could give 20 fps alone: its goal is its own, not the clients').
-    hall = _hall_fps(300, [25.0] * 300, following.Moving(1.8, 25.0 * 300, 300, 1))
-    figures = report.figures + follow_report.figures + hosts_report.figures + [hall]
+    hall = _row(300, [25.0] * 300, following.Moving(1.8, 25.0 * 300, 300, 1))
+    figures = report.figures + follow_report.figures + hosts_report.figures + hall
     assert exit_status(figures, LENIENT) == 0
     impossible = {
         "min_fps": 1e9,
@@ -399,6 +424,7 @@ def test_met_bounds_give_zero_and_each_impossible_bound_gives_one(
         "max_hostile_rss_growth": -1.0,
         "min_innocent_keep": 1e9,
         "max_follow_ms": -1.0,
+        "max_hall_follow_ms": -1.0,
         "max_hosts_follow_ms": -1.0,
         "max_recovery_s": -1.0,
     }

@@ -89,6 +89,9 @@ def _add_goals(parser: argparse.ArgumentParser, bounds: Bounds) -> None:
     goals.add_argument("--min-innocent-keep", type=fraction, default=bounds.min_innocent_keep)
     goals.add_argument("--max-follow-ms", type=positive_float, default=bounds.max_follow_ms)
     goals.add_argument(
+        "--max-hall-follow-ms", type=positive_float, default=bounds.max_hall_follow_ms
+    )
+    goals.add_argument(
         "--max-hosts-follow-ms", type=positive_float, default=bounds.max_hosts_follow_ms
     )
     goals.add_argument("--max-recovery-s", type=positive_float, default=bounds.max_recovery_s)
