@@ -206,7 +206,7 @@ class FollowCast:
         self.held = 0
         #: True while a session of the process rebuilds its own body (the server's
         #: :class:`~..hardening.budget.RebuildGate`, which holds the sessions' own frames): no
-        #: frame then. A lead's rebuild in a worker of 150 followers took up to 45 ms for its 3
+        #: frame then. A lead's rebuild in a worker of 150 followers took up to 46 ms for its 3
         #: to 5 ms of CPU beside the cast's ticks, each followed by 150 writes on viser's loop;
         #: all of the hall waits for it (its followers are posed from the old body meanwhile).
         self.yield_to: Callable[[], bool] = lambda: False
