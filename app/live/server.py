@@ -116,10 +116,8 @@ class PoinsotApp:
         self._arrivals: set[asyncio.Task[None]] = set()  # pages asked for their address
         self.discarded = 0  # sessions built for a client that had left, closed unstarted
         self._connected = threading.Condition(self._lock)
-        self.budget = budget = RebuildGate()
-        # A session's own rebuild (a lead's move among them) holds the followers' frames too
-        # (the gate alone is held: the app holds the sessions).
-        self.follow.cast.yield_to = lambda: budget.rebuilding
+        self.budget = budget = RebuildGate()  # a session's rebuild holds the followers' frames
+        self.follow.cast.yield_to = lambda: budget.rebuilding  # (the gate: not the app's self)
         # Handshakes checked before viser sees them, the share tunnel off (:mod:`.hardening.guard`).
         self.server, gate = _viser(host, port, verbose, allow_origins, serving)
         self.server.gui.configure_theme(dark_mode=True, show_share_button=False, show_logo=False)
