@@ -61,6 +61,7 @@ import viser
 
 from poinsot.app.construction.construction import PoinsotScene
 from poinsot.app.construction.sampled.motion import Motion
+from poinsot.app.live.hardening.budget import HOLD_SECONDS
 from poinsot.app.live.hardening.pacing import MAX_UNACKED, Outbox, next_due
 from poinsot.app.model.elements import Element
 from poinsot.app.viser_private import (
@@ -205,11 +206,13 @@ class FollowCast:
         #: Frames not sent while a move was held (:meth:`hold`) or another session rebuilt.
         self.held = 0
         #: True while a session of the process rebuilds its own body (the server's
-        #: :class:`~..hardening.budget.RebuildGate`, which holds the sessions' own frames): no
-        #: frame then. A lead's rebuild in a worker of 150 followers took up to 46 ms for its 3
-        #: to 5 ms of CPU beside the cast's ticks, each followed by 150 writes on viser's loop;
-        #: all of the hall waits for it (its followers are posed from the old body meanwhile).
+        #: :class:`~..hardening.budget.RebuildGate`): no frame then, for at most
+        #: :data:`~..hardening.budget.HOLD_SECONDS`, as a session's own frame is held. A lead's
+        #: rebuild in a worker of 150 followers took up to 46 ms for its 3 to 5 ms of CPU
+        #: beside the cast's ticks, each followed by 150 writes on viser's loop; all of the
+        #: hall waits for it (its followers are posed from the old body meanwhile).
         self.yield_to: Callable[[], bool] = lambda: False
+        self._yielding_since: float | None = None  # the rebuild it yields to, since
         #: New bodies handed from one follower to others, and the copies handed.
         self.fits = 0
         self.fit_copies = 0
@@ -288,7 +291,7 @@ class FollowCast:
             members = list(self._members.values())
         if self._holding(members):
             return 0
-        if self.yield_to():
+        if self._yielding():
             self.held += 1
             return 0
         groups: dict[Hashable, tuple[Source, list[Member]]] = {}
@@ -310,6 +313,17 @@ class FollowCast:
                     member.shown = (key, k)
         self.encoded += encoded
         return encoded
+
+    def _yielding(self) -> bool:
+        """Whether this tick waits for a session's rebuild (:attr:`yield_to`), at most
+        :data:`HOLD_SECONDS` from the first tick it held."""
+        if not self.yield_to():
+            self._yielding_since = None
+            return False
+        now = time.monotonic()
+        if self._yielding_since is None:
+            self._yielding_since = now
+        return now - self._yielding_since < HOLD_SECONDS
 
     # -- a new body, handed from the first follower to fit it ------------------------------
     def claim_move(self, member: Member) -> Callable[[], None] | None:

@@ -20,6 +20,10 @@ import threading
 import time
 from collections.abc import Iterator
 
+#: While a session rebuilds, another's due frame is held until the rebuild ends, for at most
+#: HOLD_SECONDS [s] (the sessions' frame loops, and the followers' shared frames).
+HOLD_SECONDS = 0.05
+
 
 class RebuildGate:
     """Gives a slider move precedence over the other sessions' frames (see the module)."""

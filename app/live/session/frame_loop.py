@@ -5,7 +5,8 @@ runs the session's queued work, and draws a frame if the browser has taken the o
 that the rate is the pacer's, not the pacer's less the frames' own delays.
 
 While another session rebuilds, a due frame waits for that rebuild to end
-(:meth:`~..hardening.budget.RebuildGate.hold` wakes it) for at most :data:`HOLD_SECONDS`, so that a
+(:meth:`~..hardening.budget.RebuildGate.hold` wakes it) for at most
+:data:`~..hardening.budget.HOLD_SECONDS`, so that a
 slider move elsewhere runs alone and many students dragging sliders never freeze the others.
 """
 
@@ -15,12 +16,8 @@ import threading
 import time
 from collections.abc import Callable
 
-from poinsot.app.live.hardening.budget import RebuildGate
+from poinsot.app.live.hardening.budget import HOLD_SECONDS, RebuildGate
 from poinsot.app.live.hardening.pacing import Pacer, SessionStats, next_due
-
-#: While another session rebuilds, a due frame is held until the rebuild ends, for at most
-#: HOLD_SECONDS [s].
-HOLD_SECONDS = 0.05
 
 
 class FrameLoop:

@@ -20,10 +20,10 @@ import viser
 
 from poinsot.app.construction.sampled.batch import Frame
 from poinsot.app.lessons.support.spec import SceneSpec, Value
+from poinsot.app.live.hardening.budget import HOLD_SECONDS
 from poinsot.app.live.panel.playback import STEP_SECONDS
 from poinsot.app.live.panel.showcase import LiveShowcase
 from poinsot.app.live.session.builder import MAX_FPS, SessionOptions, compose
-from poinsot.app.live.session.frame_loop import HOLD_SECONDS
 from poinsot.app.live.session.refresh import PLOT_HZ, PLOT_MIN_FRAMES, TIME_HZ
 from poinsot.app.model.elements import Element
 from poinsot.app.model.parameters import Parameters
